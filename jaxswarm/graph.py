@@ -81,11 +81,7 @@ class Graph:
 
     def valid_edges(self) -> jax.Array:
         """bool[N, K]: edges usable now (lattice edge, open, both ends free, corners free)."""
-        has_nbr = self.nbr >= 0
-        target_free = jnp.take(self.free, jnp.where(has_nbr, self.nbr, 0), axis=-1)
-        corner_free = jnp.take(self.free, jnp.where(self.corner >= 0, self.corner, 0), axis=-1)
-        corners_ok = jnp.all((self.corner < 0) | corner_free, axis=-1)
-        return has_nbr & self.open & self.free[..., :, None] & target_free & corners_ok
+        return _valid_edges(self)
 
     def to_dense(self) -> np.ndarray:
         """f64[N, N] weight matrix of the valid edges: 0 on the diagonal, inf where no edge.
@@ -103,6 +99,15 @@ class Graph:
                       np.asarray(self.cost, dtype=np.float64)[rows, slots])
         np.fill_diagonal(dense, 0.0)
         return dense
+
+
+@jax.jit
+def _valid_edges(graph: Graph) -> jax.Array:
+    has_nbr = graph.nbr >= 0
+    target_free = jnp.take(graph.free, jnp.where(has_nbr, graph.nbr, 0), axis=-1)
+    corner_free = jnp.take(graph.free, jnp.where(graph.corner >= 0, graph.corner, 0), axis=-1)
+    corners_ok = jnp.all((graph.corner < 0) | corner_free, axis=-1)
+    return has_nbr & graph.open & graph.free[..., :, None] & target_free & corners_ok
 
 
 jax.tree_util.register_dataclass(

@@ -92,7 +92,7 @@ def as_node(graph: Graph, point, *, name: str = "node", require_free: bool = Tru
             if len(matches) != 1:
                 raise ValueError(f"{name} {tuple(point)} names {len(matches)} nodes; pass an index")
             node = int(matches[0])
-    if require_free and not bool(graph.free[node]):
+    if require_free and not np.asarray(graph.free)[node]:
         raise ValueError(f"{name} {point!r} is blocked (an obstacle)")
     return node
 
@@ -113,6 +113,7 @@ def pad(nodes, length: int) -> np.ndarray:
     return out
 
 
+@jax.jit
 def step_slots(graph: Graph, path) -> jax.Array:
     """i32[L-1]: for each step ``path[t] -> path[t+1]`` the neighbour slot it uses.
 
@@ -125,6 +126,7 @@ def step_slots(graph: Graph, path) -> jax.Array:
     return jnp.where(match.any(axis=1), jnp.argmax(match, axis=1), NO_NODE)
 
 
+@jax.jit
 def path_length(graph: Graph, path) -> jax.Array:
     """f32[]: sum of the edge lengths along a padded path; inf if a step is not an edge.
 
@@ -139,6 +141,7 @@ def path_length(graph: Graph, path) -> jax.Array:
     return jnp.where(broken, jnp.inf, jnp.sum(jnp.where(is_step, step_cost, 0.0)))
 
 
+@jax.jit
 def is_valid_path(graph: Graph, path, start=None, goal=None) -> jax.Array:
     """bool[]: every step is a valid edge of the current map (see ``Graph.valid_edges``).
 

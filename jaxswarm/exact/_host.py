@@ -90,8 +90,10 @@ def heuristic(kind: str, host: HostGraph, target: int):
     if kind == "euclidean":
         return lambda v: math.hypot(xs[v] - tx, ys[v] - ty)
     if kind == "octile":
-        def octile(v):
+        diagonal_extra = SQRT2 - 1.0
+
+        def octile(v):  # max(dx, dy) + (sqrt 2 - 1) min(dx, dy), without call overhead
             dx, dy = abs(xs[v] - tx), abs(ys[v] - ty)
-            return max(dx, dy) + (SQRT2 - 1.0) * min(dx, dy)
+            return dx + diagonal_extra * dy if dx > dy else dy + diagonal_extra * dx
         return octile
     raise ValueError(f"unknown heuristic {kind!r}: choose 'octile', 'euclidean' or 'zero'")

@@ -16,6 +16,7 @@ SWEEPS_PER_CHECK = 4
 """Relaxation sweeps between two convergence tests (amortises the loop's overhead)."""
 
 
+@jax.jit
 def distance_field(graph: Graph, goal) -> jax.Array:
     """f32[N]: distance from every node to ``goal``; inf where the goal cannot be reached.
 
@@ -51,6 +52,7 @@ def distance_field(graph: Graph, goal) -> jax.Array:
     return d
 
 
+@jax.jit
 def optimum(graph: Graph, start, goal) -> jax.Array:
     """f32[]: shortest start-goal distance (inf if unreachable); start and goal are node indices."""
     return distance_field(graph, goal)[start]

@@ -1,0 +1,114 @@
+"""The ``jaxswarm`` command.
+
+``jaxswarm demo`` plans on one of the RFD paper's maps (or a Moving AI ``.map`` file) with the
+exact planners, prints a comparison table and writes a figure of the paths.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+from pathlib import Path
+
+from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
+from jaxswarm.maps.movingai import load_map
+from jaxswarm.maps.paper import PAPER_MAPS, paper_map
+from jaxswarm.paths import as_node
+
+EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``jaxswarm`` command; returns the exit status."""
+    parser = argparse.ArgumentParser(prog="jaxswarm", description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+    demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
+    demo.add_argument("--map", default="maze100",
+                      help=f"a paper map ({', '.join(PAPER_MAPS)}) or a Moving AI .map file")
+    demo.add_argument("--start", type=_point, help="x,y (required with a .map file)")
+    demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
+    demo.add_argument("--repeats", type=int, default=5, help="runs per planner (median time)")
+    demo.add_argument("--out", type=Path, default=Path("out/demo.png"), help="figure path")
+    args = parser.parse_args(argv)
+    try:
+        return run_demo(args)
+    except ValueError as error:
+        parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Plan with every exact planner, print the table and write the figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot as plt
+
+    from jaxswarm.plot import plot_solutions
+
+    name, graph, start, goal = _load(args)
+    if args.repeats < 1:
+        raise ValueError(f"--repeats must be at least 1, got {args.repeats}")
+    height, width = graph.shape
+    print(f"map {name}: {width}x{height}, {int(graph.free.sum())} free cells, "
+          f"start {start} -> goal {goal}")
+    rows, solutions = [], {}
+    for label, planner in EXACT_PLANNERS.items():
+        runs = [planner(graph, start, goal) for _ in range(args.repeats)]
+        solution = solutions[label] = runs[0]
+        milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
+        rows.append((label, solution.cost, solution.stats.expanded, solution.stats.generated,
+                     f"{milliseconds:.2f}"))
+    reference = solutions["Dijkstra"].cost
+    print(_table(("planner", "length", "gap", "expanded", "generated", "time [ms]"),
+                 [(label, _fmt(cost), _gap(cost, reference), *rest)
+                  for label, cost, *rest in rows]))
+    field = float(optimum(graph, as_node(graph, start), as_node(graph, goal)))
+    print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
+    fig = plot_solutions(graph, solutions, start=start, goal=goal, path=args.out,
+                         title=f"{name}: exact planners")
+    plt.close(fig)
+    print(f"figure written to {args.out}")
+    return 0
+
+
+def _load(args):
+    if args.map in PAPER_MAPS:
+        chosen = paper_map(args.map)
+        return args.map, chosen.graph(), args.start or chosen.start, args.goal or chosen.goal
+    if args.map.endswith(".map"):
+        if args.start is None or args.goal is None:
+            raise ValueError("--start and --goal are required with a .map file")
+        return Path(args.map).stem, load_map(args.map), args.start, args.goal
+    raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)} or a .map file, "
+                     f"got {args.map!r}")
+
+
+def _point(text: str) -> tuple[int, int]:
+    try:
+        x, y = (int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected x,y integers, got {text!r}") from None
+    return x, y
+
+
+def _fmt(value: float) -> str:
+    return f"{float(value):.2f}" if value != float("inf") else "no path"
+
+
+def _gap(cost: float, reference: float) -> str:
+    if reference == float("inf") or cost == float("inf"):
+        return "-"
+    return f"{(float(cost) - reference) / reference:+.2%}"
+
+
+def _table(header: tuple[str, ...], rows: list[tuple]) -> str:
+    cells = [tuple(str(c) for c in header)] + [tuple(str(c) for c in row) for row in rows]
+    widths = [max(len(row[i]) for row in cells) for i in range(len(header))]
+    lines = ["  ".join(c.ljust(w) if i == 0 else c.rjust(w) for i, (c, w) in
+                       enumerate(zip(row, widths))) for row in cells]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,16 @@
+import os
+from pathlib import Path
+
+import pytest
+
+SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
+MOVINGAI = SHARED / "benchdata" / "movingai"
+
+
+@pytest.fixture(scope="session")
+def movingai_dir():
+    if not MOVINGAI.is_dir():
+        if os.environ.get("CI"):
+            pytest.fail(f"Moving AI data not found at {MOVINGAI} (CI must have ../shared)")
+        pytest.skip(f"Moving AI data not found at {MOVINGAI}")
+    return MOVINGAI

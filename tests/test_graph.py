@@ -1,0 +1,116 @@
+import math
+
+import numpy as np
+import pytest
+import scipy.sparse.csgraph as csgraph
+
+from jaxswarm.graph import DIRECTIONS, OPPOSITE, dense_graph, grid_graph, path_map_graph
+from oracle import grid_adjacency
+
+
+def edges_of(graph):
+    """{(u, v): length} of the valid edges, via to_dense()."""
+    dense = graph.to_dense()
+    rows, cols = np.nonzero(np.isfinite(dense) & (dense > 0))
+    return {(int(u), int(v)): float(dense[u, v]) for u, v in zip(rows, cols)}
+
+
+def oracle_edges(obstacles, **options):
+    width = obstacles.shape[1]
+    adjacency = grid_adjacency(obstacles.tolist(), **options)
+    return {(y * width + x, v[1] * width + v[0]): w
+            for (x, y), out in adjacency.items() for v, w in out}
+
+
+@pytest.mark.parametrize("connectivity", [4, 8])
+@pytest.mark.parametrize("corner_cutting", [False, True])
+def test_grid_edges_match_independent_rules(connectivity, corner_cutting):
+    obstacles = np.random.default_rng(3).random((7, 9)) < 0.35
+    graph = grid_graph(obstacles, connectivity=connectivity, corner_cutting=corner_cutting)
+    assert graph.max_degree == connectivity and graph.num_nodes == 63 and graph.shape == (7, 9)
+    ours = edges_of(graph)
+    theirs = oracle_edges(obstacles, connectivity=connectivity, corner_cutting=corner_cutting)
+    assert ours.keys() == theirs.keys()
+    for edge, length in theirs.items():
+        assert ours[edge] == pytest.approx(length, rel=1e-6)
+
+
+def test_no_corner_cutting_blocks_diagonal_past_one_obstacle():
+    graph = grid_graph(np.array([[0, 1], [0, 0]]))
+    assert not np.isfinite(graph.to_dense()[0, 3])  # (0,0) -> (1,1) squeezes past (1,0)
+    cut = grid_graph(np.array([[0, 1], [0, 0]]), corner_cutting=True)
+    assert cut.to_dense()[0, 3] == pytest.approx(math.sqrt(2))
+
+
+def test_directions_and_reverse_slots_are_consistent():
+    graph = grid_graph(np.zeros((4, 5), bool))
+    nbr, rev, xy = map(np.asarray, (graph.nbr, graph.rev, graph.xy))
+    for i in range(graph.num_nodes):
+        for k in range(8):
+            j = nbr[i, k]
+            if j < 0:
+                assert rev[i, k] == -1
+                continue
+            np.testing.assert_array_equal(xy[j] - xy[i], DIRECTIONS[k])
+            assert rev[i, k] == OPPOSITE[k] and nbr[j, rev[i, k]] == i
+
+
+def test_path_map_walls_close_both_ways_unless_directed():
+    conn = np.ones((2, 3, 8), np.uint8)
+    conn[0, 0, 0] = 0  # (0,0) says: no move east
+    undirected = edges_of(path_map_graph(conn))
+    assert (0, 1) not in undirected and (1, 0) not in undirected
+    directed = edges_of(path_map_graph(conn, directed=True))
+    assert (0, 1) not in directed and (1, 0) in directed
+    # No corner rule on path maps: every lattice diagonal is present.
+    assert (0, 4) in undirected and undirected[(0, 4)] == pytest.approx(math.sqrt(2))
+
+
+def test_dense_graph_round_trip_and_shortest_paths_match_scipy():
+    rng = np.random.default_rng(0)
+    weights = np.where(rng.random((12, 12)) < 0.3, rng.uniform(0.5, 3.0, (12, 12)), np.inf)
+    graph = dense_graph(weights)
+    dense = graph.to_dense()
+    expected = weights.copy()
+    np.fill_diagonal(expected, 0.0)
+    np.testing.assert_allclose(dense, expected, rtol=1e-6)
+    ours = csgraph.shortest_path(np.where(np.isfinite(dense), dense, 0), directed=True)
+    theirs = csgraph.shortest_path(np.where(np.isfinite(weights), weights, 0), directed=True)
+    np.testing.assert_allclose(ours, theirs, rtol=1e-6)
+
+
+def test_graph_is_a_pytree_with_static_shape():
+    import jax
+
+    graph = grid_graph(np.zeros((3, 4), bool))
+    leaves, treedef = jax.tree_util.tree_flatten(graph)
+    assert len(leaves) == 7
+    rebuilt = jax.tree_util.tree_unflatten(treedef, leaves)
+    assert rebuilt.shape == (3, 4)
+    count = jax.jit(lambda g: g.valid_edges().sum())(graph)
+    assert int(count) == len(edges_of(graph))
+
+
+@pytest.mark.parametrize("bad, message", [
+    (np.zeros((0, 3)), "non-empty"),
+    (np.zeros(5), "2-D"),
+    (np.full((2, 2), 2), "0/1"),
+])
+def test_grid_graph_rejects_bad_input(bad, message):
+    with pytest.raises(ValueError, match=message):
+        grid_graph(bad)
+
+
+def test_bad_connectivity_and_weights_are_named():
+    with pytest.raises(ValueError, match="connectivity"):
+        grid_graph(np.zeros((2, 2)), connectivity=6)
+    with pytest.raises(ValueError, match="NaN"):
+        dense_graph(np.array([[0, np.nan], [1, 0]]))
+    with pytest.raises(ValueError, match="non-negative"):
+        dense_graph(np.array([[0, -1.0], [1, 0]]))
+    with pytest.raises(ValueError, match="square"):
+        dense_graph(np.ones((2, 3)))
+    with pytest.raises(ValueError, match=r"\[H, W, 8\]"):
+        path_map_graph(np.ones((2, 2, 4)))
+    with pytest.raises(ValueError, match="xy"):
+        dense_graph(np.ones((3, 3)), xy=np.zeros((2, 2)))

@@ -1,0 +1,112 @@
+import math
+
+import numpy as np
+import pytest
+
+from conftest import MOVINGAI
+from jaxswarm.exact import astar, bidirectional_astar, dijkstra
+from jaxswarm.maps.movingai import MovingAIFormatError, load_map, load_scenarios, read_map
+
+PLANNERS = [dijkstra, astar, bidirectional_astar]
+DEFAULT_SAMPLE = 8  # rows per scenario file in the default run; the slow test takes them all
+
+
+def scenario_files(root):
+    files = sorted(root.glob("*/*.scen"))
+    assert len(files) == 28, "SOURCES.md lists 28 scenario files"
+    return files
+
+
+def map_of(scen_path, scenarios):
+    return load_map(scen_path.parent / scenarios[0].map_name.split("/")[-1])
+
+
+def check_rows(scen_path, every):
+    scenarios = load_scenarios(scen_path)
+    graph = map_of(scen_path, scenarios)
+    checked = 0
+    for row in scenarios[::every]:
+        for planner in PLANNERS:
+            solution = planner(graph, row.start, row.goal)
+            if not row.reachable:
+                assert not solution.found, (scen_path.name, row.line, planner.__name__)
+                continue
+            error = abs(solution.cost - row.optimal_length) / max(row.optimal_length, 1.0)
+            assert error < 1e-4, (scen_path.name, row.line, planner.__name__, solution.cost)
+            checked += 1
+    return checked
+
+
+def test_sample_of_every_scenario_file_has_published_optimum(movingai_dir):
+    for scen in scenario_files(movingai_dir):
+        rows = len(load_scenarios(scen))
+        assert check_rows(scen, every=max(1, rows // DEFAULT_SAMPLE)) > 0
+
+
+SCENARIO_FILES = sorted(p.relative_to(MOVINGAI).as_posix() for p in MOVINGAI.glob("*/*.scen"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SCENARIO_FILES)
+def test_every_scenario_row_has_published_optimum(movingai_dir, name):
+    rows = load_scenarios(movingai_dir / name)
+    reachable = sum(row.reachable for row in rows)
+    assert check_rows(movingai_dir / name, every=1) == 3 * reachable
+
+
+def test_loader_reads_declared_sizes_and_gppc_no_path_rows(movingai_dir):
+    obstacles = read_map(movingai_dir / "dao" / "arena.map")
+    assert obstacles.shape == (49, 49) and obstacles.dtype == bool
+    rows = load_scenarios(movingai_dir / "gppc" / "rmtst01.map.scen")
+    assert len(rows) == 470
+    unreachable = [row.line for row in rows if not row.reachable]
+    assert unreachable == [6, 11]  # SOURCES.md: the two disconnected queries
+    graph = load_map(movingai_dir / "gppc" / "rmtst01.map")
+    assert graph.shape == (rows[0].height, rows[0].width)
+
+
+def write(tmp_path, text, name="bad.map"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+GOOD = "type octile\nheight 2\nwidth 3\nmap\n.@.\nT..\n"
+
+
+def test_good_map_parses_terrain(tmp_path):
+    np.testing.assert_array_equal(read_map(write(tmp_path, GOOD)), [[0, 1, 0], [1, 0, 0]])
+
+
+@pytest.mark.parametrize("text, line, problem", [
+    ("type octile\nheight 2\nwidth 3\nmap\n.@.\n", 6, "expected 2 map rows"),
+    ("type octile\nheight 2\nwidth 3\nmap\n.@.\n..\n", 6, "row has 2 cells"),
+    ("type octile\nheight 2\nwidth 3\nmap\n.@.\n.x.\n", 6, "unknown terrain 'x'"),
+    ("type octile\nheight two\nwidth 3\nmap\n", 2, "height must be an integer"),
+    ("type octile\nheight 2\nmap\n", 3, "expected 'width"),
+    ("type hex\nheight 1\nwidth 1\nmap\n.\n", 1, "only 'type octile'"),
+    ("type octile\nheight 0\nwidth 3\nmap\n", 2, "height must be positive"),
+])
+def test_malformed_map_names_line(tmp_path, text, line, problem):
+    with pytest.raises(MovingAIFormatError, match=f"line {line}: {problem}") as error:
+        read_map(write(tmp_path, text))
+    assert error.value.line == line and isinstance(error.value, ValueError)
+
+
+@pytest.mark.parametrize("text, line, problem", [
+    ("1\tm.map\t3\t2\t0\t0\t2\t1\t2.4\n", 1, "expected a .version"),
+    ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\n", 2, "expected 9 fields"),
+    ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\t2.4\n1\tm.map\t3\t2\tx\t0\t2\t1\t2.4\n", 3, "bad number"),
+    ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\t-1\n", 2, "bad optimal length"),
+])
+def test_malformed_scenarios_name_line(tmp_path, text, line, problem):
+    with pytest.raises(MovingAIFormatError, match=f"line {line}: {problem}"):
+        load_scenarios(write(tmp_path, text, "bad.scen"))
+
+
+def test_scenario_fields(tmp_path):
+    rows = load_scenarios(write(tmp_path, "version 1\n3\tm.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
+                                          "0\tm.map\t3\t2\t0\t0\t2\t0\t0\n", "ok.scen"))
+    assert rows[0].start == (0, 0) and rows[0].goal == (2, 1) and rows[0].bucket == 3
+    assert rows[0].optimal_length == pytest.approx(1 + math.sqrt(2)) and rows[0].line == 2
+    assert not rows[1].reachable

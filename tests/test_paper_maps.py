@@ -1,0 +1,114 @@
+"""The RFD paper's maps (jaxswarm.maps.paper), checked against scipy's Dijkstra as an oracle."""
+import functools
+import math
+import re
+
+import numpy as np
+import pytest
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+
+from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, PaperMap, paper_map
+
+# The paper's start and goal cells, (x, y), written out again from its section 3.
+PAPER_ENDPOINTS = {
+    "maze20": ((0, 0), (19, 19)), "mosaic20": ((1, 9), (18, 9)), "alley20": ((3, 9), (16, 9)),
+    "maze50": ((0, 0), (49, 49)), "mosaic50": ((2, 24), (46, 24)), "alley50": ((9, 24), (38, 24)),
+    "maze100": ((0, 0), (99, 99)), "mosaic100": ((2, 54), (97, 54)),
+    "alley100": ((23, 49), (75, 49)),
+}
+
+
+def octile_graph(obstacles):
+    """Sparse graph over cells y * W + x: 8-connected moves between free cells, orthogonal cost 1,
+    diagonal cost sqrt(2), no corner cutting (a diagonal needs both orthogonal neighbours free).
+    Each undirected edge is stored once; use it with ``directed=False``."""
+    height, width = obstacles.shape
+
+    def free(x, y):
+        return 0 <= x < width and 0 <= y < height and not obstacles[y, x]
+
+    sources, targets, lengths = [], [], []
+    for y in range(height):
+        for x in range(width):
+            if not free(x, y):
+                continue
+            for dx, dy in ((1, 0), (0, 1), (1, 1), (-1, 1)):
+                if not free(x + dx, y + dy):
+                    continue
+                if dx and dy and not (free(x + dx, y) and free(x, y + dy)):
+                    continue
+                sources.append(y * width + x)
+                targets.append((y + dy) * width + x + dx)
+                lengths.append(math.sqrt(2.0) if dx and dy else 1.0)
+    n = height * width
+    return csr_matrix((lengths, (sources, targets)), shape=(n, n))
+
+
+@functools.lru_cache(maxsize=None)
+def optimum(name):
+    """Shortest start-goal length on map ``name`` (inf if the goal is unreachable)."""
+    m = paper_map(name)
+    width = m.obstacles.shape[1]
+    distances = dijkstra(octile_graph(m.obstacles), directed=False,
+                         indices=m.start[1] * width + m.start[0])
+    return float(distances[m.goal[1] * width + m.goal[0]])
+
+
+def straight_line(m: PaperMap):
+    return math.dist(m.start, m.goal)
+
+
+def test_map_list_matches_optima():
+    assert len(PAPER_MAPS) == 9
+    assert set(PAPER_MAPS) == set(PAPER_OPTIMA) == set(PAPER_ENDPOINTS)
+    assert PAPER_OPTIMA["maze100"] == 510.56
+
+
+@pytest.mark.parametrize("name", PAPER_MAPS)
+def test_shape_and_endpoints(name):
+    m = paper_map(name)
+    size = int(re.search(r"\d+$", name).group())
+    assert m.name == name
+    assert m.obstacles.shape == (size, size) and m.obstacles.dtype == bool
+    assert (m.start, m.goal) == PAPER_ENDPOINTS[name]
+    for x, y in (m.start, m.goal):
+        assert 0 <= x < size and 0 <= y < size
+        assert not m.obstacles[y, x]
+
+
+@pytest.mark.parametrize("name", PAPER_MAPS)
+def test_optimum_near_paper(name):
+    length = optimum(name)
+    assert math.isfinite(length), "goal unreachable"
+    assert abs(length / PAPER_OPTIMA[name] - 1.0) <= 0.25, (length, PAPER_OPTIMA[name])
+
+
+@pytest.mark.parametrize("name", PAPER_MAPS)
+def test_paths_detour(name):
+    straight = straight_line(paper_map(name))
+    if name.startswith(("maze", "alley")):
+        assert optimum(name) > 1.5 * straight
+    else:  # mosaic: the straight line is blocked here and there
+        assert optimum(name) > straight + 1.0
+
+
+@pytest.mark.parametrize("name", PAPER_MAPS)
+def test_many_obstacles(name):
+    assert paper_map(name).obstacles.mean() >= 0.15
+
+
+@pytest.mark.parametrize("name", PAPER_MAPS)
+def test_deterministic_and_read_only(name):
+    a, b = paper_map(name), paper_map(name)
+    np.testing.assert_array_equal(a.obstacles, b.obstacles)
+    assert (a.start, a.goal) == (b.start, b.goal)
+    assert not a.obstacles.flags.writeable
+    with pytest.raises(ValueError):
+        a.obstacles[a.start[1], a.start[0]] = True
+
+
+@pytest.mark.parametrize("name", ["maze30", "Maze20", "", "alley"])
+def test_unknown_name(name):
+    with pytest.raises(ValueError, match="maze20"):
+        paper_map(name)
