@@ -1,21 +1,27 @@
 """The ``jaxswarm`` command.
 
 ``jaxswarm demo`` plans on one of the RFD paper's maps (or a Moving AI ``.map`` file) with the
-exact planners, prints a comparison table and writes a figure of the paths.
+exact planners and the swarm planners, prints a comparison table (length, optimality gap, work,
+time) and writes figures of the paths and of the swarms' memory and convergence.
 """
 from __future__ import annotations
 
 import argparse
 import statistics
 import sys
+import time
 from pathlib import Path
+
+import jax
 
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.paths import as_node
+from jaxswarm.swarm import make, make_task, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
+SWARM_PLANNERS = {"RFD*": "rfd_star"}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -23,11 +29,14 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="jaxswarm", description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
-    demo.add_argument("--map", default="maze100",
+    demo.add_argument("--map", default="maze50",
                       help=f"a paper map ({', '.join(PAPER_MAPS)}) or a Moving AI .map file")
     demo.add_argument("--start", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--repeats", type=int, default=5, help="runs per planner (median time)")
+    demo.add_argument("--seed", type=int, default=0, help="PRNG seed of the swarm planners")
+    demo.add_argument("--drops", type=int, default=256, help="agents per swarm iteration")
+    demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
     demo.add_argument("--out", type=Path, default=Path("out/demo.png"), help="figure path")
     args = parser.parse_args(argv)
     try:
@@ -43,7 +52,7 @@ def run_demo(args: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     from matplotlib import pyplot as plt
 
-    from jaxswarm.plot import plot_solutions
+    from jaxswarm.plot import plot_solutions, plot_swarm_run
 
     name, graph, start, goal = _load(args)
     if args.repeats < 1:
@@ -51,24 +60,54 @@ def run_demo(args: argparse.Namespace) -> int:
     height, width = graph.shape
     print(f"map {name}: {width}x{height}, {int(graph.free.sum())} free cells, "
           f"start {start} -> goal {goal}")
-    rows, solutions = [], {}
+    rows, solutions, traces = [], {}, {}
     for label, planner in EXACT_PLANNERS.items():
         runs = [planner(graph, start, goal) for _ in range(args.repeats)]
         solution = solutions[label] = runs[0]
         milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
-        rows.append((label, solution.cost, solution.stats.expanded, solution.stats.generated,
-                     f"{milliseconds:.2f}"))
+        rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
+    for label, name_in_registry in SWARM_PLANNERS.items():
+        solution, trace, state, milliseconds = _run_swarm(name_in_registry, graph, start, goal,
+                                                          args)
+        solutions[label], traces[label] = solution, (trace, state)
+        rows.append((label, solution.cost, "-", int(trace.iterations), f"{milliseconds:.2f}"))
     reference = solutions["Dijkstra"].cost
-    print(_table(("planner", "length", "gap", "expanded", "generated", "time [ms]"),
+    print(_table(("planner", "length", "gap", "expanded", "iterations", "time [ms]"),
                  [(label, _fmt(cost), _gap(cost, reference), *rest)
                   for label, cost, *rest in rows]))
     field = float(optimum(graph, as_node(graph, start), as_node(graph, goal)))
     print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
     fig = plot_solutions(graph, solutions, start=start, goal=goal, path=args.out,
-                         title=f"{name}: exact planners")
+                         title=f"{name}: exact and swarm planners")
     plt.close(fig)
     print(f"figure written to {args.out}")
+    for label, (trace, state) in traces.items():
+        out = args.out.with_name(f"{args.out.stem}_{SWARM_PLANNERS[label]}{args.out.suffix}")
+        fig = plot_swarm_run(graph, state.altitude, solutions[label], trace, start=start,
+                             goal=goal, optimum=reference, field_label="altitude",
+                             title=f"{name}: {label}", path=out)
+        plt.close(fig)
+        print(f"figure written to {out}")
     return 0
+
+
+def _run_swarm(registry_name: str, graph, start, goal, args):
+    """Run one swarm planner: compile once, then the median time of ``args.repeats`` runs."""
+    swarm = make(registry_name, num_agents=args.drops)
+    task = make_task(graph, start, goal)
+    key = jax.random.key(args.seed)
+
+    def once():
+        return jax.block_until_ready(run(swarm, key, graph, task, swarm.default_params,
+                                         iterations=args.iterations, patience=30))
+
+    once()  # compile
+    times = []
+    for _ in range(args.repeats):
+        began = time.perf_counter()
+        state, trace = once()
+        times.append(time.perf_counter() - began)
+    return swarm.best(state), trace, state, statistics.median(times) * 1e3
 
 
 def _load(args):

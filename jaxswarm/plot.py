@@ -187,6 +187,74 @@ def plot_solutions(graph: Graph, solutions: Mapping[str, Solution], *, start, go
     return fig
 
 
+def draw_trace(ax: Axes, trace, *, optimum=None, label=None) -> list[Line2D]:
+    """Draw a swarm run's convergence: best cost so far per iteration (solid), each iteration's
+    best (dots), the optimum as a dashed line, and the share of agents that arrived (right axis).
+
+    Args:
+      ax: the axes to draw into.
+      trace: a :class:`jaxswarm.swarm.Trace` of one run (arrays f32[T]; NaN after the stop).
+      optimum: the exact optimum (e.g. Dijkstra's cost), drawn as a horizontal line if given.
+      label: legend label of the best-so-far line (default "best so far").
+
+    Returns:
+      The lines drawn on ``ax``: best so far, iteration best, and the optimum if given.
+    """
+    best = np.asarray(trace.best_cost, dtype=np.float64)
+    ran = int(trace.iterations)
+    iterations = np.arange(1, ran + 1)
+    (best_line,) = ax.plot(iterations, _nan_if_inf(best[:ran]), lw=2,
+                           label=label or "best so far")
+    (each_line,) = ax.plot(iterations, _nan_if_inf(np.asarray(trace.iteration_cost)[:ran]), ".",
+                           ms=4, alpha=0.6, label="iteration best")
+    lines = [best_line, each_line]
+    if optimum is not None:
+        lines.append(ax.axhline(float(optimum), ls="--", color="k", lw=1, label="optimum"))
+    ax.set_xlabel("iteration")
+    ax.set_ylabel("path length")
+    share = ax.twinx()
+    share.fill_between(iterations, np.asarray(trace.arrived)[:ran], step="mid", alpha=0.15,
+                       color="tab:green")
+    share.set_ylim(0, 1)
+    share.set_ylabel("share of agents that arrived", color="tab:green")
+    ax.legend(loc="upper right", frameon=False)
+    return lines
+
+
+def plot_swarm_run(graph: Graph, field, solution: Solution, trace, *, start, goal, optimum=None,
+                   field_label=None, title=None, path=None) -> Figure:
+    """Two panels of one swarm run: its memory (altitude or pheromone per node, f[N]) as a heat
+    map with the best path over it, and its convergence trace (see :func:`draw_trace`).
+
+    Args:
+      graph: a grid map.
+      field: f[N] the swarm's per-node memory at the end of the run.
+      solution: the run's best Solution.
+      trace: the run's :class:`jaxswarm.swarm.Trace`.
+      start, goal: node indices or (x, y).
+      optimum: the exact optimum, drawn on the trace.
+      field_label: colorbar label (e.g. "altitude").
+      title: figure title.
+      path: optional PNG file to write (atomically, see :func:`save_png`).
+
+    Returns:
+      The figure (close it with ``plt.close(fig)``).
+    """
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.5))
+    draw_field(left, graph, field, label=field_label)
+    _draw_walls(left, graph)
+    label = f"best ({float(solution.cost):.2f})" if bool(solution.found) else "best (no path)"
+    draw_paths(left, graph, [solution], [label], colors=["tab:red"])
+    _draw_endpoints(left, graph, start, goal)
+    left.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncols=3, frameon=False)
+    draw_trace(right, trace, optimum=optimum)
+    if title is not None:
+        fig.suptitle(title)
+    if path is not None:
+        save_png(fig, path)
+    return fig
+
+
 def save_png(fig: Figure, path) -> None:
     """Save ``fig`` as a PNG (dpi 120, tight bounding box), atomically.
 
@@ -208,6 +276,11 @@ def save_png(fig: Figure, path) -> None:
     except BaseException:
         os.unlink(tmp)
         raise
+
+
+def _nan_if_inf(values: np.ndarray) -> np.ndarray:
+    """Costs to plot: inf (nothing arrived) becomes a gap."""
+    return np.where(np.isfinite(values), values, np.nan)
 
 
 def _grid_image_args(graph: Graph) -> dict:

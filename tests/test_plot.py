@@ -269,3 +269,44 @@ def test_save_png_interrupted_leaves_old_file_and_no_temporary(tmp_path, monkeyp
         plot.save_png(fig, target)
     assert target.read_bytes() == b"old"
     assert os.listdir(tmp_path) == ["figure.png"]
+
+
+def test_draw_trace_plots_the_run_and_the_optimum():
+    import jax.numpy as jnp
+
+    from jaxswarm.plot import draw_trace
+    from jaxswarm.swarm import Trace
+
+    nan = float("nan")
+    trace = Trace(best_cost=jnp.array([jnp.inf, 12.0, 10.0, nan]),
+                  iteration_cost=jnp.array([jnp.inf, 12.0, 10.5, nan]),
+                  arrived=jnp.array([0.0, 0.2, 0.5, nan]), iterations=jnp.int32(3))
+    fig, ax = plt.subplots()
+    best, each, optimum = draw_trace(ax, trace, optimum=9.5)
+    np.testing.assert_array_equal(best.get_xdata(), [1, 2, 3])
+    np.testing.assert_array_equal(best.get_ydata(), [np.nan, 12.0, 10.0])  # inf: a gap
+    np.testing.assert_array_equal(each.get_ydata(), [np.nan, 12.0, 10.5])
+    assert optimum.get_ydata()[0] == 9.5
+    plt.close(fig)
+
+
+def test_plot_swarm_run_writes_two_panels(tmp_path):
+    import jax
+
+    from jaxswarm.plot import plot_swarm_run
+    from jaxswarm.swarm import make, make_task, run
+
+    graph = grid_graph(np.zeros((6, 6), bool))
+    task = make_task(graph, (0, 0), (5, 5))
+    swarm = make("rfd_star", num_agents=8)
+    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params, iterations=3)
+    out = tmp_path / "run.png"
+    fig = plot_swarm_run(graph, state.altitude, swarm.best(state), trace, start=(0, 0),
+                         goal=(5, 5), optimum=5 * np.sqrt(2), field_label="altitude", path=out)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    image = fig.axes[0].get_images()[0]
+    np.testing.assert_allclose(image.get_array().filled(np.nan).ravel(), state.altitude, rtol=1e-6)
+    trace_axes = [ax for ax in fig.axes if ax.get_xlabel() == "iteration"]
+    assert len(trace_axes) == 1
+    assert trace_axes[0].get_lines()[0].get_ydata()[-1] == float(swarm.best(state).cost)
+    plt.close(fig)

@@ -1,0 +1,67 @@
+"""Wall time of RFD* to solve each paper map, beside the RFD paper's Table 1.
+
+Each map is solved by RFD* once per seed (``--seeds``, default 20): at most 100 iterations, and a
+run stops after ``--patience`` iterations without improvement (default 30) or when every drop
+follows the same path. Runs are jitted once per map (compile excluded) and timed one by one; the
+script prints the median wall time per run next to the paper's RFD* time (C#, Intel i7-3770, one
+drop at a time), the speed-up, and how many seeds reached the optimum (relative gap < 1e-4).
+
+Run from the repository root::
+
+    python benchmarks/rfd.py
+    python benchmarks/rfd.py --maps mosaic100,alley100,maze100 --seeds 5
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import os
+import platform
+import statistics
+from pathlib import Path
+
+import jax
+
+from jaxswarm.maps.paper import PAPER_MAPS
+
+PAPER_RFD_STAR_MS = {
+    "mosaic20": 59.548, "alley20": 103.421, "maze20": 84.211,
+    "mosaic50": 268.349, "alley50": 291.77, "maze50": 337.529,
+    "mosaic100": 4172.388, "alley100": 5934.1, "maze100": 5108.49,
+}
+"""The paper's Table 1, RFD* computation time [ms], static environment."""
+
+
+def _rfd_static():
+    path = Path(__file__).resolve().parents[1] / "sweeps" / "rfd_static.py"
+    spec = importlib.util.spec_from_file_location("rfd_static", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--maps", default=",".join(PAPER_MAPS))
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--patience", type=int, default=30)
+    parser.add_argument("--agents", type=int, default=256)
+    args = parser.parse_args(argv)
+    solve_map = _rfd_static().solve_map
+    print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
+          f"({jax.default_backend()})")
+    print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
+          f"{'mean iterations':>16}")
+    for name in args.maps.split(","):
+        rows = solve_map(name, "rfd_star", args.seeds, iterations=100, patience=args.patience,
+                         num_agents=args.agents)
+        ours = 1e3 * statistics.median(r["seconds"] for r in rows)
+        print(f"{name:10} {PAPER_RFD_STAR_MS[name]:>9.0f} {ours:>9.0f} "
+              f"{PAPER_RFD_STAR_MS[name] / ours:>8.1f}x "
+              f"{sum(r['success'] for r in rows):>5}/{len(rows):<2} "
+              f"{statistics.mean(r['iterations'] for r in rows):>16.1f}", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,210 @@
+"""The swarm protocol, the run loop with its stop conditions, and the registry of swarms.
+
+A swarm is a bundle of pure functions built by a factory that closes over a static, hashable
+``Config`` (sizes and switches); the numbers a sweep varies live in a traced ``Params`` pytree; the
+memory that persists between iterations (altitudes, pheromone) lives in a pytree ``State``::
+
+    swarm = jaxswarm.swarm.make("rfd_star", num_agents=256)
+    task = make_task(graph, start=(0, 0), goal=(19, 19))
+    state, trace = run(swarm, key, graph, task, swarm.default_params, iterations=100)
+    swarm.best(state)  # Solution(path, cost, found)
+
+``run`` is jitted (the swarm and the iteration budget are static), so it vmaps over keys and over
+params and compiles once per map shape. The graph is an argument, never stored in the state, so a
+batch of runs shares one copy.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+from typing import Any, Callable, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.graph import Graph
+from jaxswarm.paths import Solution, as_node
+
+
+class Task(NamedTuple):
+    """Where to go (a pytree of traced scalars: moving the goal is data, not a new shape).
+
+    Attributes:
+      start: i32[] start node.
+      goal: i32[] goal node.
+    """
+
+    start: jax.Array
+    goal: jax.Array
+
+
+def make_task(graph: Graph, start, goal) -> Task:
+    """Host-side: a Task from (x, y) cells or node indices, checked like the exact planners'.
+
+    Raises:
+      ValueError: start or goal off the map or blocked.
+    """
+    return Task(start=jnp.int32(as_node(graph, start, name="start")),
+                goal=jnp.int32(as_node(graph, goal, name="goal")))
+
+
+class StepInfo(NamedTuple):
+    """What one iteration did (returned by ``Swarm.step``).
+
+    Attributes:
+      iteration_cost: f32[] cost of this iteration's best arrived agent (inf if none arrived).
+      arrived: f32[] share of agents that reached the goal.
+      converged: bool[] every agent arrived along one and the same path.
+    """
+
+    iteration_cost: jax.Array
+    arrived: jax.Array
+    converged: jax.Array
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Swarm:
+    """A swarm algorithm: pure functions over (State, Graph, Task, Params).
+
+    Hashable by identity (it is a static argument of ``run``); factories are cached per Config, so
+    equal configs give the same Swarm and share compiled code.
+
+    Attributes:
+      name: registry name.
+      config: the static Config it was built with.
+      init: ``(key, graph, task, params) -> State``.
+      step: ``(state, graph, task, params) -> (State, StepInfo)``: all agents walk once, then the
+        memory is updated.
+      best: ``(state) -> Solution``: the best path found so far.
+      default_params: Params that work on the paper maps.
+      check_params: ``(params) -> None``, host-side; raises ValueError naming a bad value.
+    """
+
+    name: str
+    config: Any
+    init: Callable
+    step: Callable
+    best: Callable
+    default_params: Any
+    check_params: Callable
+
+
+@dataclasses.dataclass(frozen=True)
+class Trace:
+    """Per-iteration record of a run (a pytree); entries after the stop are NaN.
+
+    Attributes:
+      best_cost: f32[T] best cost found so far, after each iteration.
+      iteration_cost: f32[T] cost of each iteration's best agent (inf if none arrived).
+      arrived: f32[T] share of agents that reached the goal in each iteration.
+      iterations: i32[] iterations actually run (<= T).
+    """
+
+    best_cost: jax.Array
+    iteration_cost: jax.Array
+    arrived: jax.Array
+    iterations: jax.Array
+
+
+jax.tree_util.register_dataclass(
+    Trace, data_fields=["best_cost", "iteration_cost", "arrived", "iterations"], meta_fields=[])
+
+
+def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
+        iterations: int = 100, patience: int | None = None):
+    """Iterate a swarm until a stop condition holds.
+
+    Stops after ``iterations`` iterations, or when the best cost has not improved for ``patience``
+    iterations (if given), or when every agent of an iteration followed the same path.
+
+    Args:
+      swarm: the algorithm (static).
+      key: PRNG key; the same key and inputs give bit-identical results.
+      graph: the map.
+      task: start and goal (see :func:`make_task`).
+      params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
+      iterations: the iteration budget T (static).
+      patience: stop after this many iterations without improvement (static; None = never).
+
+    Returns:
+      ``(state, trace)``: the final State and a :class:`Trace`.
+
+    Raises:
+      ValueError: concrete params out of range (checked on the host, outside jit).
+    """
+    if iterations < 1:
+        raise ValueError(f"iterations must be at least 1, got {iterations}")
+    if patience is not None and patience < 1:
+        raise ValueError(f"patience must be at least 1, got {patience}")
+    if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
+        swarm.check_params(params)
+    return _run(swarm, key, graph, task, params, iterations, patience)
+
+
+@functools.partial(jax.jit, static_argnums=(0, 5, 6))
+def _run(swarm, key, graph, task, params, iterations, patience):
+    state = swarm.init(key, graph, task, params)
+    nan = jnp.full((iterations,), jnp.nan, jnp.float32)
+    trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0))
+    limit = iterations if patience is None else patience
+
+    def keep_going(carry):
+        _, trace, stale, converged = carry
+        return (trace.iterations < iterations) & (stale < limit) & ~converged
+
+    def one_iteration(carry):
+        state, trace, stale, _ = carry
+        before = swarm.best(state).cost
+        state, info = swarm.step(state, graph, task, params)
+        after = swarm.best(state).cost
+        t = trace.iterations
+        trace = Trace(best_cost=trace.best_cost.at[t].set(after),
+                      iteration_cost=trace.iteration_cost.at[t].set(info.iteration_cost),
+                      arrived=trace.arrived.at[t].set(info.arrived),
+                      iterations=t + 1)
+        stale = jnp.where(after < before, 0, stale + 1)
+        return state, trace, stale, info.converged
+
+    state, trace, _, _ = jax.lax.while_loop(
+        keep_going, one_iteration, (state, trace, jnp.int32(0), jnp.array(False)))
+    return state, trace
+
+
+def check_positive(name: str, value, *, allow_zero: bool = False) -> None:
+    """Host-side check of a scalar (or array) param: finite and positive (or non-negative)."""
+    array = np.asarray(value, dtype=np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    if np.any(array < 0) or (not allow_zero and np.any(array == 0)):
+        bound = "non-negative" if allow_zero else "positive"
+        raise ValueError(f"{name} must be {bound}, got {value!r}")
+
+
+_REGISTRY: dict[str, Callable[..., Swarm]] = {}
+
+
+def register(name: str):
+    """Decorator adding a Swarm factory to the registry under ``name``; the factory is cached, so
+    equal configs return the same Swarm object (and share compiled code)."""
+    def decorate(factory):
+        cached = functools.lru_cache(maxsize=None)(factory)
+        _REGISTRY[name] = cached
+        return cached
+    return decorate
+
+
+def make(name: str, **config) -> Swarm:
+    """The registered swarm ``name`` built with ``config`` (see each factory for its options).
+
+    Raises:
+      ValueError: unknown name (the message lists the registered ones) or bad config.
+    """
+    if name not in _REGISTRY:
+        raise ValueError(f"unknown swarm {name!r}; registered: {', '.join(sorted(_REGISTRY))}")
+    return _REGISTRY[name](**config)
+
+
+def registered() -> tuple[str, ...]:
+    """Names of all registered swarms."""
+    return tuple(sorted(_REGISTRY))

@@ -1,0 +1,183 @@
+"""Protocol conformance of every registered swarm, and RFD's own rules."""
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxswarm import swarm as swarms
+from jaxswarm.exact import dijkstra
+from jaxswarm.graph import grid_graph
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.paths import is_valid_path, path_length
+from jaxswarm.swarm import make, make_task, run
+
+ITERATIONS = 8
+SMALL = dict(num_agents=32)
+
+
+@pytest.fixture(scope="module")
+def maze():
+    chosen = paper_map("maze20")
+    graph = chosen.graph()
+    return graph, make_task(graph, chosen.start, chosen.goal), dijkstra(graph, chosen.start,
+                                                                         chosen.goal).cost
+
+
+def leaves_equal(a, b):
+    return all(np.array_equal(np.asarray(x), np.asarray(y), equal_nan=True)
+               for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
+
+
+def key_data(state):
+    """The state with PRNG keys turned into their raw data (comparable arrays)."""
+    return jax.tree_util.tree_map(
+        lambda x: jax.random.key_data(x) if jnp.issubdtype(x.dtype, jax.dtypes.prng_key) else x,
+        state)
+
+
+def test_registry_lists_and_builds_swarms():
+    assert {"rfd", "rfd_star"} <= set(swarms.registered())
+    assert make("rfd_star", **SMALL) is make("rfd_star", **SMALL)  # cached: compiled code shared
+    with pytest.raises(ValueError, match="unknown swarm 'bees'; registered: .*rfd_star"):
+        make("bees")
+
+
+@pytest.mark.parametrize("name", swarms.registered())
+def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
+    graph, task, _ = maze
+    swarm = make(name, **SMALL)
+    keys = jax.random.split(jax.random.key(7), 3)
+    one = [run(swarm, k, graph, task, swarm.default_params, iterations=ITERATIONS) for k in keys]
+    again = run(swarm, keys[0], graph, task, swarm.default_params, iterations=ITERATIONS)
+    assert leaves_equal(key_data(one[0]), key_data(again))
+    batch = jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
+                                   iterations=ITERATIONS))(keys)
+    for i in range(3):
+        assert leaves_equal(key_data(jax.tree_util.tree_map(lambda x: x[i], batch)),
+                            key_data(one[i]))
+    assert not leaves_equal(one[0][0].best_path, one[1][0].best_path) or \
+        not leaves_equal(key_data(one[0][0]).key, key_data(one[1][0]).key)
+
+
+@pytest.mark.parametrize("name", swarms.registered())
+def test_results_are_valid_and_never_beat_the_optimum(name, maze):
+    graph, task, optimum = maze
+    swarm = make(name, **SMALL)
+    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
+                       iterations=ITERATIONS)
+    solution = swarm.best(state)
+    assert all(np.isfinite(np.asarray(leaf)).all() for leaf in jax.tree_util.tree_leaves(state)
+               if jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0)
+    ran = int(trace.iterations)
+    assert 1 <= ran <= ITERATIONS
+    best = np.asarray(trace.best_cost)
+    assert np.isnan(best[ran:]).all()
+    assert (best[1:ran] <= best[:ran - 1]).all()  # best so far never gets worse
+    if bool(solution.found):
+        assert bool(is_valid_path(graph, solution.path, task.start, task.goal))
+        assert float(path_length(graph, solution.path)) == pytest.approx(float(solution.cost),
+                                                                          rel=1e-5)
+        assert float(solution.cost) >= optimum * (1 - 1e-6)
+        assert float(solution.cost) == best[ran - 1]
+
+
+@pytest.mark.parametrize("name", swarms.registered())
+def test_a_sweep_over_sixteen_params_compiles_once(name, maze):
+    graph, task, _ = maze
+    swarm = make(name, **SMALL)
+    traces = []
+    original_step = swarm.step
+    counted = type(swarm)(**{**swarm.__dict__, "step": lambda *a: (traces.append(1),
+                                                                     original_step(*a))[1]})
+    first = swarm.default_params._fields[0]
+    values = jnp.linspace(1.5, 40.0, 16)
+    grid = jax.tree_util.tree_map(lambda x: jnp.full((16,), x), counted.default_params)
+    grid = grid._replace(**{first: values})
+    sweep = jax.jit(jax.vmap(lambda p: run(counted, jax.random.key(0), graph, task, p,
+                                           iterations=4)[0].best_cost))
+    costs = sweep(grid)
+    sweep(grid._replace(**{first: values + 1.0}))  # new values, same shapes: no retrace
+    assert len(traces) == 1 and costs.shape == (16,)
+
+
+def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once(maze):
+    graph, task, _ = maze
+    swarm = make("rfd_star", **SMALL)
+    p_base, alpha = jnp.meshgrid(jnp.array([5.0, 20.0, 50.0, 200.0]), jnp.arange(1.0, 5.0))
+    grid = swarm.default_params._replace(p_base=p_base.ravel(), alpha=alpha.ravel())
+    grid = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (16,)), grid)
+    compiled = jax.jit(jax.vmap(lambda p: run(swarm, jax.random.key(1), graph, task, p,
+                                              iterations=4)[1].best_cost))
+    before = compiled._cache_size()
+    compiled(grid)
+    compiled(jax.tree_util.tree_map(lambda x: x * 1.01, grid))
+    assert compiled._cache_size() - before == 1
+
+
+def test_erosion_and_deposits_follow_the_paper(maze):
+    graph, task, _ = maze
+    swarm = make("rfd_star", num_agents=64)
+    params = swarm.default_params
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    altitude = np.asarray(state.altitude)
+    assert altitude[int(task.goal)] == 0.0
+    assert (altitude[np.arange(graph.num_nodes) != int(task.goal)] == float(params.initial_height)).all()
+    for _ in range(5):
+        state, info = swarm.step(state, graph, task, params)
+    altitude = np.asarray(state.altitude)
+    assert altitude[int(task.goal)] == 0.0 and (altitude >= 0).all()
+    assert not np.allclose(altitude, float(params.initial_height))  # erosion or deposits acted
+    assert 0.0 <= float(info.arrived) <= 1.0
+
+
+def test_no_erosion_and_no_sediment_leave_altitudes_alone(maze):
+    graph, task, _ = maze
+    swarm = make("rfd_star", num_agents=32)
+    params = swarm.default_params._replace(erosion=jnp.float32(0.0), sediment=jnp.float32(0.0))
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    stepped, _ = swarm.step(state, graph, task, params)
+    np.testing.assert_array_equal(stepped.altitude, state.altitude)
+
+
+def test_unreachable_goal_is_a_clean_not_found_result():
+    obstacles = np.zeros((6, 6), bool)
+    obstacles[:, 3] = True
+    graph = grid_graph(obstacles)
+    task = make_task(graph, (0, 0), (5, 5))
+    for name in swarms.registered():
+        swarm = make(name, num_agents=16)
+        state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
+                           iterations=20, patience=5)
+        solution = swarm.best(state)
+        assert not bool(solution.found) and math.isinf(float(solution.cost))
+        assert (np.asarray(solution.path) == -1).all()
+        assert int(trace.iterations) == 5  # patience ran out: nothing ever improved
+        assert (np.asarray(trace.arrived)[:5] == 0).all()
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("p_base", float("nan"), "p_base must be finite"),
+    ("p_base", 0.0, "p_base must be positive"),
+    ("p_base", -2.0, "p_base must be positive"),
+    ("alpha", float("inf"), "alpha must be finite"),
+    ("sediment", -1.0, "sediment must be non-negative"),
+])
+def test_bad_params_are_named(maze, field, value, message):
+    graph, task, _ = maze
+    swarm = make("rfd_star", **SMALL)
+    params = swarm.default_params._replace(**{field: jnp.float32(value)})
+    with pytest.raises(ValueError, match=message):
+        run(swarm, jax.random.key(0), graph, task, params, iterations=2)
+
+
+def test_bad_sizes_and_endpoints_are_named(maze):
+    graph, task, _ = maze
+    with pytest.raises(ValueError, match="num_agents must be at least 1, got 0"):
+        make("rfd_star", num_agents=0)
+    with pytest.raises(ValueError, match="iterations must be at least 1"):
+        run(make("rfd", **SMALL), jax.random.key(0), graph, task, make("rfd").default_params,
+            iterations=0)
+    with pytest.raises(ValueError, match="goal .* is blocked"):
+        make_task(graph, (0, 0), (1, 1))

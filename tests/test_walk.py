@@ -1,0 +1,74 @@
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxswarm.graph import grid_graph
+from jaxswarm.paths import is_valid_path, path_length
+from jaxswarm.swarm.walk import FORCED, sample_masked, walk
+
+
+def test_sampler_follows_weights_and_never_picks_masked_slots():
+    log_weights = jnp.log(jnp.array([[1.0, 2.0, 0.0, 5.0]] * 20000))
+    mask = jnp.array([[True, True, True, False]] * 20000)  # slot 3 is heavy but masked
+    choice, has = jax.jit(sample_masked)(jax.random.key(0), log_weights, mask)
+    assert bool(has.all())
+    counts = np.bincount(np.asarray(choice), minlength=4)
+    assert counts[2] == 0 and counts[3] == 0  # zero weight and masked
+    np.testing.assert_allclose(counts[:2] / 20000, [1 / 3, 2 / 3], atol=0.015)
+
+
+def test_sampler_reports_no_choice_instead_of_slot_zero():
+    log_weights = jnp.array([[0.0, 0.0], [jnp.nan, jnp.nan], [-jnp.inf, -jnp.inf], [0.0, 1.0]])
+    mask = jnp.array([[False, False], [True, True], [True, True], [True, True]])
+    choice, has = sample_masked(jax.random.key(1), log_weights, mask)
+    np.testing.assert_array_equal(has, [False, False, False, True])
+    np.testing.assert_array_equal(choice[:3], [-1, -1, -1])
+
+
+def test_forced_slot_always_wins():
+    log_weights = jnp.array([[3.0, FORCED, 50.0]] * 1000)
+    choice, _ = sample_masked(jax.random.key(2), log_weights, jnp.ones((1000, 3), bool))
+    assert (np.asarray(choice) == 1).all()
+
+
+def uniform(here, neighbours, edge_cost, admissible):
+    return jnp.zeros(neighbours.shape)
+
+
+def test_walks_are_valid_self_avoiding_and_measured():
+    obstacles = np.random.default_rng(0).random((10, 10)) < 0.25
+    obstacles[0, 0] = obstacles[9, 9] = False
+    graph = grid_graph(obstacles)
+    result = jax.jit(lambda key: walk(key, graph, graph.valid_edges(), 0, 99, uniform,
+                                      num_agents=64, max_steps=60))(jax.random.key(3))
+    path = np.asarray(result.path)
+    for a in range(64):
+        nodes = path[a][path[a] >= 0]
+        assert len(set(nodes.tolist())) == len(nodes)  # no revisits
+        assert bool(is_valid_path(graph, result.path[a], start=0))
+        assert float(path_length(graph, result.path[a])) == pytest.approx(float(result.length[a]))
+        if result.arrived[a]:
+            assert nodes[-1] == 99 and not result.stuck[a]
+        assert nodes[-1] == int(result.position[a])
+    # Stuck agents really have no unvisited free neighbour left.
+    valid, nbr = np.asarray(graph.valid_edges()), np.asarray(graph.nbr)
+    for a in np.nonzero(np.asarray(result.stuck))[0]:
+        nodes = set(path[a][path[a] >= 0].tolist())
+        here = int(result.position[a])
+        assert all(nbr[here, k] in nodes for k in range(8) if valid[here, k])
+    assert int(result.steps) <= 60
+
+
+def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
+    obstacles = np.ones((3, 5), bool)
+    obstacles[1, :4] = False  # a corridor (0,1)..(3,1) closed at the east end
+    graph = grid_graph(obstacles)
+    result = walk(jax.random.key(0), graph, graph.valid_edges(), 5, 14, uniform,
+                  num_agents=3, max_steps=10)
+    assert bool(result.stuck.all()) and not bool(result.arrived.any())
+    np.testing.assert_array_equal(result.position, [8, 8, 8])
+    assert int(result.steps) == 4  # three moves, then one step finds nothing admissible
+    at_goal = walk(jax.random.key(0), graph, graph.valid_edges(), 6, 6, uniform,
+                   num_agents=2, max_steps=5)
+    assert bool(at_goal.arrived.all()) and int(at_goal.steps) == 0
