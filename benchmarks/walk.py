@@ -53,9 +53,8 @@ def make_walks(map_name: str, drops: int, seeds: int):
 
     def one(key):
         state = swarm.init(key, graph, task, params)
-        rule = transition_rule(swarm.config, graph, task, state.altitude, params)
-        return walk(key, graph, graph.valid_edges(), task.start, task.goal, rule,
-                    num_agents=drops, max_steps=steps)
+        table = transition_rule(swarm.config, graph, task, state.altitude, params)
+        return walk(key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps)
 
     walks = jax.jit(jax.vmap(one))
     keys = jax.random.split(jax.random.key(0), seeds)

@@ -5,7 +5,7 @@ import pytest
 
 from jaxswarm.graph import grid_graph
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.walk import FORCED, sample_masked, walk
+from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, edge_table, sample_masked, walk
 
 
 def test_sampler_follows_weights_and_never_picks_masked_slots():
@@ -32,16 +32,16 @@ def test_forced_slot_always_wins():
     assert (np.asarray(choice) == 1).all()
 
 
-def uniform(here, neighbours, edge_cost, admissible):
-    return jnp.zeros(neighbours.shape)
+def uniform(graph):
+    return edge_table(graph, jnp.zeros(graph.nbr.shape))
 
 
 def test_walks_are_valid_self_avoiding_and_measured():
     obstacles = np.random.default_rng(0).random((10, 10)) < 0.25
     obstacles[0, 0] = obstacles[9, 9] = False
     graph = grid_graph(obstacles)
-    result = jax.jit(lambda key: walk(key, graph, graph.valid_edges(), 0, 99, uniform,
-                                      num_agents=64, max_steps=60))(jax.random.key(3))
+    result = jax.jit(lambda key: walk(key, graph, uniform(graph), 0, 99, num_agents=64,
+                                      max_steps=60))(jax.random.key(3))
     path = np.asarray(result.path)
     for a in range(64):
         nodes = path[a][path[a] >= 0]
@@ -58,17 +58,27 @@ def test_walks_are_valid_self_avoiding_and_measured():
         here = int(result.position[a])
         assert all(nbr[here, k] in nodes for k in range(8) if valid[here, k])
     assert int(result.steps) <= 60
+    np.testing.assert_array_equal(np.asarray(result.slots) >= 0, path[:, 1:] >= 0)
 
 
 def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
     obstacles = np.ones((3, 5), bool)
     obstacles[1, :4] = False  # a corridor (0,1)..(3,1) closed at the east end
     graph = grid_graph(obstacles)
-    result = walk(jax.random.key(0), graph, graph.valid_edges(), 5, 14, uniform,
-                  num_agents=3, max_steps=10)
+    result = walk(jax.random.key(0), graph, uniform(graph), 5, 14, num_agents=3, max_steps=10)
     assert bool(result.stuck.all()) and not bool(result.arrived.any())
     np.testing.assert_array_equal(result.position, [8, 8, 8])
-    assert int(result.steps) == 4  # three moves, then one step finds nothing admissible
-    at_goal = walk(jax.random.key(0), graph, graph.valid_edges(), 6, 6, uniform,
-                   num_agents=2, max_steps=5)
+    np.testing.assert_array_equal(result.path[:, :5], [[5, 6, 7, 8, -1]] * 3)
+    assert int(result.steps) == min(STEPS_PER_CHECK, 10)  # one chunk, capped by the budget
+    at_goal = walk(jax.random.key(0), graph, uniform(graph), 6, 6, num_agents=2, max_steps=5)
     assert bool(at_goal.arrived.all()) and int(at_goal.steps) == 0
+
+
+def test_excluded_and_invalid_edges_are_never_taken():
+    graph = grid_graph(np.zeros((5, 5), bool))
+    logw = jnp.zeros(graph.nbr.shape).at[:, 4:].set(-jnp.inf)  # the algorithm forbids diagonals
+    result = walk(jax.random.key(4), graph, edge_table(graph, logw), 0, 24, num_agents=32,
+                  max_steps=30)
+    slots = np.asarray(result.slots)
+    assert slots.max() <= 3 and (slots[slots >= 0] >= 0).all()
+    assert bool(result.arrived.any())

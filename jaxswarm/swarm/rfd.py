@@ -33,7 +33,7 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import StepInfo, Swarm, Task, check_positive, register
-from jaxswarm.swarm.walk import FORCED, Walk, walk
+from jaxswarm.swarm.walk import FORCED, Walk, edge_table, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -155,7 +155,7 @@ def _build(config: RFDConfig, name: str) -> Swarm:
     def step(state: RFDState, graph: Graph, task: Task, params):
         key, walk_key = jax.random.split(state.key)
         log_weights = transition_rule(config, graph, task, state.altitude, params)
-        drops = walk(walk_key, graph, graph.valid_edges(), task.start, task.goal, log_weights,
+        drops = walk(walk_key, graph, log_weights, task.start, task.goal,
                      num_agents=config.num_agents, max_steps=walk_steps(config, graph))
         altitude = _erode_and_deposit(config, graph, task, state.altitude, drops, params)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
@@ -199,32 +199,25 @@ def rfd_star(num_agents: int = 256, max_steps: int | None = None,
     return _build(RFDConfig(num_agents, max_steps, True, exponential_erosion), "rfd_star")
 
 
-def _gradient(altitude, here, there, distance):
-    return (altitude[here][..., None] - altitude[there]) / distance
-
-
 def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, params):
-    """The walker's log-weight rule (see ``walk.LogWeights``) for altitudes f32[N]: eq. 1 for
-    RFD, eq. 6 (plus the climb limit and the goal taken when adjacent) for RFD*."""
+    """f32[N, K] log-weight of every edge for altitudes f32[N] (the walker's table, see
+    :func:`jaxswarm.swarm.walk.edge_table`): eq. 1 for RFD; eq. 6 for RFD*, plus its climb limit
+    and the goal taken whenever adjacent."""
+    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
+    gradient = (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
     if config.modified:
         to_goal = jnp.linalg.norm(graph.xy - graph.xy[task.goal], axis=-1)
         # Nodes at distance 0 from the goal other than the goal (general graphs without
         # coordinates) get a neutral heuristic instead of log(0).
         log_distance = jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
-        log_base = jnp.log(params.p_base)
-
-    def log_weights(here, neighbours, edge_cost, admissible):
-        safe = jnp.where(neighbours >= 0, neighbours, 0)
-        gradient = _gradient(altitude, here, safe, jnp.where(admissible, edge_cost, 1.0))
-        if config.modified:
-            logw = gradient * log_base - params.alpha * log_distance[safe]
-            logw = jnp.where(gradient < -params.climb, -jnp.inf, logw)
-            return jnp.where(safe == task.goal, FORCED, logw)
+        logw = gradient * jnp.log(params.p_base) - params.alpha * log_distance[heads]
+        logw = jnp.where(gradient < -params.climb, -jnp.inf, logw)
+        logw = jnp.where(heads == task.goal, FORCED, logw)
+    else:
         weight = jnp.where(gradient > 0, gradient,
                            jnp.where(gradient < 0, params.omega / jnp.abs(gradient), params.delta))
-        return jnp.log(weight)
-
-    return log_weights
+        logw = jnp.log(weight)
+    return edge_table(graph, logw)
 
 
 def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, drops: Walk,

@@ -1,9 +1,10 @@
 """The lockstep walker shared by drops and ants, and the single masked sampler.
 
-``A`` agents start at one node. Each step, every still-walking agent gathers its ``K`` neighbour
-slots, keeps the admissible ones (a valid edge of the current map to a node the agent has not
-visited in this walk), asks the algorithm for one log-weight per slot, and draws one slot through
-:func:`sample_masked`. An agent stops when it reaches the goal, when it has no admissible
+``A`` agents start at one node. The algorithm hands the walker one log-weight per edge,
+``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
+heuristics do not change while the agents walk). Each step, every still-walking agent gathers
+its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
+has not visited in this walk), and draws one slot through :func:`sample_masked`. An agent stops when it reaches the goal, when it has no admissible
 neighbour ("stuck"), or when the step budget runs out. The walk is a ``lax.while_loop`` that ends
 as soon as every agent has stopped.
 
@@ -12,12 +13,17 @@ Memory: the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the paths ``i32[
 """
 from __future__ import annotations
 
-from typing import Callable, NamedTuple
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import NO_NODE, Graph
+
+STEPS_PER_CHECK = 32
+"""Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
+the old and new carry of every lane at each iteration, copying the buffers; testing every 32
+steps amortises that copy (agents that stopped simply idle in between)."""
 
 FORCED = 1e30
 """A log-weight that wins every draw: use it for moves that must be taken (e.g. into the goal)."""
@@ -34,7 +40,8 @@ class Walk(NamedTuple):
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).
       position: i32[A] the node each agent stopped at.
-      steps: i32[] number of lockstep steps taken (the slowest agent's move count).
+      steps: i32[] lockstep steps executed: the slowest agent's move count rounded up to a
+        multiple of ``STEPS_PER_CHECK``, at most ``max_steps``.
     """
 
     path: jax.Array
@@ -44,11 +51,6 @@ class Walk(NamedTuple):
     stuck: jax.Array
     position: jax.Array
     steps: jax.Array
-
-
-LogWeights = Callable[[jax.Array, jax.Array, jax.Array, jax.Array], jax.Array]
-"""``log_weights(position i32[A], neighbours i32[A, K], edge_cost f32[A, K], admissible bool[A, K])
--> f32[A, K]``: unnormalised log-probabilities of each slot (only admissible slots matter)."""
 
 
 def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
@@ -79,6 +81,27 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
     return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
 
 
+def _replay(graph: Graph, start, slots: jax.Array) -> jax.Array:
+    """i32[A, L + 1] nodes of the walks whose slots are ``slots`` (i[A, L], -1 once stopped)."""
+    def advance(here, slot):
+        moved = slot >= 0
+        there = jnp.where(moved, graph.nbr[jnp.maximum(here, 0), jnp.maximum(slot, 0)], NO_NODE)
+        return jnp.where(moved, there, NO_NODE), jnp.where(moved, there, NO_NODE)
+
+    first = jnp.full((slots.shape[0],), start, jnp.int32)
+    _, nodes = jax.lax.scan(advance, first, slots.T.astype(jnp.int32))
+    return jnp.concatenate([first[:, None], nodes.T], axis=1)
+
+
+def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
+    """f32[N, K]: ``log_weights`` where the edge is valid on the current map, else ``-inf``.
+
+    Algorithms build their per-edge log-weights (any finite values, ``FORCED`` for must-take
+    moves, ``-inf`` to exclude) and pass them through this before :func:`walk`.
+    """
+    return jnp.where(graph.valid_edges(), log_weights, -jnp.inf)
+
+
 def _mark(bits: jax.Array, agents: jax.Array, nodes: jax.Array) -> jax.Array:
     """Set bit ``nodes[a]`` in row ``agents[a]`` of a packed u32[A, ceil(N / 32)] bit set."""
     words = nodes >> 5
@@ -101,16 +124,17 @@ def _cumsum_last(x: jax.Array) -> jax.Array:
     return jnp.stack(columns, axis=-1)
 
 
-def walk(key: jax.Array, graph: Graph, valid_edges: jax.Array, start, goal,
-         log_weights: LogWeights, *, num_agents: int, max_steps: int) -> Walk:
+def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
+         max_steps: int) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal`` in lockstep.
 
     Args:
       key: PRNG key (one split per step; the same key gives the same walk).
       graph: the map.
-      valid_edges: bool[N, K] ``graph.valid_edges()``, computed once by the caller.
+      log_weights: f32[N, K] unnormalised log-probability of each edge (see
+        :func:`edge_table`); ``-inf`` where the edge may not be taken (no neighbour, not valid
+        on the current map, or excluded by the algorithm), ``FORCED`` where it must be.
       start, goal: i32[] node indices (may be traced).
-      log_weights: the algorithm's transition rule (see ``LogWeights``).
       num_agents: A (static).
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
 
@@ -122,13 +146,16 @@ def walk(key: jax.Array, graph: Graph, valid_edges: jax.Array, start, goal,
     start = jnp.asarray(start, jnp.int32)
     goal = jnp.asarray(goal, jnp.int32)
     position = jnp.full((num_agents,), start)
-    path = jnp.full((num_agents, max_steps + 1), NO_NODE, jnp.int32).at[:, 0].set(start)
+    # Only the chosen slots are stored while walking (the nodes are replayed afterwards): the
+    # smallest carry, since a vmapped while_loop copies its carry at every test. The buffer gets
+    # one spare chunk of columns so that a chunk's block always fits.
+    columns = max_steps + STEPS_PER_CHECK
+    slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
     carry = dict(
         key=key,
         position=position,
         visited=_mark(jnp.zeros((num_agents, (n + 31) // 32), jnp.uint32), agents, position),
-        path=path,
-        slots=jnp.full((num_agents, max_steps), -1, jnp.int16),
+        slots=jnp.full((num_agents, columns), -1, slot_dtype),
         length=jnp.zeros((num_agents,), jnp.float32),
         walking=jnp.full((num_agents,), start != goal),
         arrived=jnp.full((num_agents,), start == goal),
@@ -139,35 +166,48 @@ def walk(key: jax.Array, graph: Graph, valid_edges: jax.Array, start, goal,
     def keep_walking(c):
         return (c["step"] < max_steps) & jnp.any(c["walking"])
 
+    def chunk(c):
+        """STEPS_PER_CHECK steps; their slots go to a small block (cheap writes at the loop
+        index) that is copied into the slot buffer once per chunk."""
+        first = c["step"]
+
+        def step_into_block(i, inner):
+            c, block = inner
+            c, slot = one_step(c)
+            return c, block.at[:, i].set(slot)
+
+        block = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
+        c, block = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_block, (c, block))
+        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], block, (0, first)))
+
     def one_step(c):
         key, draw_key = jax.random.split(c["key"])
         here = c["position"]
         neighbours = graph.nbr[here]
-        safe = jnp.where(neighbours >= 0, neighbours, 0)
-        edge_cost = graph.cost[here]
-        seen = _is_marked(c["visited"], safe)
-        admissible = valid_edges[here] & ~seen & c["walking"][:, None]
-        choice, has_choice = sample_masked(
-            draw_key, log_weights(here, neighbours, edge_cost, admissible), admissible)
-        moving = c["walking"] & has_choice
-        slot = jnp.maximum(choice, 0)[:, None]
-        target = jnp.take_along_axis(neighbours, slot, axis=1)[:, 0]
+        row = log_weights[here]
+        seen = _is_marked(c["visited"], jnp.where(neighbours >= 0, neighbours, 0))
+        admissible = (row > -jnp.inf) & ~seen & c["walking"][:, None]
+        choice, has_choice = sample_masked(draw_key, row, admissible)
+        moving = c["walking"] & has_choice & (c["step"] < max_steps)
+        slot = jnp.maximum(choice, 0)
+        target = jnp.take_along_axis(neighbours, slot[:, None], axis=1)[:, 0]
         there = jnp.where(moving, target, here)
         arrived_now = moving & (there == goal)
-        step = c["step"]
-        return dict(
+        c = dict(
+            c,
             key=key,
             position=there,
             visited=_mark(c["visited"], agents, there),
-            path=c["path"].at[:, step + 1].set(jnp.where(moving, there, NO_NODE)),
-            slots=c["slots"].at[:, step].set(jnp.where(moving, choice, -1).astype(jnp.int16)),
-            length=c["length"] + jnp.where(moving, jnp.take_along_axis(edge_cost, slot, 1)[:, 0], 0.0),
+            length=c["length"] + jnp.where(moving, graph.cost[here, slot], 0.0),
             walking=moving & ~arrived_now,
             arrived=c["arrived"] | arrived_now,
             stuck=c["stuck"] | (c["walking"] & ~has_choice),
-            step=step + 1,
+            step=jnp.minimum(c["step"] + 1, max_steps),
         )
+        return c, jnp.where(moving, choice, -1).astype(slot_dtype)
 
-    c = jax.lax.while_loop(keep_walking, one_step, carry)
-    return Walk(path=c["path"], slots=c["slots"], length=c["length"], arrived=c["arrived"],
-                stuck=c["stuck"], position=c["position"], steps=c["step"])
+    c = jax.lax.while_loop(keep_walking, chunk, carry)
+    slots = c["slots"][:, :max_steps]
+    return Walk(path=_replay(graph, start, slots), slots=slots.astype(jnp.int16),
+                length=c["length"], arrived=c["arrived"], stuck=c["stuck"],
+                position=c["position"], steps=c["step"])
