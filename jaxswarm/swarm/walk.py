@@ -20,9 +20,9 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import NO_NODE, Graph
 
-STEPS_PER_CHECK = 32
+STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
-the old and new carry of every lane at each iteration, copying the buffers; testing every 32
+the old and new carry of every lane at each iteration, copying the buffers; testing every 64
 steps amortises that copy (agents that stopped simply idle in between)."""
 
 FORCED = 1e30
