@@ -6,7 +6,7 @@ import math
 import time
 
 from jaxswarm.exact._host import host_graph, heuristic as make_heuristic
-from jaxswarm.exact.best_first import search, walk_back
+from jaxswarm.exact.best_first import relax, search, walk_back
 from jaxswarm.exact.stats import SearchStats, make_solution
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, as_node
@@ -85,15 +85,11 @@ def _bidirectional(host, source: int, target: int, kind: str):
         if g_u > g[u]:
             continue
         expanded += 1
-        for v, w in edges[u]:
-            g_v = g_u + w
-            if g_v < g.get(v, math.inf):
-                g[v] = g_v
-                parent[v] = u
-                heapq.heappush(heap, (g_v + h(v), -g_v, v))
-                generated += 1
-                if v in g_other and g_v + g_other[v] < mu:
-                    mu, meet = g_v + g_other[v], v
+        improved = relax(u, g_u, edges[u], g, parent, heap, h)
+        generated += len(improved)
+        for v in improved:
+            if v in g_other and g[v] + g_other[v] < mu:
+                mu, meet = g[v] + g_other[v], v
     counts = (iterations, expanded, generated)
     if meet < 0:
         return None, math.inf, counts

@@ -49,14 +49,22 @@ def best_first(host: HostGraph, source: int, target: int, h):
         if u == target:
             return walk_back(parent, target)[::-1], g_u, (iterations, expanded, generated)
         expanded += 1
-        for v, w in succ[u]:
-            g_v = g_u + w
-            if g_v < g.get(v, math.inf):
-                g[v] = g_v
-                parent[v] = u
-                heapq.heappush(heap, (g_v + h(v), -g_v, v))
-                generated += 1
+        generated += len(relax(u, g_u, succ[u], g, parent, heap, h))
     return None, math.inf, (iterations, expanded, generated)
+
+
+def relax(u: int, g_u: float, edges: list, g: dict, parent: dict, heap: list, h) -> list[int]:
+    """Expand ``u``: every edge (v, w) that improves g[v] updates g and parent and pushes v with
+    priority (g + h, -g) (ties towards the larger g). Returns the improved nodes."""
+    improved = []
+    for v, w in edges:
+        g_v = g_u + w
+        if g_v < g.get(v, math.inf):
+            g[v] = g_v
+            parent[v] = u
+            heapq.heappush(heap, (g_v + h(v), -g_v, v))
+            improved.append(v)
+    return improved
 
 
 def walk_back(parent: dict, node: int) -> list[int]:
