@@ -178,11 +178,10 @@ def _build(config: RFDConfig, name: str) -> Swarm:
         return Solution(path=state.best_path, cost=state.best_cost,
                         found=jnp.isfinite(state.best_cost))
 
-    if config.modified:
-        return Swarm(name=name, config=config, init=init, step=step, best=best,
-                     default_params=DEFAULT_RFD_STAR, check_params=_check_rfd_star)
+    defaults, check = ((DEFAULT_RFD_STAR, _check_rfd_star) if config.modified
+                       else (DEFAULT_RFD, _check_rfd))
     return Swarm(name=name, config=config, init=init, step=step, best=best,
-                 default_params=DEFAULT_RFD, check_params=_check_rfd)
+                 default_params=defaults, check_params=check)
 
 
 @register("rfd")
