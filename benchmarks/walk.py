@@ -31,8 +31,8 @@ import jax.numpy as jnp
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task
-from jaxswarm.swarm.rfd import walk_steps, transition_rule
-from jaxswarm.swarm.walk import walk
+from jaxswarm.swarm.rfd import transition_rule
+from jaxswarm.swarm.walk import step_budget, walk
 
 MiB = 2 ** 20
 
@@ -49,7 +49,7 @@ def make_walks(map_name: str, drops: int, seeds: int):
     task = make_task(graph, chosen.start, chosen.goal)
     swarm = make("rfd_star", num_agents=drops)
     params = swarm.default_params
-    steps = walk_steps(swarm.config, graph)
+    steps = step_budget(graph, swarm.config.max_steps)
 
     def one(key):
         state = swarm.init(key, graph, task, params)

@@ -21,7 +21,7 @@ from jaxswarm.paths import as_node
 from jaxswarm.swarm import make, make_task, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
-SWARM_PLANNERS = {"RFD*": "rfd_star"}
+SWARM_PLANNERS = {"RFD*": "rfd_star", "ACO*": "aco_star"}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -82,9 +82,10 @@ def run_demo(args: argparse.Namespace) -> int:
     plt.close(fig)
     print(f"figure written to {args.out}")
     for label, (trace, state) in traces.items():
-        out = args.out.with_name(f"{args.out.stem}_{SWARM_PLANNERS[label]}{args.out.suffix}")
-        fig = plot_swarm_run(graph, state.altitude, solutions[label], trace, start=start,
-                             goal=goal, optimum=reference, field_label="altitude",
+        swarm = make(SWARM_PLANNERS[label], num_agents=args.drops)
+        out = args.out.with_name(f"{args.out.stem}_{swarm.name}{args.out.suffix}")
+        fig = plot_swarm_run(graph, swarm.memory(state), solutions[label], trace, start=start,
+                             goal=goal, optimum=reference, field_label=swarm.memory_label,
                              title=f"{name}: {label}", path=out)
         plt.close(fig)
         print(f"figure written to {out}")

@@ -12,16 +12,17 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     assert main(["demo", "--map", "maze20", "--repeats", "1", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     lengths = {}
-    for planner in ("Dijkstra", "A\\*", "bidirectional A\\*", "RFD\\*"):
+    for planner in ("Dijkstra", "A\\*", "bidirectional A\\*", "RFD\\*", "ACO\\*"):
         row = re.search(rf"^{planner}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
         assert row, f"no row for {planner} in:\n{text}"
         lengths[planner] = row.group(1)
-        if planner != "RFD\\*":
+        if planner not in ("RFD\\*", "ACO\\*"):
             assert row.group(2) == "+0.00%"
     assert len({lengths["Dijkstra"], lengths["A\\*"], lengths["bidirectional A\\*"]}) == 1
-    rfd_gap = re.search(r"^RFD\*\s+\S+\s+(\S+)", text, re.MULTILINE).group(1)
-    assert rfd_gap == "-" or not rfd_gap.startswith("-")  # no swarm beats the optimum
-    for png in (out, tmp_path / "demo_rfd_star.png"):
+    for swarm in ("RFD", "ACO"):
+        gap = re.search(rf"^{swarm}\*\s+\S+\s+(\S+)", text, re.MULTILINE).group(1)
+        assert gap == "-" or not gap.startswith("-")  # no swarm beats the optimum
+    for png in (out, tmp_path / "demo_rfd_star.png", tmp_path / "demo_aco_star.png"):
         assert png.read_bytes()[:4] == b"\x89PNG"
 
 

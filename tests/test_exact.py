@@ -169,4 +169,5 @@ def test_optimum_agrees_with_dijkstra_on_directed_graph():
     for source, target in rng.integers(20, size=(15, 2)):
         expected = dijkstra(graph, int(source), int(target)).cost
         got = float(optimum(graph, int(source), int(target)))
-        assert got == pytest.approx(expected, rel=1e-5) or (math.isinf(got) and math.isinf(expected))
+        assert got == pytest.approx(expected, rel=1e-5) or (
+            math.isinf(got) and math.isinf(expected))

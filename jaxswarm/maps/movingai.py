@@ -68,17 +68,20 @@ def read_map(path) -> np.ndarray:
             raise MovingAIFormatError(path, number, f"missing '{expected}' header line")
         words = lines[number - 1].split()
         if not words or words[0] != expected or len(words) != (1 if expected == "map" else 2):
-            raise MovingAIFormatError(path, number, f"expected '{expected} ...', got {lines[number - 1]!r}")
+            raise MovingAIFormatError(path, number,
+                                      f"expected '{expected} ...', got {lines[number - 1]!r}")
         header[expected] = words[1:] and words[1]
     if header["type"] != "octile":
-        raise MovingAIFormatError(path, 1, f"only 'type octile' maps are supported, got {header['type']!r}")
+        raise MovingAIFormatError(path, 1,
+                                  f"only 'type octile' maps are supported, got {header['type']!r}")
     height = _positive_int(header["height"], path, 2, "height")
     width = _positive_int(header["width"], path, 3, "width")
     rows = lines[4:]
     while rows and not rows[-1].strip():
         rows.pop()
     if len(rows) != height:
-        raise MovingAIFormatError(path, 5 + len(rows), f"expected {height} map rows, found {len(rows)}")
+        raise MovingAIFormatError(path, 5 + len(rows),
+                                  f"expected {height} map rows, found {len(rows)}")
     obstacles = np.zeros((height, width), dtype=bool)
     for y, row in enumerate(rows):
         number = 5 + y
@@ -123,7 +126,8 @@ def load_scenarios(path) -> list[Scenario]:
             raise MovingAIFormatError(path, number, f"bad optimal length {fields[8]!r}")
         if length == 0 and (sx, sy) != (gx, gy):
             length = math.inf
-        scenarios.append(Scenario(bucket, fields[1], width, height, (sx, sy), (gx, gy), length, number))
+        scenarios.append(Scenario(bucket, fields[1], width, height, (sx, sy), (gx, gy), length,
+                                  number))
     return scenarios
 
 

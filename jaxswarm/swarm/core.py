@@ -79,6 +79,9 @@ class Swarm:
       best: ``(state) -> Solution``: the best path found so far.
       default_params: Params that work on the paper maps.
       check_params: ``(params) -> None``, host-side; raises ValueError naming a bad value.
+      memory: ``(state) -> f32[N]``: the swarm's memory per node (altitude, pheromone), for
+        figures and for inspecting what persists between iterations.
+      memory_label: what ``memory`` shows, for colorbars.
     """
 
     name: str
@@ -88,6 +91,8 @@ class Swarm:
     best: Callable
     default_params: Any
     check_params: Callable
+    memory: Callable
+    memory_label: str
 
 
 @dataclasses.dataclass(frozen=True)

@@ -19,8 +19,9 @@ p_base ** gradient`` (the exponential form the paper suggests, which also erodes
 drop that got stuck deposits ``sediment`` where it stands. RFD* drops do not climb slopes steeper
 than ``climb``: a drop whose only moves are steeper is stuck too, so deposits fill a blind alley
 from its end back to its entrance and later drops avoid it (the paper's "reduces the likelihood
-of transition to blind alleys"; without it a one-cell-wide dead end never fills). Finally every node gains ``erosionProduced / (N - 1)`` (eq. 5), altitudes are kept
-non-negative and the goal is reset to 0. Drops that run out of steps simply evaporate.
+of transition to blind alleys"; without it a one-cell-wide dead end never fills). Finally every
+node gains ``erosionProduced / (N - 1)`` (eq. 5), altitudes are kept non-negative and the goal
+is reset to 0. Drops that run out of steps simply evaporate.
 """
 from __future__ import annotations
 
@@ -33,7 +34,7 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import StepInfo, Swarm, Task, check_positive, register
-from jaxswarm.swarm.walk import FORCED, Walk, edge_table, walk
+from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -136,27 +137,21 @@ jax.tree_util.register_dataclass(
     RFDState, data_fields=["key", "altitude", "best_path", "best_cost"], meta_fields=[])
 
 
-def walk_steps(config: RFDConfig, graph: Graph) -> int:
-    """The step budget of one walk (static): ``config.max_steps`` or its default for ``graph``."""
-    if config.max_steps is not None:
-        return config.max_steps
-    longest = max(graph.num_nodes - 1, 1)
-    return min(longest, 8 * sum(graph.shape)) if graph.is_grid else longest
-
-
 def _build(config: RFDConfig, name: str) -> Swarm:
     def init(key, graph: Graph, task: Task, params) -> RFDState:
         n = graph.num_nodes
         altitude = jnp.full((n,), params.initial_height, jnp.float32).at[task.goal].set(0.0)
         return RFDState(key=key, altitude=altitude,
-                        best_path=jnp.full((walk_steps(config, graph) + 1,), -1, jnp.int32),
+                        best_path=jnp.full((step_budget(graph, config.max_steps) + 1,), -1,
+                                           jnp.int32),
                         best_cost=jnp.float32(jnp.inf))
 
     def step(state: RFDState, graph: Graph, task: Task, params):
         key, walk_key = jax.random.split(state.key)
         log_weights = transition_rule(config, graph, task, state.altitude, params)
         drops = walk(walk_key, graph, log_weights, task.start, task.goal,
-                     num_agents=config.num_agents, max_steps=walk_steps(config, graph))
+                     num_agents=config.num_agents,
+                    max_steps=step_budget(graph, config.max_steps))
         altitude = _erode_and_deposit(config, graph, task, state.altitude, drops, params)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
         winner = jnp.argmin(costs)
@@ -181,7 +176,8 @@ def _build(config: RFDConfig, name: str) -> Swarm:
     defaults, check = ((DEFAULT_RFD_STAR, _check_rfd_star) if config.modified
                        else (DEFAULT_RFD, _check_rfd))
     return Swarm(name=name, config=config, init=init, step=step, best=best,
-                 default_params=defaults, check_params=check)
+                 default_params=defaults, check_params=check,
+                 memory=lambda state: state.altitude, memory_label="altitude")
 
 
 @register("rfd")

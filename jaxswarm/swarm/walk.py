@@ -4,12 +4,13 @@
 ``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
 heuristics do not change while the agents walk). Each step, every still-walking agent gathers
 its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
-has not visited in this walk), and draws one slot through :func:`sample_masked`. An agent stops when it reaches the goal, when it has no admissible
-neighbour ("stuck"), or when the step budget runs out. The walk is a ``lax.while_loop`` that ends
-as soon as every agent has stopped.
+has not visited in this walk), and draws one slot through :func:`sample_masked`. An agent stops
+when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
+runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped.
 
-Memory: the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the paths ``i32[A, L]`` and the chosen slots
-``i16[A, L - 1]`` with ``L = max_steps + 1``; batch sizes in sweeps must be chosen with that in mind.
+Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]`` and the chosen slots
+``i8[A, L - 1]`` (``L = max_steps + 1``); the paths ``i32[A, L]`` are replayed from the slots at the
+end. Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
 
@@ -91,6 +92,15 @@ def _replay(graph: Graph, start, slots: jax.Array) -> jax.Array:
     first = jnp.full((slots.shape[0],), start, jnp.int32)
     _, nodes = jax.lax.scan(advance, first, slots.T.astype(jnp.int32))
     return jnp.concatenate([first[:, None], nodes.T], axis=1)
+
+
+def step_budget(graph: Graph, max_steps: int | None) -> int:
+    """The step budget of a walk (static): ``max_steps``, or by default N - 1 (the longest walk
+    without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids."""
+    if max_steps is not None:
+        return max_steps
+    longest = max(graph.num_nodes - 1, 1)
+    return min(longest, 8 * sum(graph.shape)) if graph.is_grid else longest
 
 
 def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
