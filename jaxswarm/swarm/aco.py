@@ -12,7 +12,13 @@ with ``eta_ij = 1 / length(i, j)`` and ``d_j`` the straight-line distance from `
 * Ant System: evaporation ``tau <- (1 - rho) tau`` (eq. 9) and, for every ant that reached the
   goal, a deposit ``Q / f(S)`` on each edge of its path ``S`` of length ``f(S)`` (eq. 8);
 * Max-Min ACO: evaporation, a deposit by the best ant only (this iteration's or the best so far,
-  a config switch), and ``tau`` kept within ``[tau_min, tau_max]``.
+  a config switch), and ``tau`` kept within ``[tau_min, tau_max]``;
+* Improved Max-Min ACO (the Max-Min ACO paper): ``eta_ij`` is the desirability of the move's
+  direction given the direction of the goal, ``(1 + cos angle) / 2``; pheromone starts at
+  ``tau0`` (one in the paper); the Bug2-like first ant (:mod:`jaxswarm.swarm.bug2`, the limit of
+  a large heuristic weight) sets the first best path; after each population evaporation is
+  floored at ``tau_min`` (the paper's ``minpher``) and the best path so far gains ``q`` (its
+  ``delta``) on every edge.
 """
 from __future__ import annotations
 
@@ -25,7 +31,11 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, step_slots
 from jaxswarm.swarm.core import StepInfo, Swarm, Task, check_positive, register
+from jaxswarm.swarm.bug2 import bug2_path, direction_cosine
 from jaxswarm.swarm.walk import FORCED, edge_table, step_budget, walk
+
+DIRECTION_FLOOR = 1e-3
+"""Added to the direction desirability so that a move straight away from the goal stays possible."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -39,6 +49,7 @@ class ACOConfig:
       goal_heuristic: ACO*: divide each weight by ``d_j ** alpha_goal`` (goal taken when adjacent).
       max_min: Max-Min ACO (best ant deposits, pheromone bounds) instead of Ant System.
       global_best: Max-Min only: the best path so far deposits instead of this iteration's best.
+      improved: Improved Max-Min ACO (direction heuristic, Bug2-like first ant, floor only).
     """
 
     num_agents: int = 256
@@ -46,6 +57,7 @@ class ACOConfig:
     goal_heuristic: bool = False
     max_min: bool = False
     global_best: bool = False
+    improved: bool = False
 
     def __post_init__(self):
         if self.num_agents < 1:
@@ -106,8 +118,11 @@ jax.tree_util.register_dataclass(
 def transition_rule(config: ACOConfig, graph: Graph, task: Task, pheromone, params):
     """f32[N, K] log-weight of every edge (the walker's table): eq. 7 in its general form."""
     heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-    length = jnp.where(graph.nbr >= 0, graph.cost, 1.0)
-    logw = params.alpha * jnp.log(pheromone) - params.beta * jnp.log(length)
+    if config.improved:
+        eta = (1.0 + direction_cosine(graph, task.goal)) / 2.0 + DIRECTION_FLOOR
+    else:
+        eta = 1.0 / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
+    logw = params.alpha * jnp.log(pheromone) + params.beta * jnp.log(eta)
     if config.goal_heuristic:
         to_goal = jnp.linalg.norm(graph.xy - graph.xy[task.goal], axis=-1)
         logw = logw - params.alpha_goal * jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))[heads]
@@ -129,13 +144,27 @@ def _deposit(graph: Graph, pheromone, nodes, slots, amount):
                         jnp.maximum(back, 0)].add(value, mode="drop")
 
 
+def _reinforce(graph: Graph, pheromone, path, amount):
+    """Add the scalar ``amount`` on every edge of one padded path, both directions."""
+    return _deposit(graph, pheromone, path[None, :-1], step_slots(graph, path)[None],
+                    amount[None])
+
+
 def _build(config: ACOConfig, name: str) -> Swarm:
     def init(key, graph: Graph, task: Task, params) -> ACOState:
-        return ACOState(key=key,
-                        pheromone=jnp.full(graph.nbr.shape, params.tau0, jnp.float32),
-                        best_path=jnp.full((step_budget(graph, config.max_steps) + 1,), -1,
-                                           jnp.int32),
-                        best_cost=jnp.float32(jnp.inf))
+        length = step_budget(graph, config.max_steps) + 1
+        pheromone = jnp.full(graph.nbr.shape, params.tau0, jnp.float32)
+        if not config.improved:
+            return ACOState(key=key, pheromone=pheromone,
+                            best_path=jnp.full((length,), -1, jnp.int32),
+                            best_cost=jnp.float32(jnp.inf))
+        path, cost, found = bug2_path(graph, task.start, task.goal)
+        fits = found & (jnp.sum(path >= 0) <= length)  # a longer first path cannot be stored
+        path = jnp.where(fits, jnp.pad(path, (0, max(length - path.shape[0], 0)),
+                                       constant_values=-1)[:length], -1)
+        pheromone = _reinforce(graph, pheromone, path, jnp.where(fits, params.q, 0.0))
+        return ACOState(key=key, pheromone=pheromone, best_path=path,
+                        best_cost=jnp.where(fits, cost, jnp.inf).astype(jnp.float32))
 
     def step(state: ACOState, graph: Graph, task: Task, params):
         key, walk_key = jax.random.split(state.key)
@@ -145,20 +174,24 @@ def _build(config: ACOConfig, name: str) -> Swarm:
                     max_steps=step_budget(graph, config.max_steps))
         costs = jnp.where(ants.arrived, ants.length, jnp.inf)
         winner = jnp.argmin(costs)
-        improved = costs[winner] < state.best_cost
+        # The Improved Max-Min ACO keeps the latest of equally short paths (its "<=").
+        improved = ((costs[winner] <= state.best_cost) & jnp.isfinite(costs[winner])
+                    if config.improved else costs[winner] < state.best_cost)
         best_path = jnp.where(improved, ants.path[winner], state.best_path)
         best_cost = jnp.where(improved, costs[winner], state.best_cost)
         pheromone = (1.0 - params.rho) * state.pheromone
-        if not config.max_min:
+        if config.improved:
+            pheromone = _reinforce(graph, jnp.maximum(pheromone, params.tau_min), best_path,
+                                   jnp.where(jnp.isfinite(best_cost), params.q, 0.0))
+        elif not config.max_min:
             pheromone = _deposit(graph, pheromone, ants.path[:, :-1], ants.slots,
                                  jnp.where(ants.arrived, params.q / ants.length, 0.0))
         else:
             path, cost = ((best_path, best_cost) if config.global_best
                           else (ants.path[winner], costs[winner]))
             amount = jnp.where(jnp.isfinite(cost), params.q / cost, 0.0)
-            pheromone = _deposit(graph, pheromone, path[None, :-1], step_slots(graph, path)[None],
-                                 amount[None])
-            pheromone = jnp.clip(pheromone, params.tau_min, params.tau_max)
+            pheromone = jnp.clip(_reinforce(graph, pheromone, path, amount), params.tau_min,
+                                 params.tau_max)
         new_state = ACOState(key=key, pheromone=pheromone, best_path=best_path,
                              best_cost=best_cost)
         info = StepInfo(
@@ -197,6 +230,14 @@ def max_min_aco(num_agents: int = 256, max_steps: int | None = None,
     deposits, and pheromone stays within [tau_min, tau_max]."""
     return _build(ACOConfig(num_agents, max_steps, max_min=True, global_best=global_best),
                   "max_min_aco")
+
+
+@register("improved_max_min_aco")
+def improved_max_min_aco(num_agents: int = 50, max_steps: int | None = None) -> Swarm:
+    """Improved Max-Min ACO (the Max-Min ACO paper): direction heuristic, Bug2-like first ant,
+    evaporation floored at ``tau_min`` and ``q`` added on the best path after each population
+    of ``num_agents`` ants (50 in the paper)."""
+    return _build(ACOConfig(num_agents, max_steps, improved=True), "improved_max_min_aco")
 
 
 def _check(params: ACOParams) -> None:
