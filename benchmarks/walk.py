@@ -1,9 +1,10 @@
-"""Throughput and memory of the lockstep walker with the RFD* transition rule, on maze100.
+"""Throughput and memory of the lockstep walker with the RFD* and ant transition rules, on maze100.
 
-For each total agent count (drops x seeds: 64 = 64 x 1, 1,024 = 256 x 4, 16,384 = 256 x 64 by
-default) one RFD* walk per seed is run under ``vmap`` from the initial (flat) altitudes, jitted,
-after one warm-up call (compile excluded). Printed per configuration, as the median over
-``--repeats`` runs:
+For each swarm (``--swarms``, default RFD* and ACO*) and each total agent count (agents x seeds:
+64 = 64 x 1, 1,024 = 256 x 4, 16,384 = 256 x 64 by default) one walk per seed is run under
+``vmap`` from the swarm's initial memory (flat altitudes, uniform pheromone), jitted, after one
+warm-up call (compile excluded). Printed per configuration, as the median over ``--repeats``
+runs:
 
 * ``lockstep steps``: iterations of the walk's ``while_loop`` (under ``vmap`` every lane runs
   until the slowest lane's agents have all stopped),
@@ -31,7 +32,7 @@ import jax.numpy as jnp
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task
-from jaxswarm.swarm.rfd import transition_rule
+from jaxswarm.swarm import aco, rfd
 from jaxswarm.swarm.walk import step_budget, walk
 
 MiB = 2 ** 20
@@ -42,18 +43,23 @@ def machine() -> str:
             f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()})")
 
 
-def make_walks(map_name: str, drops: int, seeds: int):
-    """A jitted function key -> Walk (vmapped over ``seeds`` keys) and its inputs."""
+TRANSITION_RULES = {"rfd_star": rfd.transition_rule, "aco_star": aco.transition_rule}
+
+
+def make_walks(swarm_name: str, map_name: str, drops: int, seeds: int):
+    """A jitted function keys -> Walk (vmapped over ``seeds`` keys) and its inputs."""
     chosen = paper_map(map_name)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("rfd_star", num_agents=drops)
+    swarm = make(swarm_name, num_agents=drops)
     params = swarm.default_params
     steps = step_budget(graph, swarm.config.max_steps)
+    rule = TRANSITION_RULES[swarm_name]
 
     def one(key):
         state = swarm.init(key, graph, task, params)
-        table = transition_rule(swarm.config, graph, task, state.altitude, params)
+        memory = state.altitude if swarm_name == "rfd_star" else state.pheromone
+        table = rule(swarm.config, graph, task, memory, params)
         return walk(key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps)
 
     walks = jax.jit(jax.vmap(one))
@@ -61,8 +67,8 @@ def make_walks(map_name: str, drops: int, seeds: int):
     return walks, keys
 
 
-def measure(map_name: str, drops: int, seeds: int, repeats: int) -> dict:
-    walks, keys = make_walks(map_name, drops, seeds)
+def measure(swarm_name: str, map_name: str, drops: int, seeds: int, repeats: int) -> dict:
+    walks, keys = make_walks(swarm_name, map_name, drops, seeds)
     compiled = walks.lower(keys).compile()
     memory = compiled.memory_analysis()
     buffers = (memory.argument_size_in_bytes + memory.output_size_in_bytes
@@ -88,21 +94,25 @@ def measure(map_name: str, drops: int, seeds: int, repeats: int) -> dict:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default="maze100")
+    parser.add_argument("--swarms", default="rfd_star,aco_star",
+                        help=f"comma-separated, from {', '.join(TRANSITION_RULES)}")
     parser.add_argument("--layouts", default="64x1,256x4,256x64",
                         help="comma-separated DROPSxSEEDS")
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args(argv)
     print(f"machine: {machine()}")
-    print(f"RFD* walk on {args.map}, initial altitudes, median of {args.repeats} runs "
+    print(f"walks on {args.map} from the initial memory, median of {args.repeats} runs "
           "after a warm-up compile")
-    print(f"{'agents':>7} {'drops x seeds':>14} {'ms':>9} {'lockstep steps':>15} "
+    print(f"{'swarm':9} {'agents':>7} {'per x seeds':>12} {'ms':>9} {'lockstep steps':>15} "
           f"{'agent-steps/s':>14} {'moves/s':>11} {'XLA MiB':>8} {'peak RSS MiB':>13}")
-    for layout in args.layouts.split(","):
-        drops, seeds = (int(part) for part in layout.split("x"))
-        r = measure(args.map, drops, seeds, args.repeats)
-        print(f"{r['agents']:>7} {f'{drops} x {seeds}':>14} {1e3 * r['seconds']:>9.1f} "
-              f"{r['steps']:>15.0f} {r['agent_steps'] / 1e6:>12.1f} M {r['moves'] / 1e6:>9.1f} M "
-              f"{r['buffers']:>8.0f} {r['rss']:>13.0f}", flush=True)
+    for swarm_name in args.swarms.split(","):
+        for layout in args.layouts.split(","):
+            drops, seeds = (int(part) for part in layout.split("x"))
+            r = measure(swarm_name, args.map, drops, seeds, args.repeats)
+            print(f"{swarm_name:9} {r['agents']:>7} {f'{drops} x {seeds}':>12} "
+                  f"{1e3 * r['seconds']:>9.1f} {r['steps']:>15.0f} "
+                  f"{r['agent_steps'] / 1e6:>12.1f} M {r['moves'] / 1e6:>9.1f} M "
+                  f"{r['buffers']:>8.0f} {r['rss']:>13.0f}", flush=True)
     return 0
 
 

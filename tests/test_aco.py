@@ -105,3 +105,21 @@ def test_improved_max_min_starts_from_the_bug2_path_and_keeps_the_floor():
         state, _ = swarm.step(state, graph, task, params)
     assert float(state.best_cost) <= float(cost)
     assert np.asarray(state.pheromone).min() >= float(params.tau_min) * (1 - 1e-6)
+
+
+def test_path_map_study_reproduces_the_papers_ordering_on_a_small_map():
+    import importlib.util
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "sweeps" / "aco_pathmaps.py"
+    spec = importlib.util.spec_from_file_location("aco_pathmaps", script)
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    rows = {row["algorithm"]: row for row in study.compare(10, 10, seed=0, runs=3, ants=50,
+                                                            max_ants=1500, patience=10)}
+    assert set(rows) == set(study.ALGORITHMS)
+    for row in rows.values():
+        assert row["min_ratio"] >= 1 - 1e-6 and row["found"] == 3  # no ant beats the optimum
+    improved = rows["Improved Max-Min ACO"]["mean_length"]
+    assert improved <= rows["Ant System"]["mean_length"]
+    assert improved <= rows["Max-Min ACO"]["mean_length"]
