@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution, as_node
+from jaxswarm.paths import as_node
 
 
 class Task(NamedTuple):
