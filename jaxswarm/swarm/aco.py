@@ -30,7 +30,7 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, step_slots
-from jaxswarm.swarm.core import StepInfo, Swarm, Task, check_positive, register
+from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
 from jaxswarm.swarm.bug2 import bug2_path, direction_cosine
 from jaxswarm.swarm.walk import FORCED, edge_table, step_budget, walk
 
@@ -60,10 +60,7 @@ class ACOConfig:
     improved: bool = False
 
     def __post_init__(self):
-        if self.num_agents < 1:
-            raise ValueError(f"num_agents must be at least 1, got {self.num_agents}")
-        if self.max_steps is not None and self.max_steps < 1:
-            raise ValueError(f"max_steps must be at least 1, got {self.max_steps}")
+        check_sizes(self.num_agents, self.max_steps)
         if self.global_best and not self.max_min:
             raise ValueError("global_best is a Max-Min ACO switch (max_min=True)")
 
@@ -175,13 +172,9 @@ def _build(config: ACOConfig, name: str) -> Swarm:
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
                     max_steps=step_budget(graph, config.max_steps))
-        costs = jnp.where(ants.arrived, ants.length, jnp.inf)
-        winner = jnp.argmin(costs)
         # The Improved Max-Min ACO keeps the latest of equally short paths (its "<=").
-        improved = ((costs[winner] <= state.best_cost) & jnp.isfinite(costs[winner])
-                    if config.improved else costs[winner] < state.best_cost)
-        best_path = jnp.where(improved, ants.path[winner], state.best_path)
-        best_cost = jnp.where(improved, costs[winner], state.best_cost)
+        best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
+                                               ties=config.improved)
         pheromone = (1.0 - params.rho) * state.pheromone
         if config.improved:
             pheromone = _reinforce(graph, jnp.maximum(pheromone, params.tau_min), best_path,
@@ -190,19 +183,14 @@ def _build(config: ACOConfig, name: str) -> Swarm:
             pheromone = _deposit(graph, pheromone, ants.path[:, :-1], ants.slots,
                                  jnp.where(ants.arrived, params.q / ants.length, 0.0))
         else:
+            winner = jnp.argmin(jnp.where(ants.arrived, ants.length, jnp.inf))
             path, cost = ((best_path, best_cost) if config.global_best
-                          else (ants.path[winner], costs[winner]))
+                          else (ants.path[winner], info.iteration_cost))
             amount = jnp.where(jnp.isfinite(cost), params.q / cost, 0.0)
             pheromone = jnp.clip(_reinforce(graph, pheromone, path, amount), params.tau_min,
                                  params.tau_max)
-        new_state = ACOState(key=key, pheromone=pheromone, best_path=best_path,
-                             best_cost=best_cost)
-        info = StepInfo(
-            iteration_cost=costs[winner],
-            arrived=jnp.mean(ants.arrived.astype(jnp.float32)),
-            converged=jnp.all(ants.arrived) & jnp.all(ants.path == ants.path[:1]),
-        )
-        return new_state, info
+        return ACOState(key=key, pheromone=pheromone, best_path=best_path,
+                        best_cost=best_cost), info
 
     def best(state: ACOState) -> Solution:
         return Solution(path=state.best_path, cost=state.best_cost,

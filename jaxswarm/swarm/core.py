@@ -176,6 +176,36 @@ def _run(swarm, key, graph, task, params, iterations, patience):
     return state, trace
 
 
+def check_sizes(num_agents: int, max_steps: int | None) -> None:
+    """Static config check shared by the swarms: at least one agent and one step."""
+    if num_agents < 1:
+        raise ValueError(f"num_agents must be at least 1, got {num_agents}")
+    if max_steps is not None and max_steps < 1:
+        raise ValueError(f"max_steps must be at least 1, got {max_steps}")
+
+
+def keep_best(walk, best_path, best_cost, *, ties: bool = False):
+    """The bookkeeping every swarm does after its agents walked.
+
+    Args:
+      walk: the iteration's :class:`jaxswarm.swarm.walk.Walk`.
+      best_path: i32[L] the best path so far; best_cost: f32[] its length.
+      ties: take this iteration's best also when it only equals the best so far.
+
+    Returns:
+      ``(best_path, best_cost, StepInfo)`` updated with this iteration's best arrived agent.
+    """
+    costs = jnp.where(walk.arrived, walk.length, jnp.inf)
+    winner = jnp.argmin(costs)
+    cost = costs[winner]
+    better = ((cost <= best_cost) & jnp.isfinite(cost)) if ties else cost < best_cost
+    info = StepInfo(iteration_cost=cost,
+                    arrived=jnp.mean(walk.arrived.astype(jnp.float32)),
+                    converged=jnp.all(walk.arrived) & jnp.all(walk.path == walk.path[:1]))
+    return (jnp.where(better, walk.path[winner], best_path), jnp.where(better, cost, best_cost),
+            info)
+
+
 def check_positive(name: str, value, *, allow_zero: bool = False) -> None:
     """Host-side check of a scalar (or array) param: finite and positive (or non-negative)."""
     array = np.asarray(value, dtype=np.float64)

@@ -33,7 +33,7 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution
-from jaxswarm.swarm.core import StepInfo, Swarm, Task, check_positive, register
+from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
 from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, walk
 
 
@@ -55,10 +55,7 @@ class RFDConfig:
     exponential_erosion: bool = False
 
     def __post_init__(self):
-        if self.num_agents < 1:
-            raise ValueError(f"num_agents must be at least 1, got {self.num_agents}")
-        if self.max_steps is not None and self.max_steps < 1:
-            raise ValueError(f"max_steps must be at least 1, got {self.max_steps}")
+        check_sizes(self.num_agents, self.max_steps)
         if self.exponential_erosion and not self.modified:
             raise ValueError("exponential_erosion needs the modified RFD* (p_base)")
 
@@ -153,21 +150,9 @@ def _build(config: RFDConfig, name: str) -> Swarm:
                      num_agents=config.num_agents,
                     max_steps=step_budget(graph, config.max_steps))
         altitude = _erode_and_deposit(config, graph, task, state.altitude, drops, params)
-        costs = jnp.where(drops.arrived, drops.length, jnp.inf)
-        winner = jnp.argmin(costs)
-        improved = costs[winner] < state.best_cost
-        new_state = RFDState(
-            key=key,
-            altitude=altitude,
-            best_path=jnp.where(improved, drops.path[winner], state.best_path),
-            best_cost=jnp.where(improved, costs[winner], state.best_cost),
-        )
-        info = StepInfo(
-            iteration_cost=costs[winner],
-            arrived=jnp.mean(drops.arrived.astype(jnp.float32)),
-            converged=jnp.all(drops.arrived) & jnp.all(drops.path == drops.path[:1]),
-        )
-        return new_state, info
+        best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
+        return RFDState(key=key, altitude=altitude, best_path=best_path,
+                        best_cost=best_cost), info
 
     def best(state: RFDState) -> Solution:
         return Solution(path=state.best_path, cost=state.best_cost,
