@@ -67,9 +67,10 @@ def run_demo(args: argparse.Namespace) -> int:
         milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
         rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
     for label, name_in_registry in SWARM_PLANNERS.items():
-        solution, trace, state, milliseconds = _run_swarm(name_in_registry, graph, start, goal,
-                                                          args)
-        solutions[label], traces[label] = solution, (trace, state)
+        swarm = make(name_in_registry, num_agents=args.drops)
+        state, trace, milliseconds = _run_swarm(swarm, graph, start, goal, args)
+        solution = solutions[label] = swarm.best(state)
+        traces[label] = (swarm, state, trace)
         rows.append((label, solution.cost, "-", int(trace.iterations), f"{milliseconds:.2f}"))
     reference = solutions["Dijkstra"].cost
     print(_table(("planner", "length", "gap", "expanded", "iterations", "time [ms]"),
@@ -81,8 +82,7 @@ def run_demo(args: argparse.Namespace) -> int:
                          title=f"{name}: exact and swarm planners")
     plt.close(fig)
     print(f"figure written to {args.out}")
-    for label, (trace, state) in traces.items():
-        swarm = make(SWARM_PLANNERS[label], num_agents=args.drops)
+    for label, (swarm, state, trace) in traces.items():
         out = args.out.with_name(f"{args.out.stem}_{swarm.name}{args.out.suffix}")
         fig = plot_swarm_run(graph, swarm.memory(state), solutions[label], trace, start=start,
                              goal=goal, optimum=reference, field_label=swarm.memory_label,
@@ -92,9 +92,9 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_swarm(registry_name: str, graph, start, goal, args):
-    """Run one swarm planner: compile once, then the median time of ``args.repeats`` runs."""
-    swarm = make(registry_name, num_agents=args.drops)
+def _run_swarm(swarm, graph, start, goal, args):
+    """Run one swarm planner: compile once, then ``(state, trace, median ms)`` of
+    ``args.repeats`` timed runs."""
     task = make_task(graph, start, goal)
     key = jax.random.key(args.seed)
 
@@ -108,7 +108,7 @@ def _run_swarm(registry_name: str, graph, start, goal, args):
         began = time.perf_counter()
         state, trace = once()
         times.append(time.perf_counter() - began)
-    return swarm.best(state), trace, state, statistics.median(times) * 1e3
+    return state, trace, statistics.median(times) * 1e3
 
 
 def _load(args):
