@@ -132,13 +132,97 @@ def test_erosion_and_deposits_follow_the_paper(maze):
     assert 0.0 <= float(info.arrived) <= 1.0
 
 
-def test_no_erosion_and_no_sediment_leave_altitudes_alone(maze):
+@pytest.mark.parametrize("law", ["linear", "exponential"])
+def test_no_erosion_and_no_sediment_leave_altitudes_alone(maze, law):
     graph, task, _ = maze
-    swarm = make("rfd_star", num_agents=32)
+    swarm = make("rfd_star", num_agents=32, erosion_law=law)
     params = swarm.default_params._replace(erosion=jnp.float32(0.0), sediment=jnp.float32(0.0))
     state = swarm.init(jax.random.key(0), graph, task, params)
     stepped, _ = swarm.step(state, graph, task, params)
     np.testing.assert_array_equal(stepped.altitude, state.altitude)
+
+
+@pytest.fixture(scope="module")
+def corridor():
+    """A 1 x 5 corridor from (0, 0) to (4, 0): every drop walks the same four unit edges."""
+    graph = grid_graph(np.zeros((1, 5), bool))
+    return graph, make_task(graph, (0, 0), (4, 0))
+
+
+def one_iteration(swarm, graph, task, **params):
+    params = swarm.default_params._replace(**{k: jnp.float32(v) for k, v in params.items()})
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    state, info = swarm.step(state, graph, task, params)
+    assert float(info.arrived) == 1.0
+    return np.asarray(state.altitude)
+
+
+def test_linear_erosion_is_eqs_4_and_5(corridor):
+    # Only edge 3 -> 4 has a gradient (1 - 0) / 1: node 3 loses E / (N - 1) summed over the D
+    # drops; eq. 5 then gives every node that total / (N - 1); the goal is reset to 0.
+    graph, task = corridor
+    swarm = make("rfd_star", num_agents=8, erosion_law="linear")
+    altitude = one_iteration(swarm, graph, task, initial_height=1.0, erosion=1.0, sediment=0.0)
+    np.testing.assert_allclose(altitude, [1 + 1 / 16, 1 + 1 / 16, 1 + 1 / 16,
+                                          1 - 1 / 4 + 1 / 16, 0.0], rtol=1e-6)
+
+
+def test_exponential_erosion_also_erodes_flat_ground(corridor):
+    # p_base ** gradient: 1 on the three flat edges, p_base = 2 on the last one.
+    graph, task = corridor
+    swarm = make("rfd_star", num_agents=8, erosion_law="exponential")
+    altitude = one_iteration(swarm, graph, task, p_base=2.0, initial_height=1.0, erosion=1.0,
+                             sediment=0.0)
+    produced = (3 + 2) / 4
+    np.testing.assert_allclose(altitude, [1 - 1 / 4 + produced / 4] * 3
+                               + [1 - 2 / 4 + produced / 4, 0.0], rtol=1e-6)
+
+
+def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corridor):
+    graph, task = corridor
+    swarm = make("rfd_star", num_agents=8)
+    altitude = one_iteration(swarm, graph, task, erosion=0.5, initial_height=100.0)
+    np.testing.assert_allclose(altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
+    # A higher slope cuts less deep, and the bed never rises: min(old, new) per node.
+    params = swarm.default_params._replace(erosion=jnp.float32(0.5),
+                                           initial_height=jnp.float32(100.0))
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    state, _ = swarm.step(state, graph, task, params)
+    state, _ = swarm.step(state, graph, task, params._replace(erosion=jnp.float32(2.0)))
+    np.testing.assert_allclose(state.altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
+
+
+def test_graded_drops_climb_out_of_a_carved_bed_at_most_climb_steep():
+    from jaxswarm.swarm import rfd
+    graph = grid_graph(np.zeros((2, 3), bool))  # nodes 0 1 2 / 3 4 5, goal 2
+    task = make_task(graph, (0, 0), (2, 0))
+    swarm = make("rfd_star", num_agents=4)
+    params = swarm.default_params
+    plateau = float(params.initial_height)
+    altitude = jnp.array([2.0, 1.0, 0.0, plateau, plateau + 5, plateau], jnp.float32)
+    table = np.asarray(rfd.transition_rule(swarm.config, graph, task, altitude, params))
+    nbr = np.asarray(graph.nbr)
+    log_p, alpha = math.log(float(params.p_base)), float(params.alpha)
+
+    def logw(i, j):
+        return table[i, list(nbr[i]).index(j)]
+
+    # Carved node 0 -> plateau node 3: the uphill gradient is floored at -climb.
+    expected = -float(params.climb) * log_p - alpha * math.log(math.hypot(2, 1))
+    assert logw(0, 3) == pytest.approx(expected, rel=1e-5)
+    assert logw(0, 1) == pytest.approx(1.0 * log_p - alpha * math.log(1.0), rel=1e-5)
+    # Uncarved node 3 -> the deposit hill at 4 (5 higher): too steep, banned.
+    assert logw(3, 4) == -np.inf
+    # Uncarved 5 -> the hill at 4 is banned too; the goal is forced whenever adjacent.
+    assert logw(5, 4) == -np.inf and logw(1, 2) > 1e29
+
+
+def test_erosion_law_is_checked():
+    with pytest.raises(ValueError, match="unknown erosion_law 'sideways'; choose one of linear"):
+        make("rfd_star", erosion_law="sideways")
+    from jaxswarm.swarm.rfd import RFDConfig
+    with pytest.raises(ValueError, match="erosion_law 'graded' needs the modified RFD"):
+        RFDConfig(modified=False, erosion_law="graded")
 
 
 def test_unreachable_goal_is_a_clean_not_found_result():
@@ -163,6 +247,7 @@ def test_unreachable_goal_is_a_clean_not_found_result():
     ("p_base", -2.0, "p_base must be positive"),
     ("alpha", float("inf"), "alpha must be finite"),
     ("sediment", -1.0, "sediment must be non-negative"),
+    ("erosion", 0.0, "erosion must be positive"),  # the graded law's slope
 ])
 def test_bad_params_are_named(maze, field, value, message):
     graph, task, _ = maze

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import inspect
 from typing import Any, Callable, NamedTuple
 
 import jax
@@ -235,9 +236,18 @@ def make(name: str, **config) -> Swarm:
     Raises:
       ValueError: unknown name (the message lists the registered ones) or bad config.
     """
+    return _factory(name)(**config)
+
+
+def config_options(name: str) -> tuple[str, ...]:
+    """The keyword options (static config) of the registered swarm ``name``'s factory."""
+    return tuple(inspect.signature(_factory(name)).parameters)
+
+
+def _factory(name: str) -> Callable[..., Swarm]:
     if name not in _REGISTRY:
         raise ValueError(f"unknown swarm {name!r}; registered: {', '.join(sorted(_REGISTRY))}")
-    return _REGISTRY[name](**config)
+    return _REGISTRY[name]
 
 
 def registered() -> tuple[str, ...]:

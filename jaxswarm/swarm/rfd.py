@@ -10,18 +10,35 @@ choosing among admissible neighbours ``j`` of their node ``i`` by the gradient
 * RFD* (eq. 6): weight ``p_base ** gradient / d_j ** alpha`` for every admissible neighbour, with
   ``d_j`` the straight-line distance from ``j`` to the goal; the goal is taken whenever adjacent.
 
-After the walk, each edge ``i -> j`` of every path that reached the goal erodes node ``i`` by
+After the walk the drops that reached the goal erode their paths, by one of three laws
+(``erosion_law``; the original RFD always uses ``"linear"``):
 
-    erosion(i, j) = E / ((N - 1) * D) * gradient(i, j)                               (eq. 4)
+* ``"linear"`` (eq. 4): each edge ``i -> j`` of an arrived path erodes node ``i`` by
+  ``E / ((N - 1) * D) * gradient(i, j)`` (negative gradients erode nothing); then every node gains
+  ``erosionProduced / (N - 1)`` (eq. 5).
+* ``"exponential"``: the same with ``p_base ** gradient`` in place of ``gradient`` (the exponential
+  form the paper suggests for erosion too; it also erodes flat ground), and eq. 5.
+* ``"graded"`` (RFD*'s default, our law): a river cuts its bed down to a graded profile, so a
+  drop that arrived lowers every node of its path to ``E * (length still to walk to the goal)``
+  when that is lower than the node's altitude. The altitude of a carved node is then ``E`` times
+  the shortest route to the goal any drop has walked from it, and at a fork the branch with the
+  shorter remainder is the steeper one, whichever drop found it. Ground that no drop has carved
+  stays at ``initial_height`` (keep it above ``E`` times the longest walk); a drop standing in a
+  carved bed climbs onto it as if the slope were at most ``climb`` steep, so it keeps looking
+  for shortcuts beside its river (weight ``p_base ** -climb`` at worst). No eq. 5 sediment: the
+  profile is not levelled.
 
-(negative gradients erode nothing) or, as an RFD* option, by ``E / ((N - 1) * D) *
-p_base ** gradient`` (the exponential form the paper suggests, which also erodes flat ground). A
-drop that got stuck deposits ``sediment`` where it stands. RFD* drops do not climb slopes steeper
-than ``climb``: a drop whose only moves are steeper is stuck too, so deposits fill a blind alley
-from its end back to its entrance and later drops avoid it (the paper's "reduces the likelihood
-of transition to blind alleys"; without it a one-cell-wide dead end never fills). Finally every
-node gains ``erosionProduced / (N - 1)`` (eq. 5), altitudes are kept non-negative and the goal
-is reset to 0. Drops that run out of steps simply evaporate.
+Why a third law: with eqs. 4 and 5 an altitude difference has to travel back from the goal one
+node per iteration and reflects how often an edge was used rather than how short the paths
+through it were; on the paper's 50 x 50 and 100 x 100 maps this converged to long paths within
+100 iterations for every setting we tried (``sweeps/rfd_static.py`` reports both laws).
+
+A drop that got stuck deposits ``sediment`` where it stands. RFD* drops do not climb slopes
+steeper than ``climb`` on uncarved ground: a drop whose only moves are steeper is stuck too, so
+deposits fill a blind alley from its end back to its entrance and later drops avoid it (the
+paper's "reduces the likelihood of transition to blind alleys"; without it a one-cell-wide dead
+end never fills). Altitudes are kept non-negative and the goal is reset to 0. Drops that run out
+of steps simply evaporate.
 """
 from __future__ import annotations
 
@@ -37,6 +54,10 @@ from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_b
 from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, walk
 
 
+EROSION_LAWS = ("linear", "exponential", "graded")
+"""How arrived drops erode their paths (see the module docstring)."""
+
+
 @dataclasses.dataclass(frozen=True)
 class RFDConfig:
     """Static sizes and switches.
@@ -46,18 +67,23 @@ class RFDConfig:
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
       modified: RFD* (eq. 6) instead of the original RFD (eq. 1).
-      exponential_erosion: RFD* only: erode by ``p_base ** gradient`` instead of ``gradient``.
+      erosion_law: one of ``EROSION_LAWS`` (see the module docstring); the original RFD only
+        has ``"linear"``.
     """
 
     num_agents: int = 256
     max_steps: int | None = None
     modified: bool = True
-    exponential_erosion: bool = False
+    erosion_law: str = "graded"
 
     def __post_init__(self):
         check_sizes(self.num_agents, self.max_steps)
-        if self.exponential_erosion and not self.modified:
-            raise ValueError("exponential_erosion needs the modified RFD* (p_base)")
+        if self.erosion_law not in EROSION_LAWS:
+            raise ValueError(f"unknown erosion_law {self.erosion_law!r}; "
+                             f"choose one of {', '.join(EROSION_LAWS)}")
+        if self.erosion_law != "linear" and not self.modified:
+            raise ValueError(f"erosion_law {self.erosion_law!r} needs the modified RFD* "
+                             "(the original RFD erodes by eq. 4 only)")
 
 
 class RFDParams(NamedTuple):
@@ -84,11 +110,14 @@ class RFDStarParams(NamedTuple):
     Attributes:
       p_base: base of the exponential transition weight ``p_base ** gradient``.
       alpha: exponent of the goal-distance heuristic ``1 / d_j ** alpha``.
-      initial_height: altitude of every node but the goal at the start.
-      erosion: E in eq. 4.
+      initial_height: altitude of every node but the goal at the start (graded law: the
+        uncarved plateau, above ``erosion`` times the longest walk).
+      erosion: E in eq. 4 (linear and exponential laws); the graded law's slope, altitude per
+        unit of path still to walk.
       sediment: what a stuck drop deposits where it stands.
-      climb: the steepest uphill gradient a drop will take; a drop whose only moves are steeper
-        is stuck (so deposits fill blind alleys from their end back to their entrance).
+      climb: the steepest uphill gradient a drop on uncarved ground will take; a drop whose only
+        moves are steeper is stuck (so deposits fill blind alleys from their end back to their
+        entrance). Graded law: from a carved node, uphill moves count as at most this steep.
     """
 
     p_base: jax.Array
@@ -109,8 +138,12 @@ def _f32(**values):
 
 DEFAULT_RFD = RFDParams(**_f32(initial_height=1.0, erosion=1.0, sediment=0.1, omega=0.1,
                                delta=0.1))
-DEFAULT_RFD_STAR = RFDStarParams(**_f32(p_base=50.0, alpha=50.0, initial_height=1.0,
-                                        erosion=50.0, sediment=0.3, climb=0.3))
+DEFAULT_RFD_STAR = RFDStarParams(**_f32(p_base=10.0, alpha=7.0, initial_height=1e4,
+                                        erosion=1.0, sediment=0.3, climb=1.0))
+"""Defaults for the graded law (tuned on the nine paper maps, see ``sweeps/rfd_static.py``)."""
+DEFAULT_RFD_STAR_EQ4 = RFDStarParams(**_f32(p_base=50.0, alpha=50.0, initial_height=1.0,
+                                            erosion=50.0, sediment=0.3, climb=0.3))
+"""Defaults for the linear and exponential laws (eqs. 4 and 5)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -158,8 +191,12 @@ def _build(config: RFDConfig, name: str) -> Swarm:
         return Solution(path=state.best_path, cost=state.best_cost,
                         found=jnp.isfinite(state.best_cost))
 
-    defaults, check = ((DEFAULT_RFD_STAR, _check_rfd_star) if config.modified
-                       else (DEFAULT_RFD, _check_rfd))
+    if not config.modified:
+        defaults, check = DEFAULT_RFD, _check_rfd
+    elif config.erosion_law == "graded":
+        defaults, check = DEFAULT_RFD_STAR, _check_graded
+    else:
+        defaults, check = DEFAULT_RFD_STAR_EQ4, _check_rfd_star
     return Swarm(name=name, config=config, init=init, step=step, best=best,
                  default_params=defaults, check_params=check,
                  memory=lambda state: state.altitude, memory_label="altitude")
@@ -168,21 +205,21 @@ def _build(config: RFDConfig, name: str) -> Swarm:
 @register("rfd")
 def rfd(num_agents: int = 256, max_steps: int | None = None) -> Swarm:
     """The original River Formation Dynamics (eqs. 1-5), with RFDParams."""
-    return _build(RFDConfig(num_agents, max_steps, modified=False, exponential_erosion=False),
-                  "rfd")
+    return _build(RFDConfig(num_agents, max_steps, modified=False, erosion_law="linear"), "rfd")
 
 
 @register("rfd_star")
 def rfd_star(num_agents: int = 256, max_steps: int | None = None,
-             exponential_erosion: bool = False) -> Swarm:
-    """The modified RFD* (eq. 6), with RFDStarParams."""
-    return _build(RFDConfig(num_agents, max_steps, True, exponential_erosion), "rfd_star")
+             erosion_law: str = "graded") -> Swarm:
+    """The modified RFD* (eq. 6), with RFDStarParams; ``erosion_law`` one of EROSION_LAWS."""
+    return _build(RFDConfig(num_agents, max_steps, True, erosion_law), "rfd_star")
 
 
 def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, params):
     """f32[N, K] log-weight of every edge for altitudes f32[N] (the walker's table, see
     :func:`jaxswarm.swarm.walk.edge_table`): eq. 1 for RFD; eq. 6 for RFD*, plus its climb limit
-    and the goal taken whenever adjacent."""
+    (a floor on the uphill gradient out of a carved bed, under the graded law) and the goal taken
+    whenever adjacent."""
     heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
     gradient = (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
     if config.modified:
@@ -190,8 +227,13 @@ def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, param
         # Nodes at distance 0 from the goal other than the goal (general graphs without
         # coordinates) get a neutral heuristic instead of log(0).
         log_distance = jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
+        too_steep = gradient < -params.climb
+        if config.erosion_law == "graded":
+            carved = (altitude < params.initial_height)[:, None]
+            too_steep = too_steep & ~carved
+            gradient = jnp.where(carved, jnp.maximum(gradient, -params.climb), gradient)
         logw = gradient * jnp.log(params.p_base) - params.alpha * log_distance[heads]
-        logw = jnp.where(gradient < -params.climb, -jnp.inf, logw)
+        logw = jnp.where(too_steep, -jnp.inf, logw)
         logw = jnp.where(heads == task.goal, FORCED, logw)
     else:
         weight = jnp.where(gradient > 0, gradient,
@@ -202,25 +244,45 @@ def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, param
 
 def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, drops: Walk,
                        params):
-    """Eqs. 4 and 5: erosion along arrived paths, sediment of stuck drops, uniform sediment."""
+    """One iteration's erosion (by ``config.erosion_law``) and the sediment of stuck drops."""
     n = graph.num_nodes
-    here, there = drops.path[:, :-1], drops.path[:, 1:]
     moved = (drops.slots >= 0) & drops.arrived[:, None]
-    here_safe = jnp.where(moved, here, 0)
-    there_safe = jnp.where(moved, there, 0)
-    distance = graph.cost[here_safe, jnp.maximum(drops.slots, 0).astype(jnp.int32)]
-    gradient = (altitude[here_safe] - altitude[there_safe]) / jnp.where(moved, distance, 1.0)
-    if config.exponential_erosion:
+    here = jnp.where(moved, drops.path[:, :-1], 0)
+    distance = jnp.where(moved, graph.cost[here, jnp.maximum(drops.slots, 0).astype(jnp.int32)],
+                         0.0)
+    if config.erosion_law == "graded":
+        altitude = _carve_graded(altitude, here, moved, distance, drops.length, params)
+    else:
+        altitude = _erode_eq4(config, altitude, drops, here, moved, distance, params)
+    stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
+    altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
+    return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
+
+
+def _erode_eq4(config: RFDConfig, altitude, drops: Walk, here, moved, distance, params):
+    """Eqs. 4 and 5 (or the exponential form of eq. 4): f32[N] altitudes after erosion."""
+    n = altitude.shape[0]
+    there = jnp.where(moved, drops.path[:, 1:], 0)
+    gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
+    if config.erosion_law == "exponential":
         # p_base ** gradient, capped so that a cliff cannot overflow float32.
         shape = jnp.exp(jnp.minimum(gradient * jnp.log(params.p_base), MAX_LOG_EROSION))
     else:
         shape = jnp.maximum(gradient, 0.0)
     amount = jnp.where(moved, params.erosion / ((n - 1) * config.num_agents) * shape, 0.0)
-    altitude = altitude.at[here_safe].add(-amount)
-    stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
-    altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
-    altitude = altitude + jnp.sum(amount) / (n - 1)
-    return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
+    altitude = altitude.at[here].add(-amount)
+    return altitude + jnp.sum(amount) / (n - 1)
+
+
+def _carve_graded(altitude, here, moved, distance, length, params):
+    """The graded law: f32[N] altitudes after each arrived path (nodes ``here`` i32[A, L - 1],
+    edge lengths ``distance`` f32[A, L - 1], path lengths ``length`` f32[A]) lowered its nodes to
+    ``erosion`` times the length still to walk from them."""
+    n = altitude.shape[0]
+    to_walk = length[:, None] - jnp.cumsum(distance, axis=1) + distance
+    bed = jnp.full((n,), jnp.inf, altitude.dtype).at[jnp.where(moved, here, n)].min(
+        params.erosion * to_walk, mode="drop")
+    return jnp.minimum(altitude, bed)
 
 
 def _check_rfd(params: RFDParams) -> None:
@@ -238,3 +300,8 @@ def _check_rfd_star(params: RFDStarParams) -> None:
     check_positive("erosion", params.erosion, allow_zero=True)
     check_positive("sediment", params.sediment, allow_zero=True)
     check_positive("climb", params.climb, allow_zero=True)
+
+
+def _check_graded(params: RFDStarParams) -> None:
+    _check_rfd_star(params)
+    check_positive("erosion", params.erosion)  # the slope: 0 would flatten every bed to the sea
