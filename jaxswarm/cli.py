@@ -3,6 +3,10 @@
 ``jaxswarm demo`` plans on one of the RFD paper's maps (or a Moving AI ``.map`` file) with the
 exact planners and the swarm planners, prints a comparison table (length, optimality gap, work,
 time) and writes figures of the paths and of the swarms' memory and convergence.
+
+``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
+:mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
+map.
 """
 from __future__ import annotations
 
@@ -38,11 +42,39 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--drops", type=int, default=256, help="agents per swarm iteration")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
     demo.add_argument("--out", type=Path, default=Path("out/demo.png"), help="figure path")
+    sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
+    sweep.add_argument("file", type=Path, help="the sweep spec (TOML)")
+    sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
+    sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
+    sweep.add_argument("--no-plots", action="store_true", help="write no figures")
     args = parser.parse_args(argv)
     try:
-        return run_demo(args)
+        return run_demo(args) if args.command == "demo" else run_sweep_command(args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
+
+
+def run_sweep_command(args: argparse.Namespace) -> int:
+    """Check the spec (before any compute), run or resume the sweep, plot, print a summary."""
+    from jaxswarm.sweep import default_out, load_spec, run_sweep
+    from jaxswarm.sweep.plots import plot_sweep, summary
+
+    spec = load_spec(args.file)
+    out = args.out if args.out is not None else default_out(spec)
+    print(f"sweep {spec.name}: {spec.algorithm}, {len(spec.maps)} map(s) x {len(spec.grid())} "
+          f"param combination(s) x {len(spec.seeds)} seed(s) = {spec.num_runs * len(spec.maps)} "
+          f"runs -> {out}")
+    frame = run_sweep(spec, out, progress=not args.no_progress)
+    swept = list(spec.params)
+    if swept and not args.no_plots:
+        for path in plot_sweep(frame, swept, out):
+            print(f"wrote {path}")
+    table = summary(frame, ["map", *swept])
+    best = table.sort_values(["success", "gap"], ascending=[False, True]).groupby(
+        "map", sort=False).head(1)
+    print("best params per map (highest success rate, then lowest mean gap):")
+    print(best.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    return 0
 
 
 def run_demo(args: argparse.Namespace) -> int:

@@ -1,0 +1,8 @@
+"""Parameter sweeps: specs as TOML data (``spec``), the batched, sharded, resumable runner
+(``runner``), the Parquet results store (``store``) and plots of the results (``plots``)."""
+from jaxswarm.sweep.runner import SUCCESS_GAP, default_out, run_sweep
+from jaxswarm.sweep.spec import SpecError, SweepSpec, load_spec, spec_from_dict
+from jaxswarm.sweep.store import ResultsStore, StoreMismatchError, read_results
+
+__all__ = ["SUCCESS_GAP", "ResultsStore", "SpecError", "StoreMismatchError", "SweepSpec",
+           "default_out", "load_spec", "read_results", "run_sweep", "spec_from_dict"]

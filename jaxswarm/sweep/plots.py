@@ -1,0 +1,116 @@
+"""Figures from a sweep's results: heat maps over two params, lines over one, faceted by map.
+
+Every function takes the DataFrame of :func:`jaxswarm.sweep.read_results` (one row per run with
+the swept params as columns) and aggregates over seeds (and over any params not drawn).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib import patheffects  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from jaxswarm.plot import save_png  # noqa: E402
+
+METRICS = {"success": "success rate", "gap": "mean gap to the optimum"}
+
+
+def _check_columns(frame: pd.DataFrame, *columns: str) -> None:
+    missing = [c for c in columns if c not in frame.columns]
+    if missing:
+        raise ValueError(f"no column {', '.join(map(repr, missing))} in the results (columns: "
+                         f"{', '.join(frame.columns)})")
+
+
+def summary(frame: pd.DataFrame, by: list[str]) -> pd.DataFrame:
+    """Per group of ``by`` columns: runs, success rate, mean and std of the gap (inf gaps, i.e.
+    runs without a path, count as failures and are left out of the gap), found rate."""
+    _check_columns(frame, *by, "success", "gap", "found")
+    finite = frame.assign(gap=frame["gap"].where(np.isfinite(frame["gap"])))
+    grouped = finite.groupby(by, sort=True)
+    return pd.DataFrame(dict(runs=grouped.size(), success=grouped["success"].mean(),
+                             found=grouped["found"].mean(), gap=grouped["gap"].mean(),
+                             gap_std=grouped["gap"].std(ddof=0))).reset_index()
+
+
+def heatmap_figure(frame: pd.DataFrame, x: str, y: str, metric: str = "success"):
+    """A figure with one heat map per map: ``metric`` (``"success"`` or ``"gap"``) over params
+    ``x`` (columns) and ``y`` (rows), each cell annotated with its value."""
+    if metric not in METRICS:
+        raise ValueError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
+    table = summary(frame, ["map", y, x])
+    maps = list(dict.fromkeys(frame["map"]))
+    fig, axes = plt.subplots(1, len(maps), figsize=(4.2 * len(maps), 3.8), squeeze=False)
+    for ax, name in zip(axes[0], maps):
+        grid = table[table["map"] == name].pivot(index=y, columns=x, values=metric)
+        image = ax.imshow(grid.to_numpy(dtype=float), origin="lower", aspect="auto",
+                          cmap="viridis" if metric == "success" else "magma_r",
+                          vmin=0.0 if metric == "success" else None,
+                          vmax=1.0 if metric == "success" else None)
+        ax.set_xticks(range(grid.shape[1]), [f"{v:g}" for v in grid.columns], rotation=45)
+        ax.set_yticks(range(grid.shape[0]), [f"{v:g}" for v in grid.index])
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.set_title(f"{name}: {METRICS[metric]}", fontsize=10)
+        for (row, col), value in np.ndenumerate(grid.to_numpy(dtype=float)):
+            ax.text(col, row, "n/a" if np.isnan(value) else f"{value:.2f}", ha="center",
+                    va="center", fontsize=7, color="black",
+                    path_effects=[patheffects.withStroke(linewidth=2, foreground="white")])
+        fig.colorbar(image, ax=ax, shrink=0.8)
+    fig.tight_layout()
+    return fig
+
+
+def line_figure(frame: pd.DataFrame, x: str):
+    """A figure with one panel per map: the mean gap over param ``x`` with a band of one
+    standard deviation over seeds, and the success rate on a second axis."""
+    table = summary(frame, ["map", x])
+    maps = list(dict.fromkeys(frame["map"]))
+    fig, axes = plt.subplots(1, len(maps), figsize=(4.2 * len(maps), 3.4), squeeze=False)
+    for ax, name in zip(axes[0], maps):
+        rows = table[table["map"] == name]
+        ax.plot(rows[x], rows["gap"], marker="o", color="tab:blue", label="mean gap")
+        ax.fill_between(rows[x], rows["gap"] - rows["gap_std"], rows["gap"] + rows["gap_std"],
+                        color="tab:blue", alpha=0.2)
+        ax.set_xlabel(x)
+        ax.set_ylabel("gap to the optimum", color="tab:blue")
+        rate = ax.twinx()
+        rate.plot(rows[x], rows["success"], marker="s", color="tab:green", label="success")
+        rate.set_ylim(-0.05, 1.05)
+        rate.set_ylabel("success rate", color="tab:green")
+        ax.set_title(name, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def plot_sweep(frame: pd.DataFrame, params: list[str], out_dir) -> list[Path]:
+    """Write the standard figures of a sweep next to its results and return their paths:
+    heat maps of success and gap over the first two swept ``params`` (if two or more), and one
+    line figure per swept param."""
+    out_dir = Path(out_dir)
+    for name in params:
+        _check_columns(frame, name)
+    written = []
+    if len(params) >= 2:
+        x, y = params[0], params[1]
+        for metric in METRICS:
+            path = out_dir / f"heatmap_{metric}_{y}_vs_{x}.png"
+            _save(heatmap_figure(frame, x, y, metric), path)
+            written.append(path)
+    for name in params:
+        path = out_dir / f"line_{name}.png"
+        _save(line_figure(frame, name), path)
+        written.append(path)
+    return written
+
+
+def _save(fig, path: Path) -> None:
+    try:
+        save_png(fig, path)
+    finally:
+        plt.close(fig)

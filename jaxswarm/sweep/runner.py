@@ -1,0 +1,205 @@
+"""The sweep runner: every (params, seed) run of a spec on every map, batched and resumable.
+
+Per map, the runs are ordered combination-major (run ``r`` = combination ``r // S``, seed
+``seeds[r % S]``) and cut into chunks of ``chunk_size``. A chunk is one call of a compiled
+``vmap`` of :func:`jaxswarm.swarm.run` over keys and stacked params; its batch axis is sharded
+over ``jax.devices()`` (the chunk is padded to a multiple of the device count; padding rows are
+dropped). Maps of the same shape share the compiled program; each compile is logged. A run with
+seed ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``.
+
+Each map's optimum comes from the batched distance field, so every row carries its optimality
+gap. Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec
+again skips them.
+"""
+from __future__ import annotations
+
+import datetime
+import importlib.metadata
+import math
+import platform
+import subprocess
+import time
+from pathlib import Path
+from typing import Callable
+
+import jax
+import numpy as np
+import pandas as pd
+from jax.sharding import Mesh, NamedSharding, PartitionSpec
+from tqdm.auto import tqdm
+
+from jaxswarm.exact.field import optimum
+from jaxswarm.swarm import make, make_task, run
+from jaxswarm.sweep.maps import SweepMap, resolve_map
+from jaxswarm.sweep.spec import SweepSpec
+from jaxswarm.sweep.store import ResultsStore, read_results
+
+SUCCESS_GAP = 1e-4
+"""A run succeeds when its relative gap to the optimum is below this."""
+
+
+def default_out(spec: SweepSpec) -> Path:
+    """``out/sweeps/<name>``: where a sweep writes unless told otherwise."""
+    return Path("out") / "sweeps" / spec.name
+
+
+def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
+              log: Callable[[str], None] = print) -> pd.DataFrame:
+    """Run (or resume) a sweep and return all its rows.
+
+    Args:
+      spec: a checked spec (:func:`jaxswarm.sweep.load_spec`).
+      out: the store directory (default :func:`default_out`).
+      progress: show a progress bar (runs, runs/s) updated per chunk.
+      log: where one-line messages go (compiles, skipped chunks).
+
+    Returns:
+      DataFrame, one row per (map, params, seed): ``map``, ``map_index``, ``run``, ``algorithm``,
+      ``seed``, one column per swept param, ``cost`` (inf if no path), ``optimum``, ``gap``
+      (relative), ``found``, ``success`` (gap < 1e-4), ``iterations`` (used), ``seconds`` (the
+      chunk's wall time divided by its runs, compile excluded), ``chunk``.
+
+    Raises:
+      ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec.
+    """
+    out = Path(out) if out is not None else default_out(spec)
+    base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
+    maps = [resolve_map(entry, base_dir) for entry in spec.maps]
+    writer = jax.process_index() == 0
+    store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps), writer=writer)
+    swarm = make(spec.algorithm, **spec.config)
+    grid = spec.grid()
+    seeds = np.asarray(spec.seeds)
+    num_runs = spec.num_runs
+    params = _stacked_params(swarm.default_params, grid, len(seeds))
+    devices = jax.devices()
+    mesh = Mesh(np.asarray(devices), ("runs",))
+    batch_sharding = NamedSharding(mesh, PartitionSpec("runs"))
+    replicated = NamedSharding(mesh, PartitionSpec())
+    padded = -(-spec.chunk_size // len(devices)) * len(devices)
+    batch = jax.jit(jax.vmap(_one_run(swarm, spec), in_axes=(0, 0, None, None)))
+    compiled = {}
+
+    chunks = [(m, c) for m in range(len(maps)) for c in range(math.ceil(num_runs / spec.chunk_size))]
+    done = [(m, c) for m, c in chunks if store.finished(m, c)]
+    if done:
+        log(f"resuming {out}: {len(done)} of {len(chunks)} chunks already finished")
+    bar = tqdm(total=num_runs * len(maps), unit="run", disable=not progress, desc=spec.name,
+               initial=sum(_chunk_runs(c, spec.chunk_size, num_runs) for _, c in done))
+    try:
+        for m, sweep_map in enumerate(maps):
+            todo = [c for mm, c in chunks if mm == m and (mm, c) not in done]
+            if not todo:
+                continue
+            task = make_task(sweep_map.graph, sweep_map.start, sweep_map.goal)
+            best = float(optimum(sweep_map.graph, task.start, task.goal))
+            graph, task = jax.device_put((sweep_map.graph, task), replicated)
+            shape = _program_key(sweep_map.graph)
+            if shape not in compiled:
+                began = time.perf_counter()
+                example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
+                compiled[shape] = batch.lower(*example, graph, task).compile()
+                log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
+                    f"per chunk on {len(devices)} device(s) in {time.perf_counter() - began:.1f} s")
+            for c in todo:
+                first = c * spec.chunk_size
+                count = _chunk_runs(c, spec.chunk_size, num_runs)
+                inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
+                began = time.perf_counter()
+                cost, iterations = _gather(compiled[shape](*inputs, graph, task))
+                seconds = (time.perf_counter() - began) / count
+                rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
+                             cost[:count], iterations[:count], best, seconds)
+                if writer:
+                    store.write_chunk(m, c, rows)
+                bar.update(count)
+    finally:
+        bar.close()
+    return read_results(out)
+
+
+def _program_key(graph) -> tuple:
+    """Graphs with equal structure and array shapes share one compiled program."""
+    leaves, treedef = jax.tree_util.tree_flatten(graph)
+    return treedef, tuple(leaf.shape for leaf in leaves)
+
+
+def _one_run(swarm, spec: SweepSpec):
+    def one(seed, params, graph, task):
+        state, trace = run(swarm, jax.random.key(seed), graph, task, params,
+                           iterations=spec.iterations, patience=spec.patience)
+        return swarm.best(state).cost, trace.iterations
+    return one
+
+
+def _stacked_params(defaults, grid: list[dict], num_seeds: int):
+    """Params pytree with leaves f32[P * S]: combination ``r // S`` for run ``r``."""
+    columns = {name: np.full(len(grid), np.float32(value))
+               for name, value in defaults._asdict().items()}
+    for p, combination in enumerate(grid):
+        for name, value in combination.items():
+            columns[name][p] = value
+    return defaults._replace(**{name: np.repeat(values, num_seeds)
+                                for name, values in columns.items()})
+
+
+def _chunk_runs(chunk: int, chunk_size: int, num_runs: int) -> int:
+    return min(chunk_size, num_runs - chunk * chunk_size)
+
+
+def _chunk_inputs(params, seeds: np.ndarray, first: int, padded: int, num_runs: int, sharding):
+    """Seeds i32[padded] and params (leaves f32[padded]) of runs ``first ..``, padded by
+    repeating the last run, as global arrays sharded over the batch axis (each process builds
+    only its own devices' shards, so this also works across hosts)."""
+    index = np.minimum(np.arange(first, first + padded), num_runs - 1)
+    host = (seeds[index % len(seeds)].astype(np.int32),
+            jax.tree_util.tree_map(lambda leaf: leaf[index], params))
+    return jax.tree_util.tree_map(
+        lambda x: jax.make_array_from_callback(x.shape, sharding, lambda i, x=x: x[i]), host)
+
+
+def _gather(outputs):
+    """Batch outputs as host arrays, from every process's devices."""
+    if jax.process_count() > 1:
+        from jax.experimental import multihost_utils
+        return multihost_utils.process_allgather(outputs, tiled=True)
+    return jax.device_get(outputs)
+
+
+def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, cost, iterations,
+          best, seconds) -> dict:
+    runs = np.arange(first, first + count)
+    cost = np.asarray(cost, np.float64)
+    found = np.isfinite(cost)
+    gap = (cost - best) / best if math.isfinite(best) and best > 0 else np.full(count, np.nan)
+    rows = dict(map=[label] * count, map_index=np.full(count, map_index, np.int32),
+                run=runs.astype(np.int64), algorithm=[spec.algorithm] * count,
+                seed=seeds[runs % len(seeds)].astype(np.int64))
+    for name in spec.params:
+        rows[name] = np.array([grid[r // len(seeds)][name] for r in runs], np.float64)
+    rows.update(cost=cost, optimum=np.full(count, best), gap=gap, found=found,
+                success=found & (gap < SUCCESS_GAP), iterations=np.asarray(iterations, np.int32),
+                seconds=np.full(count, seconds), chunk=np.full(count, chunk, np.int32))
+    return rows
+
+
+def _metadata(spec: SweepSpec, maps: list[SweepMap]) -> dict:
+    import jaxlib
+    return dict(
+        created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        jaxswarm=importlib.metadata.version("jaxswarm"), jax=jax.__version__, jaxlib=jaxlib.__version__,
+        numpy=np.__version__, python=platform.python_version(), machine=platform.machine(),
+        devices=[str(d) for d in jax.devices()], git_commit=_git_commit(),
+        algorithm=spec.algorithm, config=spec.config, seeds=list(spec.seeds),
+        maps=[dict(label=m.label, start=m.start, goal=m.goal,
+                   size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])
+
+
+def _git_commit() -> str | None:
+    """The commit of the jaxswarm checkout, if it is one."""
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                              cwd=Path(__file__).parent, check=True,
+                              timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None

@@ -1,0 +1,271 @@
+"""Sweep specifications: a TOML file that names what to run, checked before any compute.
+
+A spec names one algorithm of the swarm registry, the maps, a grid of params (the Cartesian
+product of lists or ranges), the seeds, the iteration budget and the static config::
+
+    # What it asks, in a sentence or two.
+    [sweep]
+    name = "rfd_star_pbase_alpha"       # results go to out/sweeps/<name> unless --out is given
+    algorithm = "rfd_star"
+    maps = ["mosaic50", { random = 50, seed = 3 }, { movingai = "mapf/maze-32-32-2.map", scenario = 5 }]
+    seeds = 20                          # range(20), or an explicit list [0, 4, 9]
+    iterations = 100
+    patience = 30                       # optional: stop a run after 30 iterations without gain
+    chunk_size = 256                    # optional: runs per compiled batch (bounds memory)
+
+    [config]                            # static: sizes and switches of the swarm factory
+    num_agents = 64
+
+    [params]                            # traced: every combination is one run per seed
+    p_base = [5, 10, 20]
+    alpha = { start = 1, stop = 10, num = 4 }             # inclusive linspace
+    erosion = { start = 0.5, stop = 50, num = 3, log = true }  # geometric spacing
+
+Params not named keep the swarm's defaults. Maps: a paper map name (``mosaic20`` ...), a seeded
+random grid ``{ random = SIZE, seed = S, density = 0.3 }``, or a Moving AI map with one row of its
+scenario file ``{ movingai = "PATH.map", scenario = ROW }`` (a relative PATH is looked up beside
+the spec, then under ``$JAXSWARM_SHARED/benchdata/movingai``). Every mistake raises
+:class:`SpecError` naming the file and the key.
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+from jaxswarm.swarm import core as swarm_core
+
+SECTIONS = {"sweep", "config", "params"}
+SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size"}
+DEFAULT_CHUNK_SIZE = 256
+
+
+class SpecError(ValueError):
+    """A sweep spec that cannot run; the message names the file and the key."""
+
+
+@dataclasses.dataclass(frozen=True)
+class SweepSpec:
+    """A checked sweep.
+
+    Attributes:
+      name: the sweep's name (the default results directory).
+      algorithm: a registered swarm name.
+      maps: map entries as written (str or dict), resolved by :mod:`jaxswarm.sweep.maps`.
+      seeds: the integer seeds; run ``s`` uses ``jax.random.key(s)``.
+      iterations: iteration budget of each run.
+      patience: stop after this many iterations without improvement (None = never).
+      chunk_size: runs per compiled batch.
+      config: static keyword arguments of the swarm factory.
+      params: param name -> tuple of float values (swept params only).
+      source: the file it came from (or "<dict>").
+    """
+
+    name: str
+    algorithm: str
+    maps: tuple
+    seeds: tuple[int, ...]
+    iterations: int
+    patience: int | None
+    chunk_size: int
+    config: dict
+    params: dict
+    source: str = "<dict>"
+
+    def grid(self) -> list[dict[str, float]]:
+        """Every combination of the swept params, in a fixed order (the last param varies
+        fastest); ``[{}]`` when nothing is swept."""
+        names = list(self.params)
+        return [dict(zip(names, values)) for values in itertools.product(*self.params.values())]
+
+    @property
+    def num_runs(self) -> int:
+        """Runs per map: combinations x seeds."""
+        return len(self.grid()) * len(self.seeds)
+
+    def as_dict(self) -> dict:
+        """JSON-ready form (the store's metadata and its resume check)."""
+        return dict(name=self.name, algorithm=self.algorithm, maps=list(self.maps),
+                    seeds=list(self.seeds), iterations=self.iterations, patience=self.patience,
+                    chunk_size=self.chunk_size, config=dict(self.config),
+                    params={k: list(v) for k, v in self.params.items()})
+
+
+def load_spec(path) -> SweepSpec:
+    """Read and check a sweep file (see the module docstring).
+
+    Raises:
+      SpecError: unreadable TOML, unknown section/key/algorithm/param/config/map, empty grid,
+        bad numbers; the message names the file and the key (and the line for TOML syntax).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as error:
+        raise SpecError(f"{path}: cannot read the sweep file ({error.strerror})") from None
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise SpecError(f"{path}: not valid TOML: {error}") from None
+    return spec_from_dict(document, source=str(path))
+
+
+def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
+    """Check a parsed spec (the TOML document as a dict); see :func:`load_spec`."""
+    where = source
+
+    def fail(key: str, problem: str):
+        raise SpecError(f"{where}: {key}: {problem}")
+
+    for section in document:
+        if section not in SECTIONS:
+            fail(section, f"unknown section; expected {', '.join(sorted(SECTIONS))}")
+    sweep = document.get("sweep")
+    if not isinstance(sweep, dict):
+        fail("[sweep]", "missing section")
+    for key in sweep:
+        if key not in SWEEP_KEYS:
+            fail(f"sweep.{key}", f"unknown key; expected one of {', '.join(sorted(SWEEP_KEYS))}")
+    for key in ("algorithm", "maps", "seeds"):
+        if key not in sweep:
+            fail(f"sweep.{key}", "missing")
+
+    algorithm = sweep["algorithm"]
+    if algorithm not in swarm_core.registered():
+        fail("sweep.algorithm", f"unknown algorithm {algorithm!r}; registered: "
+             f"{', '.join(swarm_core.registered())}")
+    name = sweep.get("name", algorithm)
+    if not isinstance(name, str) or not name or "/" in name:
+        fail("sweep.name", f"must be a non-empty string without '/', got {name!r}")
+
+    maps = sweep["maps"]
+    if not isinstance(maps, list) or not maps:
+        fail("sweep.maps", "must be a non-empty list")
+    from jaxswarm.sweep.maps import check_map_entry  # avoids an import cycle at module load
+    for i, entry in enumerate(maps):
+        problem = check_map_entry(entry)
+        if problem:
+            fail(f"sweep.maps[{i}]", problem)
+
+    seeds = sweep["seeds"]
+    if isinstance(seeds, int) and not isinstance(seeds, bool):
+        if seeds < 1:
+            fail("sweep.seeds", f"must be at least 1, got {seeds}")
+        seeds = tuple(range(seeds))
+    elif isinstance(seeds, list) and seeds and all(
+            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
+        if len(set(seeds)) != len(seeds):
+            fail("sweep.seeds", "repeats a seed")
+        seeds = tuple(seeds)
+    else:
+        fail("sweep.seeds", f"must be a count or a non-empty list of non-negative integers, "
+             f"got {seeds!r}")
+
+    iterations = _positive_int(sweep.get("iterations", 100), "sweep.iterations", fail)
+    patience = sweep.get("patience")
+    if patience is not None:
+        patience = _positive_int(patience, "sweep.patience", fail)
+    chunk_size = _positive_int(sweep.get("chunk_size", DEFAULT_CHUNK_SIZE), "sweep.chunk_size",
+                               fail)
+
+    config = document.get("config", {})
+    if not isinstance(config, dict):
+        fail("[config]", "must be a table")
+    accepted = swarm_core.config_options(algorithm)
+    for key in config:
+        if key not in accepted:
+            fail(f"config.{key}", f"unknown config of {algorithm}; accepted: "
+                 f"{', '.join(accepted)}")
+    try:
+        swarm = swarm_core.make(algorithm, **config)
+    except (TypeError, ValueError) as error:
+        fail("[config]", str(error))
+
+    params = document.get("params", {})
+    if not isinstance(params, dict):
+        fail("[params]", "must be a table")
+    known = swarm.default_params._fields
+    checked = {}
+    for key, value in params.items():
+        if key not in known:
+            fail(f"params.{key}", f"unknown param of {algorithm}; known: {', '.join(known)}")
+        checked[key] = _values(value, f"params.{key}", fail)
+    spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds,
+                     iterations=iterations, patience=patience, chunk_size=chunk_size,
+                     config=dict(config), params=checked, source=source)
+    for combination in spec.grid():  # out-of-range values fail here, before any compute
+        try:
+            swarm.check_params(swarm.default_params._replace(
+                **{k: np.float32(v) for k, v in combination.items()}))
+        except ValueError as error:
+            key = next((k for k in combination if str(error).startswith(k)), "[params]")
+            fail(f"params.{key}" if key in combination else key, str(error))
+    return spec
+
+
+def _positive_int(value: Any, key: str, fail) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+        fail(key, f"must be a positive integer, got {value!r}")
+    return value
+
+
+def _values(value: Any, key: str, fail) -> tuple[float, ...]:
+    """A param's values: a number, a list of numbers, or a range table."""
+    if _is_number(value):
+        return (float(value),)
+    if isinstance(value, list):
+        if not value:
+            fail(key, "empty list: a sweep needs at least one value")
+        if not all(_is_number(v) for v in value):
+            fail(key, f"values must be numbers, got {value!r}")
+        return tuple(float(v) for v in value)
+    if isinstance(value, dict):
+        return _range(value, key, fail)
+    fail(key, f"must be a number, a list or a range table, got {value!r}")
+
+
+def _range(table: dict, key: str, fail) -> tuple[float, ...]:
+    allowed = {"start", "stop", "num", "step", "log"}
+    unknown = set(table) - allowed
+    if unknown:
+        fail(key, f"unknown range keys {sorted(unknown)}; use start, stop and num (with "
+             "log = true for geometric spacing) or start, stop and step")
+    if "start" not in table or "stop" not in table:
+        fail(key, "a range needs start and stop")
+    start, stop = table["start"], table["stop"]
+    if not (_is_number(start) and _is_number(stop)):
+        fail(key, "start and stop must be numbers")
+    if ("num" in table) == ("step" in table):
+        fail(key, "give exactly one of num (inclusive linspace) and step (arange)")
+    if "num" in table:
+        num = table["num"]
+        if isinstance(num, bool) or not isinstance(num, int) or num < 1:
+            fail(key, f"num must be a positive integer, got {num!r}")
+        if table.get("log", False):
+            if start <= 0 or stop <= 0:
+                fail(key, "a log range needs positive start and stop")
+            values = np.geomspace(start, stop, num)
+        else:
+            values = np.linspace(start, stop, num)
+    else:
+        step = table["step"]
+        if not _is_number(step) or step == 0 or (stop - start) / step < 0:
+            fail(key, f"step {step!r} does not lead from {start} to {stop}")
+        values = np.arange(start, stop, step)
+    if len(values) == 0:
+        fail(key, "the range is empty: a sweep needs at least one value")
+    return tuple(float(v) for v in values)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)

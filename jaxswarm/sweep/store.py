@@ -1,0 +1,109 @@
+"""The results store: a Parquet dataset written one finished chunk at a time, plus metadata.
+
+Layout of a store directory::
+
+    metadata.json        package and JAX versions, spec, static config, seeds, git commit, maps
+    runs/part-MMM-CCCCC.parquet   one file per finished chunk (map MMM, chunk CCCCC)
+
+A chunk is written to a hidden temporary file in ``runs/`` and moved into place with
+``os.replace``, so a reader (``pandas.read_parquet(store / "runs")``, which skips hidden files)
+never sees half a chunk, and a killed sweep leaves only whole chunks behind. Reopening a store
+for the same spec finds the finished chunks (resume); a different spec is refused.
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+TEMP_PREFIX = ".tmp-"
+
+
+class StoreMismatchError(ValueError):
+    """The directory holds results of a different sweep spec."""
+
+
+class ResultsStore:
+    """One sweep's results directory (see the module docstring)."""
+
+    def __init__(self, root, spec: dict, metadata: dict, *, writer: bool = True):
+        """Open (or create) the store at ``root`` for ``spec`` (the spec's ``as_dict()``).
+
+        The writer (process 0 of a multi-host sweep; the only process otherwise) removes stale
+        temporary files of an interrupted write and writes ``metadata`` (with the spec under
+        ``"spec"``) for a new store; other processes only read it.
+
+        Raises:
+          StoreMismatchError: ``root`` already holds results of another spec.
+        """
+        self.root = Path(root)
+        self.runs = self.root / "runs"
+        self.runs.mkdir(parents=True, exist_ok=True)
+        if writer:
+            for stale in self.runs.glob(TEMP_PREFIX + "*"):
+                stale.unlink()
+        existing = self.read_metadata(self.root)
+        if existing is None and writer:
+            _write_atomically(self.root / "metadata.json",
+                              json.dumps(dict(metadata, spec=spec), indent=2, default=str)
+                              .encode())
+        elif existing is not None and existing.get("spec") != json.loads(json.dumps(spec, default=str)):
+            differ = sorted(k for k in set(spec) | set(existing.get("spec", {}))
+                            if existing.get("spec", {}).get(k) != spec.get(k))
+            raise StoreMismatchError(
+                f"{self.root} holds results of a different sweep (differs in: "
+                f"{', '.join(differ)}); choose another --out or delete it")
+
+    def chunk_path(self, map_index: int, chunk_index: int) -> Path:
+        """Where chunk ``chunk_index`` of map ``map_index`` lives once finished."""
+        return self.runs / f"part-{map_index:03d}-{chunk_index:05d}.parquet"
+
+    def finished(self, map_index: int, chunk_index: int) -> bool:
+        """Whether that chunk was written completely."""
+        return self.chunk_path(map_index, chunk_index).is_file()
+
+    def write_chunk(self, map_index: int, chunk_index: int, rows: dict) -> Path:
+        """Write one chunk's rows (column name -> list or array, equal lengths) atomically."""
+        table = pa.table(rows)
+        path = self.chunk_path(map_index, chunk_index)
+        handle, temporary = tempfile.mkstemp(prefix=TEMP_PREFIX, dir=self.runs)
+        os.close(handle)
+        try:
+            pq.write_table(table, temporary)
+            os.replace(temporary, path)
+        except BaseException:
+            os.unlink(temporary)
+            raise
+        return path
+
+    @staticmethod
+    def read_metadata(root) -> dict | None:
+        """The store's metadata record, or None if there is none yet."""
+        path = Path(root) / "metadata.json"
+        return json.loads(path.read_text()) if path.is_file() else None
+
+
+def read_results(root) -> pd.DataFrame:
+    """All finished rows of the store at ``root`` as a DataFrame (empty if none yet)."""
+    runs = Path(root) / "runs"
+    if not runs.is_dir() or not any(runs.glob("part-*.parquet")):
+        return pd.DataFrame()
+    return pd.read_parquet(runs).sort_values(["map_index", "run"], kind="stable").reset_index(
+        drop=True)
+
+
+def _write_atomically(path: Path, data: bytes) -> None:
+    handle, temporary = tempfile.mkstemp(prefix=TEMP_PREFIX, dir=path.parent)
+    try:
+        with os.fdopen(handle, "wb") as file:
+            file.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+        raise

@@ -1,0 +1,281 @@
+"""The sweep runner: specs, results store, resume after a kill, sharding, plots."""
+import json
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pandas as pd
+import pytest
+
+from jaxswarm.exact import dijkstra
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.swarm import make, make_task, run
+from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
+                            spec_from_dict)
+from jaxswarm.sweep.plots import plot_sweep, summary
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def tiny(**changes):
+    """A small spec document: 2 x 2 params x 3 seeds on one paper map and one random map."""
+    document = {
+        "sweep": {"name": "tiny", "algorithm": "rfd_star",
+                  "maps": ["mosaic20", {"random": 12, "seed": 4}], "seeds": 3, "iterations": 6,
+                  "chunk_size": 5},
+        "config": {"num_agents": 8},
+        "params": {"p_base": [5.0, 20.0], "alpha": {"start": 2, "stop": 8, "num": 2}},
+    }
+    for section, values in changes.items():
+        document[section] = dict(document.get(section, {}), **values)
+    return document
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    out = tmp_path_factory.mktemp("sweep") / "tiny"
+    spec = spec_from_dict(tiny())
+    return spec, out, run_sweep(spec, out, progress=False, log=lambda _: None)
+
+
+def test_spec_grid_ranges_and_seeds():
+    spec = spec_from_dict(tiny(params={"erosion": {"start": 0.5, "stop": 50, "num": 3,
+                                                   "log": True},
+                                       "climb": {"start": 0.5, "stop": 2.0, "step": 0.5}}))
+    assert spec.params["alpha"] == (2.0, 8.0)
+    np.testing.assert_allclose(spec.params["erosion"], [0.5, 5.0, 50.0])
+    assert spec.params["climb"] == (0.5, 1.0, 1.5)
+    assert spec.seeds == (0, 1, 2)
+    grid = spec.grid()
+    assert len(grid) == 2 * 2 * 3 * 3 and spec.num_runs == len(grid) * 3
+    assert grid[0] == dict(p_base=5.0, alpha=2.0, erosion=0.5, climb=0.5)
+    assert grid[1]["climb"] == 1.0  # the last param varies fastest
+
+
+@pytest.mark.parametrize("changes, message", [
+    (dict(sweep={"algorithm": "bees"}), "sweep.algorithm: unknown algorithm 'bees'"),
+    (dict(params={"p_bse": [1.0]}), "params.p_bse: unknown param of rfd_star; known: p_base"),
+    (dict(params={"alpha": []}), "params.alpha: empty list"),
+    (dict(params={"alpha": {"start": 5, "stop": 1, "step": 1}}), "params.alpha: step 1 does"),
+    (dict(params={"p_base": [float("nan")]}), "params.p_base: p_base must be finite"),
+    (dict(params={"sediment": [-1.0]}), "params.sediment: sediment must be non-negative"),
+    (dict(sweep={"maps": ["mosaic30"]}), r"sweep.maps\[0\]: unknown map 'mosaic30'"),
+    (dict(sweep={"maps": [{"random": 20}]}), r"sweep.maps\[0\]: seed = None"),
+    (dict(sweep={"seeds": 0}), "sweep.seeds: must be at least 1"),
+    (dict(sweep={"iterations": 0}), "sweep.iterations: must be a positive integer"),
+    (dict(sweep={"colour": "red"}), "sweep.colour: unknown key"),
+    (dict(config={"num_ants": 4}), "config.num_ants: unknown config of rfd_star"),
+    (dict(config={"num_agents": 0}), r"\[config\]: num_agents must be at least 1"),
+    (dict(extra={"x": 1}), "extra: unknown section"),
+])
+def test_bad_specs_name_the_key(changes, message):
+    with pytest.raises(SpecError, match=message):
+        spec_from_dict(tiny(**changes), source="study.toml")
+
+
+def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[sweep]\nalgorithm = "rfd_star"\nmaps = = ["mosaic20"]\n')
+    with pytest.raises(SpecError, match=r"bad.toml: not valid TOML: .*line 3"):
+        load_spec(bad)
+    unknown = tmp_path / "unknown.toml"
+    unknown.write_text('[sweep]\nalgorithm = "rfd_star"\nmaps = ["atlantis"]\nseeds = 2\n')
+    out = tmp_path / "results"
+    finished = subprocess.run(
+        [sys.executable, "-c", "from jaxswarm.cli import main; raise SystemExit(main())",
+         "sweep", str(unknown), "--out", str(out)], capture_output=True, text=True, timeout=120)
+    assert finished.returncode == 2
+    assert "unknown.toml: sweep.maps[0]: unknown map 'atlantis'" in finished.stderr
+    assert not out.exists()  # nothing was started
+
+
+def test_rows_are_tidy_and_match_single_runs(finished):
+    spec, out, frame = finished
+    assert len(frame) == 2 * spec.num_runs == 24
+    assert not frame.duplicated(["map", "run"]).any()
+    assert set(frame.columns) >= {"map", "algorithm", "seed", "p_base", "alpha", "cost",
+                                  "optimum", "gap", "found", "success", "iterations", "seconds"}
+    chosen = paper_map("mosaic20")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    optimum = dijkstra(graph, chosen.start, chosen.goal).cost
+    rows = frame[frame["map"] == "mosaic20"]
+    np.testing.assert_allclose(rows["optimum"], optimum, rtol=1e-6)
+    assert (rows["gap"][rows["found"]] > -1e-6).all()
+    swarm = make("rfd_star", num_agents=8)
+    for _, row in rows.iloc[[0, 7, 11]].iterrows():  # a row equals run() with key(seed)
+        params = swarm.default_params._replace(p_base=jnp.float32(row.p_base),
+                                               alpha=jnp.float32(row.alpha))
+        state, trace = run(swarm, jax.random.key(int(row.seed)), graph, task, params,
+                           iterations=6)
+        assert float(swarm.best(state).cost) == pytest.approx(row.cost, rel=0, abs=0)
+        assert int(trace.iterations) == row.iterations
+    # The store is a Parquet dataset pandas reads directly, with a metadata record.
+    direct = pd.read_parquet(out / "runs")
+    assert len(direct) == len(frame)
+    metadata = json.loads((out / "metadata.json").read_text())
+    assert metadata["spec"]["params"]["p_base"] == [5.0, 20.0]
+    assert metadata["jax"] == jax.__version__ and metadata["seeds"] == [0, 1, 2]
+    assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
+
+
+def test_same_spec_resumes_without_recomputing_and_other_spec_is_refused(finished):
+    spec, out, frame = finished
+    stamps = {p.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*.parquet")}
+    messages = []
+    again = run_sweep(spec, out, progress=False, log=messages.append)
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*.parquet")} == stamps
+    assert messages == [f"resuming {out}: 6 of 6 chunks already finished"]
+    pd.testing.assert_frame_equal(again, frame)
+    with pytest.raises(StoreMismatchError, match="differs in: seeds"):
+        run_sweep(spec_from_dict(tiny(sweep={"seeds": 4})), out, progress=False)
+
+
+def test_plots_are_written_next_to_the_results(finished):
+    spec, out, frame = finished
+    paths = plot_sweep(frame, ["p_base", "alpha"], out)
+    assert [p.name for p in paths] == ["heatmap_success_alpha_vs_p_base.png",
+                                       "heatmap_gap_alpha_vs_p_base.png", "line_p_base.png",
+                                       "line_alpha.png"]
+    assert all(p.stat().st_size > 5000 for p in paths)
+    table = summary(frame, ["map", "p_base"])
+    rows = frame[(frame["map"] == "mosaic20") & (frame["p_base"] == 5.0)]
+    cell = table[(table["map"] == "mosaic20") & (table["p_base"] == 5.0)].iloc[0]
+    assert cell.runs == 6 and cell.success == pytest.approx(rows["success"].mean())
+    with pytest.raises(ValueError, match="no column 'rho'"):
+        plot_sweep(frame, ["rho"], out)
+
+
+SLOW_SPEC = """
+[sweep]
+name = "killed"
+algorithm = "rfd_star"
+maps = ["mosaic50"]
+seeds = 24
+iterations = 40
+chunk_size = 2
+
+[config]
+num_agents = 64
+"""
+
+
+def sweep_command(spec: Path, out: Path):
+    return [sys.executable, "-c", "from jaxswarm.cli import main; raise SystemExit(main())",
+            "sweep", str(spec), "--out", str(out), "--no-progress", "--no-plots"]
+
+
+def test_a_killed_sweep_resumes_without_losing_or_repeating_a_chunk(tmp_path):
+    spec = tmp_path / "killed.toml"
+    spec.write_text(SLOW_SPEC)
+    out = tmp_path / "killed"
+    process = subprocess.Popen(sweep_command(spec, out), stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while not list(out.glob("runs/part-*.parquet")):
+        assert process.poll() is None, process.communicate()
+        assert time.monotonic() < deadline, "no chunk finished in time"
+        time.sleep(0.02)
+    process.send_signal(signal.SIGKILL)
+    process.wait()
+    before = {p.name: (p.stat().st_mtime_ns, p.read_bytes())
+              for p in (out / "runs").glob("part-*.parquet")}
+    assert 0 < len(before) < 12, "the sweep must be killed mid-way"
+    # Only whole chunks are visible; anything half-written is a hidden temporary file.
+    assert len(read_results(out)) == 2 * len(before)
+    assert all(p.name.startswith((".", "part-")) for p in (out / "runs").iterdir())
+
+    finished = subprocess.run(sweep_command(spec, out), capture_output=True, text=True,
+                              timeout=600)
+    assert finished.returncode == 0, finished.stderr
+    assert f"{len(before)} of 12 chunks already finished" in finished.stdout
+    after = {p.name: (p.stat().st_mtime_ns, p.read_bytes())
+             for p in (out / "runs").glob("part-*.parquet")}
+    assert len(after) == 12 and all(after[name] == before[name] for name in before)
+    frame = read_results(out)
+    assert sorted(frame["run"]) == list(range(24))
+    assert not any(p.name.startswith(".") for p in (out / "runs").iterdir())
+
+
+SHARDED = textwrap.dedent("""
+    import sys, jax
+    from jaxswarm.sweep import spec_from_dict, run_sweep
+    sys.path.insert(0, {tests!r})
+    from test_sweep import tiny
+    frame = run_sweep(spec_from_dict(tiny()), {out!r}, progress=False, log=print)
+    print("devices", len(jax.devices()))
+""")
+
+
+def test_sharding_over_four_cpu_devices_gives_identical_rows(finished, tmp_path):
+    _, _, frame = finished
+    out = tmp_path / "sharded"
+    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=4")
+    done = subprocess.run([sys.executable, "-c", SHARDED.format(tests=str(REPO / "tests"),
+                                                                 out=str(out))],
+                          capture_output=True, text=True, timeout=600, env=env, cwd=REPO)
+    assert done.returncode == 0, done.stderr
+    assert "devices 4" in done.stdout and "on 4 device(s)" in done.stdout
+    sharded = read_results(out)
+    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
+    pd.testing.assert_frame_equal(sharded[columns], frame[columns])
+
+
+@pytest.mark.slow
+def test_ten_thousand_runs_on_a_50x50_map_fit_in_memory(tmp_path):
+    spec = spec_from_dict({
+        "sweep": {"name": "ten_thousand", "algorithm": "rfd_star", "maps": ["mosaic50"],
+                  "seeds": 100, "iterations": 5, "chunk_size": 1000},
+        "config": {"num_agents": 8},
+        "params": {"p_base": {"start": 2, "stop": 200, "num": 10, "log": True},
+                   "alpha": {"start": 1, "stop": 20, "num": 10}}})
+    frame = run_sweep(spec, tmp_path / "big", progress=False)
+    assert len(frame) == 10_000 and not frame.duplicated(["run"]).any()
+    assert (frame["gap"][frame["found"]] > -1e-6).all()
+
+
+@pytest.mark.parametrize("path", sorted((REPO / "sweeps").glob("*.toml")), ids=lambda p: p.name)
+def test_bundled_studies_are_valid_and_explain_themselves(path):
+    spec = load_spec(path)
+    assert spec.name == path.stem and len(spec.grid()) > 1
+    assert path.read_text().startswith("#")  # a comment saying what the study asks
+
+
+MULTI_HOST = textwrap.dedent("""
+    import sys, jax
+    jax.config.update("jax_cpu_collectives_implementation", "gloo")
+    jax.distributed.initialize({address!r}, num_processes=2, process_id=int(sys.argv[1]))
+    sys.path.insert(0, {tests!r})
+    from test_sweep import tiny
+    from jaxswarm.sweep import spec_from_dict, run_sweep
+    run_sweep(spec_from_dict(tiny()), {out!r}, progress=False, log=print)
+    print("processes", jax.process_count(), "devices", len(jax.devices()))
+""")
+
+
+@pytest.mark.slow
+def test_two_processes_with_jax_distributed_give_identical_rows(finished, tmp_path):
+    import socket
+    with socket.socket() as probe:
+        probe.bind(("localhost", 0))
+        port = probe.getsockname()[1]
+    _, _, frame = finished
+    out = tmp_path / "multihost"
+    script = MULTI_HOST.format(address=f"localhost:{port}", tests=str(REPO / "tests"),
+                               out=str(out))
+    env = dict(os.environ, XLA_FLAGS="--xla_force_host_platform_device_count=2")
+    processes = [subprocess.Popen([sys.executable, "-c", script, str(i)], env=env, cwd=REPO,
+                                  stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                 for i in range(2)]
+    outputs = [p.communicate(timeout=600) for p in processes]
+    assert all(p.returncode == 0 for p in processes), outputs
+    assert all("processes 2 devices 4" in stdout for stdout, _ in outputs)
+    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
+    pd.testing.assert_frame_equal(read_results(out)[columns], frame[columns])
