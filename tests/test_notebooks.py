@@ -1,0 +1,146 @@
+"""Run the notebooks in ``notebooks/`` top to bottom at small sizes and check what they produce.
+
+Each notebook runs in a fresh Jupyter kernel through ``nbclient`` with
+``JAXSWARM_NOTEBOOK_SMALL=1``, so it uses fewer seeds, iterations and agents. Its output directory
+(``JAXSWARM_NOTEBOOK_OUT``) is pytest's ``tmp_path``. A cell that raises makes ``nbclient`` raise
+``CellExecutionError``, which fails the test and shows the cell and its traceback.
+The notebooks also check their own results with ``assert``. After a run, the test checks:
+
+* quickstart: the JSON line printed by the cell tagged ``checks``. The three exact planners report
+  one finite optimum, no swarm beats it, and a repeated key reproduces its run. Its figures were
+  shown inline.
+* sweep_analysis: the Parquet store under ``tmp_path``. Read back with pandas, it holds
+  maps x combinations x seeds rows, one per run, taken from the spec in ``metadata.json``. No gap
+  is below -1e-6. The PNGs of ``plot_sweep`` exist. The figures were shown inline, which
+  confirms the notebook's ``%matplotlib inline`` after the import of ``jaxswarm.sweep.plots``;
+  that module selects Agg at import.
+
+Which Python runs the kernel: the notebooks must run in the interpreter that runs pytest (the
+project's ``.venv``, where jaxswarm is installed). The kernel name ``python3`` would also match a
+kernelspec in the user's ``~/.local/share/jupyter`` or the system's ``/usr/share/jupyter``, and
+such a spec may point at another Python. So the test writes its own ``python3`` kernelspec, whose
+argv starts with ``sys.executable``, into a temporary directory. It then puts that directory on
+``JUPYTER_PATH``. jupyter_client searches ``JUPYTER_PATH`` before any other place, and the
+variable only lives for the test (monkeypatch). Nothing is installed, and no user or venv files
+change. Before a notebook's own cells, the test runs one extra cell, added to the in-memory copy
+only. It prints the kernel's ``sys.prefix``, and the test checks that this equals pytest's.
+
+Run time on 2 CPU cores: about 1 minute for both notebooks, mostly JAX compiling. Each cell may
+take up to ``CELL_TIMEOUT`` seconds.
+"""
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+nbclient = pytest.importorskip("nbclient")
+pytest.importorskip("ipykernel")
+pd = pytest.importorskip("pandas")
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+CELL_TIMEOUT = 300
+SIZE_VARIABLES = ("JAXSWARM_NOTEBOOK_MAP", "JAXSWARM_NOTEBOOK_AGENTS",
+                  "JAXSWARM_NOTEBOOK_ITERATIONS", "JAXSWARM_NOTEBOOK_SEEDS")
+PROBE = "import sys\nprint(sys.prefix)"
+
+
+@pytest.fixture
+def notebook_env(tmp_path, monkeypatch):
+    """Small sizes, output under tmp_path, and a python3 kernelspec pinned to sys.executable."""
+    spec_dir = tmp_path / "jupyter" / "kernels" / "python3"
+    spec_dir.mkdir(parents=True)
+    (spec_dir / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "Python 3 (jaxswarm test)", "language": "python"}))
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
+    monkeypatch.setenv("JAXSWARM_NOTEBOOK_SMALL", "1")
+    out = tmp_path / "out"
+    monkeypatch.setenv("JAXSWARM_NOTEBOOK_OUT", str(out))
+    for name in SIZE_VARIABLES:  # the small defaults, whatever the caller's shell has set
+        monkeypatch.delenv(name, raising=False)
+    return out
+
+
+def execute(name: str):
+    """Run notebook ``name`` in a fresh kernel (cwd: the repo root); return the executed copy."""
+    nb = nbformat.read(NOTEBOOKS / name, as_version=4)
+    nb.cells.insert(0, nbformat.v4.new_code_cell(PROBE))
+    client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
+                                     resources={"metadata": {"path": str(ROOT)}})
+    client.execute()  # CellExecutionError if any cell raises
+    kernel_prefix = stdout(nb.cells[0]).strip()
+    assert Path(kernel_prefix).resolve() == Path(sys.prefix).resolve(), (
+        f"the kernel ran in {kernel_prefix}, not in pytest's interpreter {sys.prefix}")
+    return nb
+
+
+def stdout(cell) -> str:
+    return "".join(o.get("text", "") for o in cell.get("outputs", [])
+                   if o.output_type == "stream" and o.name == "stdout")
+
+
+def count_images(nb) -> int:
+    return sum("image/png" in o.get("data", {}) for cell in nb.cells if cell.cell_type == "code"
+               for o in cell.get("outputs", []))
+
+
+def test_notebooks_are_stored_without_outputs():
+    for path in sorted(NOTEBOOKS.glob("*.ipynb")):
+        nb = nbformat.read(path, as_version=4)
+        nbformat.validate(nb)
+        for cell in nb.cells:
+            if cell.cell_type == "code":
+                assert not cell.outputs and cell.execution_count is None, (
+                    f"{path.name}: clear the outputs before committing")
+
+
+def test_quickstart(notebook_env):
+    nb = execute("quickstart.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+
+    exact = result["exact"]
+    assert set(exact) == {"Dijkstra", "A*", "bidirectional A*"}
+    optimum = exact["Dijkstra"]
+    assert math.isfinite(optimum) and optimum > 0
+    for name, cost in exact.items():
+        assert cost == pytest.approx(optimum, rel=1e-9), f"{name} disagrees with Dijkstra"
+    assert len(result["swarms"]) == 3
+    for name, cost in result["swarms"].items():
+        assert cost >= optimum * (1 - 1e-5), f"{name} beats the optimum"
+    assert result["reproducible"] is True
+    assert count_images(nb) >= 6
+
+
+def test_sweep_analysis(notebook_env):
+    nb = execute("sweep_analysis.ipynb")
+    store = notebook_env / "sweep_analysis"
+    spec = json.loads((store / "metadata.json").read_text())["spec"]
+    assert spec["seeds"] == [0, 1] and spec["iterations"] == 15, "JAXSWARM_NOTEBOOK_SMALL ignored"
+
+    frame = pd.read_parquet(store / "runs")
+    combinations = math.prod(len(values) for values in spec["params"].values())
+    assert len(frame) == len(spec["maps"]) * combinations * len(spec["seeds"])
+    assert not frame.duplicated(["map", "run"]).any()
+    assert set(frame["map"]) == set(spec["maps"])
+    assert set(frame["seed"]) == set(spec["seeds"])
+    for name, values in spec["params"].items():
+        assert sorted(set(frame[name])) == sorted(values)
+    assert frame["found"].any()
+    # Relative gaps to the float32 optimum; a run without a path has cost and gap inf.
+    assert (frame["gap"] >= -1e-6).all(), frame.loc[~(frame["gap"] >= -1e-6), ["map", "run", "gap"]]
+    assert (frame.loc[~frame["found"], "success"] == False).all()  # noqa: E712
+
+    for png in ("heatmap_success_alpha_vs_p_base.png", "heatmap_gap_alpha_vs_p_base.png",
+                "line_p_base.png", "line_alpha.png"):
+        path = store / png
+        assert path.is_file(), f"missing {path}"
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert count_images(nb) >= 6  # heat maps, lines, the PNG shown, and one replay per map
