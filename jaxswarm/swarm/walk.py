@@ -82,16 +82,23 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
     return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
 
 
-def _replay(graph: Graph, start, slots: jax.Array) -> jax.Array:
-    """i32[A, L + 1] nodes of the walks whose slots are ``slots`` (i[A, L], -1 once stopped)."""
-    def advance(here, slot):
+def _replay(graph: Graph, start, slots: jax.Array, steps) -> jax.Array:
+    """i32[A, L + 1] nodes of the walks whose slots are ``slots`` (i[A, L], -1 once stopped);
+    only the first ``steps`` (i32[], traced) columns can hold moves, so only they are replayed."""
+    num_agents, budget = slots.shape
+    by_step = slots.T.astype(jnp.int32)  # [L, A]: each step's slots contiguous
+    first = jnp.full((num_agents,), start, jnp.int32)
+    nodes = jnp.full((budget + 1, num_agents), NO_NODE, jnp.int32).at[0].set(first)
+
+    def advance(t, carry):
+        here, nodes = carry
+        slot = by_step[t]
         moved = slot >= 0
         there = jnp.where(moved, graph.nbr[jnp.maximum(here, 0), jnp.maximum(slot, 0)], NO_NODE)
-        return jnp.where(moved, there, NO_NODE), jnp.where(moved, there, NO_NODE)
+        return there, jax.lax.dynamic_update_slice(nodes, there[None], (t + 1, 0))
 
-    first = jnp.full((slots.shape[0],), start, jnp.int32)
-    _, nodes = jax.lax.scan(advance, first, slots.T.astype(jnp.int32))
-    return jnp.concatenate([first[:, None], nodes.T], axis=1)
+    _, nodes = jax.lax.fori_loop(0, steps, advance, (first, nodes))
+    return nodes.T
 
 
 def step_budget(graph: Graph, max_steps: int | None) -> int:
@@ -218,6 +225,6 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
 
     c = jax.lax.while_loop(keep_walking, chunk, carry)
     slots = c["slots"][:, :max_steps]
-    return Walk(path=_replay(graph, start, slots), slots=slots.astype(jnp.int16),
+    return Walk(path=_replay(graph, start, slots, c["step"]), slots=slots.astype(jnp.int16),
                 length=c["length"], arrived=c["arrived"], stuck=c["stuck"],
                 position=c["position"], steps=c["step"])
