@@ -8,9 +8,9 @@ has not visited in this walk), and draws one slot through :func:`sample_masked`.
 when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
 runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped.
 
-Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]`` and the chosen slots
-``i8[A, L - 1]`` (``L = max_steps + 1``); the paths ``i32[A, L]`` are replayed from the slots at the
-end. Batch sizes in sweeps must be chosen with that in mind.
+Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
+``i8[A, L - 1]`` and the nodes ``i32[A, L - 1]`` (``L = max_steps + 1``), written a block of
+``STEPS_PER_CHECK`` steps at a time. Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
 
@@ -82,25 +82,6 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
     return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
 
 
-def _replay(graph: Graph, start, slots: jax.Array, steps) -> jax.Array:
-    """i32[A, L + 1] nodes of the walks whose slots are ``slots`` (i[A, L], -1 once stopped);
-    only the first ``steps`` (i32[], traced) columns can hold moves, so only they are replayed."""
-    num_agents, budget = slots.shape
-    by_step = slots.T.astype(jnp.int32)  # [L, A]: each step's slots contiguous
-    first = jnp.full((num_agents,), start, jnp.int32)
-    nodes = jnp.full((budget + 1, num_agents), NO_NODE, jnp.int32).at[0].set(first)
-
-    def advance(t, carry):
-        here, nodes = carry
-        slot = by_step[t]
-        moved = slot >= 0
-        there = jnp.where(moved, graph.nbr[jnp.maximum(here, 0), jnp.maximum(slot, 0)], NO_NODE)
-        return there, jax.lax.dynamic_update_slice(nodes, there[None], (t + 1, 0))
-
-    _, nodes = jax.lax.fori_loop(0, steps, advance, (first, nodes))
-    return nodes.T
-
-
 def step_budget(graph: Graph, max_steps: int | None) -> int:
     """The step budget of a walk (static): ``max_steps``, or by default N - 1 (the longest walk
     without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids."""
@@ -163,9 +144,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     start = jnp.asarray(start, jnp.int32)
     goal = jnp.asarray(goal, jnp.int32)
     position = jnp.full((num_agents,), start)
-    # Only the chosen slots are stored while walking (the nodes are replayed afterwards): the
-    # smallest carry, since a vmapped while_loop copies its carry at every test. The buffer gets
-    # one spare chunk of columns so that a chunk's block always fits.
+    # The buffers get one spare chunk of columns so that a chunk's block always fits.
     columns = max_steps + STEPS_PER_CHECK
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
     carry = dict(
@@ -173,6 +152,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         position=position,
         visited=_mark(jnp.zeros((num_agents, (n + 31) // 32), jnp.uint32), agents, position),
         slots=jnp.full((num_agents, columns), -1, slot_dtype),
+        nodes=jnp.full((num_agents, columns), NO_NODE, jnp.int32),
         length=jnp.zeros((num_agents,), jnp.float32),
         walking=jnp.full((num_agents,), start != goal),
         arrived=jnp.full((num_agents,), start == goal),
@@ -184,18 +164,21 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         return (c["step"] < max_steps) & jnp.any(c["walking"])
 
     def chunk(c):
-        """STEPS_PER_CHECK steps; their slots go to a small block (cheap writes at the loop
-        index) that is copied into the slot buffer once per chunk."""
+        """STEPS_PER_CHECK steps; their slots and nodes go to small blocks (cheap writes at the
+        static loop index) that are copied into the buffers once per chunk."""
         first = c["step"]
 
-        def step_into_block(i, inner):
-            c, block = inner
-            c, slot = one_step(c)
-            return c, block.at[:, i].set(slot)
+        def step_into_blocks(i, inner):
+            c, slots, nodes = inner
+            c, slot, node = one_step(c)
+            return c, slots.at[:, i].set(slot), nodes.at[:, i].set(node)
 
-        block = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
-        c, block = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_block, (c, block))
-        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], block, (0, first)))
+        slots = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
+        nodes = jnp.full((num_agents, STEPS_PER_CHECK), NO_NODE, jnp.int32)
+        c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
+                                            (c, slots, nodes))
+        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots, (0, first)),
+                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes, (0, first)))
 
     def one_step(c):
         key, draw_key = jax.random.split(c["key"])
@@ -221,10 +204,11 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
             stuck=c["stuck"] | (c["walking"] & ~has_choice),
             step=jnp.minimum(c["step"] + 1, max_steps),
         )
-        return c, jnp.where(moving, choice, -1).astype(slot_dtype)
+        return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
+                jnp.where(moving, there, NO_NODE))
 
     c = jax.lax.while_loop(keep_walking, chunk, carry)
-    slots = c["slots"][:, :max_steps]
-    return Walk(path=_replay(graph, start, slots, c["step"]), slots=slots.astype(jnp.int16),
+    path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps]], axis=1)
+    return Walk(path=path, slots=c["slots"][:, :max_steps].astype(jnp.int16),
                 length=c["length"], arrived=c["arrived"], stuck=c["stuck"],
                 position=c["position"], steps=c["step"])

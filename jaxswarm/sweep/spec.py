@@ -11,7 +11,7 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
     seeds = 20                          # range(20), or an explicit list [0, 4, 9]
     iterations = 100
     patience = 30                       # optional: stop a run after 30 iterations without gain
-    chunk_size = 256                    # optional: runs per compiled batch (bounds memory)
+    chunk_size = 64                     # optional: runs per compiled batch (bounds memory)
 
     [config]                            # static: sizes and switches of the swarm factory
     num_agents = 64
@@ -47,7 +47,7 @@ from jaxswarm.swarm import core as swarm_core
 
 SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size"}
-DEFAULT_CHUNK_SIZE = 256
+DEFAULT_CHUNK_SIZE = 64
 
 
 class SpecError(ValueError):
