@@ -9,8 +9,9 @@ when it reaches the goal, when it has no admissible neighbour ("stuck"), or when
 runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped.
 
 Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
-``i8[A, L - 1]`` and the nodes ``i32[A, L - 1]`` (``L = max_steps + 1``), written a block of
-``STEPS_PER_CHECK`` steps at a time. Batch sizes in sweeps must be chosen with that in mind.
+``i8[A, L - 1]`` and the nodes ``i16[A, L - 1]`` (i32 above 32,767 nodes; ``L = max_steps + 1``),
+written a block of ``STEPS_PER_CHECK`` steps at a time; the paths come out as ``i32[A, L]``.
+Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
 
@@ -147,12 +148,13 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     # The buffers get one spare chunk of columns so that a chunk's block always fits.
     columns = max_steps + STEPS_PER_CHECK
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
+    node_dtype = jnp.int16 if n <= 32767 else jnp.int32
     carry = dict(
         key=key,
         position=position,
         visited=_mark(jnp.zeros((num_agents, (n + 31) // 32), jnp.uint32), agents, position),
         slots=jnp.full((num_agents, columns), -1, slot_dtype),
-        nodes=jnp.full((num_agents, columns), NO_NODE, jnp.int32),
+        nodes=jnp.full((num_agents, columns), NO_NODE, node_dtype),
         length=jnp.zeros((num_agents,), jnp.float32),
         walking=jnp.full((num_agents,), start != goal),
         arrived=jnp.full((num_agents,), start == goal),
@@ -174,7 +176,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
             return c, slots.at[:, i].set(slot), nodes.at[:, i].set(node)
 
         slots = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
-        nodes = jnp.full((num_agents, STEPS_PER_CHECK), NO_NODE, jnp.int32)
+        nodes = jnp.full((num_agents, STEPS_PER_CHECK), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
                                             (c, slots, nodes))
         return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots, (0, first)),
@@ -205,10 +207,11 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
             step=jnp.minimum(c["step"] + 1, max_steps),
         )
         return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
-                jnp.where(moving, there, NO_NODE))
+                jnp.where(moving, there, NO_NODE).astype(node_dtype))
 
     c = jax.lax.while_loop(keep_walking, chunk, carry)
-    path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps]], axis=1)
+    path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
+                           axis=1)
     return Walk(path=path, slots=c["slots"][:, :max_steps].astype(jnp.int16),
                 length=c["length"], arrived=c["arrived"], stuck=c["stuck"],
                 position=c["position"], steps=c["step"])
