@@ -44,6 +44,7 @@ import numpy as np
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep import run_sweep, spec_from_dict
+from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
 
 GiB = 2 ** 30
 MiB = 2 ** 20
@@ -145,7 +146,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--values", type=int, default=8,
                         help="values per param (the grid is values x values)")
-    parser.add_argument("--chunk-size", type=int, default=256, help="runs per sweep chunk")
+    parser.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
+                        help="runs per sweep chunk (default: the sweep spec's default)")
     parser.add_argument("--loop-runs", type=int, default=None,
                         help="time only this many loop runs and extrapolate (default: all)")
     args = parser.parse_args(argv)

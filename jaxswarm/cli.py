@@ -25,7 +25,11 @@ from jaxswarm.paths import as_node
 from jaxswarm.swarm import make, make_task, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
-SWARM_PLANNERS = {"RFD*": "rfd_star", "ACO*": "aco_star"}
+SWARM_PLANNERS = {"RFD*": "rfd_star", "Ant System": "ant_system", "ACO*": "aco_star",
+                  "Max-Min ACO": "max_min_aco", "Improved Max-Min ACO": "improved_max_min_aco"}
+OWN_POPULATION = {"improved_max_min_aco"}
+"""Swarms that keep their own agent count (the Max-Min ACO paper's populations of 50 ants)
+instead of ``--drops``."""
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -39,7 +43,8 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--repeats", type=int, default=5, help="runs per planner (median time)")
     demo.add_argument("--seed", type=int, default=0, help="PRNG seed of the swarm planners")
-    demo.add_argument("--drops", type=int, default=256, help="agents per swarm iteration")
+    demo.add_argument("--drops", type=int, default=256,
+                      help="agents per swarm iteration (Improved Max-Min ACO keeps its 50)")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
     demo.add_argument("--out", type=Path, default=Path("out/demo.png"), help="figure path")
     sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
@@ -99,7 +104,8 @@ def run_demo(args: argparse.Namespace) -> int:
         milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
         rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
     for label, name_in_registry in SWARM_PLANNERS.items():
-        swarm = make(name_in_registry, num_agents=args.drops)
+        config = {} if name_in_registry in OWN_POPULATION else dict(num_agents=args.drops)
+        swarm = make(name_in_registry, **config)
         state, trace, milliseconds = _run_swarm(swarm, graph, start, goal, args)
         solution = solutions[label] = swarm.best(state)
         traces[label] = (swarm, state, trace)

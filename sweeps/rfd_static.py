@@ -1,8 +1,8 @@
 """RFD and RFD* on the nine paper maps, static environment (the RFD paper's Table 1 set-up).
 
 For every map, each algorithm runs once per seed (``--seeds``, default 20) for at most 100
-iterations (``--iterations``; a run also stops after ``--patience`` iterations without
-improvement, or when every drop follows the same path). Each run is jitted once per map and
+iterations (``--iterations``; a run also stops when every drop follows the same path, and, if
+``--patience`` is given, after that many iterations without improvement). Each run is jitted once per map and
 algorithm and then timed on its own (compile excluded). Printed per map: the optimum (Dijkstra),
 each algorithm's mean best length over the seeds, its success count (relative gap < 1e-4 to the
 optimum) and the median wall time of one run. Written to ``--out`` (default ``out/rfd_static``):
@@ -108,7 +108,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--maps", default=",".join(PAPER_MAPS), help="comma-separated paper maps")
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--iterations", type=int, default=100)
-    parser.add_argument("--patience", type=int, default=30)
+    parser.add_argument("--patience", type=int, default=None,
+                        help="also stop after this many iterations without improvement "
+                             "(default: never, the paper's plain 100 iterations)")
     parser.add_argument("--agents", type=int, default=256, help="drops per iteration")
     parser.add_argument("--out", type=Path, default=Path("out/rfd_static"))
     args = parser.parse_args(argv)

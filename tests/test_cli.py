@@ -12,17 +12,20 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     assert main(["demo", "--map", "maze20", "--repeats", "1", "--out", str(out)]) == 0
     text = capsys.readouterr().out
     lengths = {}
-    for planner in ("Dijkstra", "A\\*", "bidirectional A\\*", "RFD\\*", "ACO\\*"):
-        row = re.search(rf"^{planner}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
+    exact = ("Dijkstra", "A*", "bidirectional A*")
+    swarms = ("RFD*", "Ant System", "ACO*", "Max-Min ACO", "Improved Max-Min ACO")
+    for planner in exact + swarms:
+        row = re.search(rf"^{re.escape(planner)}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
         assert row, f"no row for {planner} in:\n{text}"
         lengths[planner] = row.group(1)
-        if planner not in ("RFD\\*", "ACO\\*"):
-            assert row.group(2) == "+0.00%"
-    assert len({lengths["Dijkstra"], lengths["A\\*"], lengths["bidirectional A\\*"]}) == 1
-    for swarm in ("RFD", "ACO"):
-        gap = re.search(rf"^{swarm}\*\s+\S+\s+(\S+)", text, re.MULTILINE).group(1)
-        assert gap == "-" or not gap.startswith("-")  # no swarm beats the optimum
-    for png in (out, tmp_path / "demo_rfd_star.png", tmp_path / "demo_aco_star.png"):
+        gap = row.group(2)
+        if planner in exact:
+            assert gap == "+0.00%"
+        else:
+            assert gap == "-" or not gap.startswith("-")  # no swarm beats the optimum
+    assert len({lengths[planner] for planner in exact}) == 1
+    names = ("rfd_star", "ant_system", "aco_star", "max_min_aco", "improved_max_min_aco")
+    for png in (out, *(tmp_path / f"demo_{name}.png" for name in names)):
         assert png.read_bytes()[:4] == b"\x89PNG"
 
 
