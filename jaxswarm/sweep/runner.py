@@ -187,12 +187,20 @@ def _metadata(spec: SweepSpec, maps: list[SweepMap]) -> dict:
     import jaxlib
     return dict(
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        jaxswarm=importlib.metadata.version("jaxswarm"), jax=jax.__version__, jaxlib=jaxlib.__version__,
+        jaxswarm=_version(), jax=jax.__version__, jaxlib=jaxlib.__version__,
         numpy=np.__version__, python=platform.python_version(), machine=platform.machine(),
         devices=[str(d) for d in jax.devices()], git_commit=_git_commit(),
         algorithm=spec.algorithm, config=spec.config, seeds=list(spec.seeds),
         maps=[dict(label=m.label, start=m.start, goal=m.goal,
                    size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])
+
+
+def _version() -> str | None:
+    """The installed jaxswarm version (None when run from a source tree that is not installed)."""
+    try:
+        return importlib.metadata.version("jaxswarm")
+    except importlib.metadata.PackageNotFoundError:
+        return None
 
 
 def _git_commit() -> str | None:
