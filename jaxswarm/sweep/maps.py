@@ -49,7 +49,8 @@ def check_map_entry(entry) -> str | None:
     if "random" in entry:
         unknown = set(entry) - RANDOM_KEYS
         if unknown:
-            return f"unknown keys {sorted(unknown)} for a random map ({', '.join(sorted(RANDOM_KEYS))})"
+            return (f"unknown keys {sorted(unknown)} for a random map "
+                    f"({', '.join(sorted(RANDOM_KEYS))})")
         size, seed = entry["random"], entry.get("seed")
         if not _int_at_least(size, 2):
             return f"random = {size!r}: the size must be an integer >= 2"

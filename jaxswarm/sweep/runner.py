@@ -80,8 +80,9 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     batch = jax.jit(jax.vmap(_one_run(swarm, spec), in_axes=(0, 0, None, None)))
     compiled = {}
 
-    chunks = [(m, c) for m in range(len(maps)) for c in range(math.ceil(num_runs / spec.chunk_size))]
-    done = [(m, c) for m, c in chunks if store.finished(m, c)]
+    per_map = math.ceil(num_runs / spec.chunk_size)
+    chunks = [(m, c) for m in range(len(maps)) for c in range(per_map)]
+    done = {(m, c) for m, c in chunks if store.finished(m, c)}
     if done:
         log(f"resuming {out}: {len(done)} of {len(chunks)} chunks already finished")
     bar = tqdm(total=num_runs * len(maps), unit="run", disable=not progress, desc=spec.name,
@@ -94,11 +95,11 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
             task = make_task(sweep_map.graph, sweep_map.start, sweep_map.goal)
             best = float(optimum(sweep_map.graph, task.start, task.goal))
             graph, task = jax.device_put((sweep_map.graph, task), replicated)
-            shape = _program_key(sweep_map.graph)
-            if shape not in compiled:
+            program = _program_key(sweep_map.graph)
+            if program not in compiled:
                 began = time.perf_counter()
                 example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
-                compiled[shape] = batch.lower(*example, graph, task).compile()
+                compiled[program] = batch.lower(*example, graph, task).compile()
                 log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
                     f"per chunk on {len(devices)} device(s) in {time.perf_counter() - began:.1f} s")
             for c in todo:
@@ -106,7 +107,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 count = _chunk_runs(c, spec.chunk_size, num_runs)
                 inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
                 began = time.perf_counter()
-                cost, iterations = _gather(compiled[shape](*inputs, graph, task))
+                cost, iterations = _gather(compiled[program](*inputs, graph, task))
                 seconds = (time.perf_counter() - began) / count
                 rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
                              cost[:count], iterations[:count], best, seconds)

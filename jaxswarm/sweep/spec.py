@@ -7,7 +7,8 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
     [sweep]
     name = "rfd_star_pbase_alpha"       # results go to out/sweeps/<name> unless --out is given
     algorithm = "rfd_star"
-    maps = ["mosaic50", { random = 50, seed = 3 }, { movingai = "mapf/maze-32-32-2.map", scenario = 5 }]
+    maps = ["mosaic50", { random = 50, seed = 3 },
+            { movingai = "mapf/maze-32-32-2.map", scenario = 5 }]
     seeds = 20                          # range(20), or an explicit list [0, 4, 9]
     iterations = 100
     patience = 30                       # optional: stop a run after 30 iterations without gain
@@ -44,6 +45,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from jaxswarm.swarm import core as swarm_core
+from jaxswarm.sweep.maps import check_map_entry
 
 SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size"}
@@ -151,26 +153,12 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     maps = sweep["maps"]
     if not isinstance(maps, list) or not maps:
         fail("sweep.maps", "must be a non-empty list")
-    from jaxswarm.sweep.maps import check_map_entry  # avoids an import cycle at module load
     for i, entry in enumerate(maps):
         problem = check_map_entry(entry)
         if problem:
             fail(f"sweep.maps[{i}]", problem)
 
-    seeds = sweep["seeds"]
-    if isinstance(seeds, int) and not isinstance(seeds, bool):
-        if seeds < 1:
-            fail("sweep.seeds", f"must be at least 1, got {seeds}")
-        seeds = tuple(range(seeds))
-    elif isinstance(seeds, list) and seeds and all(
-            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in seeds):
-        if len(set(seeds)) != len(seeds):
-            fail("sweep.seeds", "repeats a seed")
-        seeds = tuple(seeds)
-    else:
-        fail("sweep.seeds", f"must be a count or a non-empty list of non-negative integers, "
-             f"got {seeds!r}")
-
+    seeds = _seeds(sweep["seeds"], fail)
     iterations = _positive_int(sweep.get("iterations", 100), "sweep.iterations", fail)
     patience = sweep.get("patience")
     if patience is not None:
@@ -211,6 +199,21 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
             key = next((k for k in combination if str(error).startswith(k)), "[params]")
             fail(f"params.{key}" if key in combination else key, str(error))
     return spec
+
+
+def _seeds(value: Any, fail) -> tuple[int, ...]:
+    """A seed count (``range(count)``) or an explicit list of distinct non-negative integers."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value < 1:
+            fail("sweep.seeds", f"must be at least 1, got {value}")
+        return tuple(range(value))
+    if isinstance(value, list) and value and all(
+            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value):
+        if len(set(value)) != len(value):
+            fail("sweep.seeds", "repeats a seed")
+        return tuple(value)
+    fail("sweep.seeds", f"must be a count or a non-empty list of non-negative integers, "
+         f"got {value!r}")
 
 
 def _positive_int(value: Any, key: str, fail) -> int:

@@ -48,13 +48,16 @@ class ResultsStore:
             for stale in self.runs.glob(TEMP_PREFIX + "*"):
                 stale.unlink()
         existing = self.read_metadata(self.root)
-        if existing is None and writer:
-            _write_atomically(self.root / "metadata.json",
-                              json.dumps(dict(metadata, spec=spec), indent=2, default=str)
-                              .encode())
-        elif existing is not None and existing.get("spec") != json.loads(json.dumps(spec, default=str)):
-            differ = sorted(k for k in set(spec) | set(existing.get("spec", {}))
-                            if existing.get("spec", {}).get(k) != spec.get(k))
+        as_stored = json.loads(json.dumps(spec, default=str))  # the spec as JSON gives it back
+        if existing is None:
+            if writer:
+                _write_atomically(self.root / "metadata.json",
+                                  json.dumps(dict(metadata, spec=spec), indent=2,
+                                             default=str).encode())
+        elif existing.get("spec") != as_stored:
+            before = existing.get("spec", {})
+            differ = sorted(k for k in set(as_stored) | set(before)
+                            if before.get(k) != as_stored.get(k))
             raise StoreMismatchError(
                 f"{self.root} holds results of a different sweep (differs in: "
                 f"{', '.join(differ)}); choose another --out or delete it")
