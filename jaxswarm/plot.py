@@ -20,8 +20,6 @@ Nothing here selects a backend or shows a window; callers own the figures they g
 """
 from __future__ import annotations
 
-import os
-import secrets
 from collections.abc import Mapping
 
 import matplotlib
@@ -34,6 +32,7 @@ from matplotlib.figure import Figure
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 
+from jaxswarm.atomic import atomic_path
 from jaxswarm.graph import OPPOSITE, Graph
 from jaxswarm.paths import Solution, as_node, trim
 
@@ -262,20 +261,8 @@ def save_png(fig: Figure, path) -> None:
     directory and moved into place with ``os.replace``, so an interrupted save never leaves a
     half-written file at ``path`` (an existing file stays intact until the new one is complete).
     """
-    path = os.path.abspath(os.fspath(path))
-    folder = os.path.dirname(path)
-    os.makedirs(folder, exist_ok=True)
-    tmp = os.path.join(folder, f".{os.path.basename(path)}.{secrets.token_hex(6)}.tmp")
-    # os.open with mode 0o666 lets the umask decide the permissions, as a plain open() would
-    # (tempfile.mkstemp would leave the PNG readable by its owner only).
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    try:
-        with os.fdopen(fd, "wb") as file:
-            fig.savefig(file, format="png", dpi=120, bbox_inches="tight")
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    with atomic_path(path) as temporary, open(temporary, "wb") as file:
+        fig.savefig(file, format="png", dpi=120, bbox_inches="tight")
 
 
 def _nan_if_inf(values: np.ndarray) -> np.ndarray:

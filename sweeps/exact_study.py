@@ -39,7 +39,6 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import os
 import sys
 import time
 from pathlib import Path
@@ -48,6 +47,7 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
+from jaxswarm.atomic import atomic_path
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
@@ -187,27 +187,12 @@ def summarise(rows: list[dict]) -> list[dict]:
     return summary
 
 
-def _atomic_write(path: Path, write: Callable[[str], None]) -> None:
-    """Call ``write(tmp_name)`` on a temporary file next to ``path``, then rename it over ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = str(path.with_name(f".{path.name}.{os.getpid()}.tmp"))
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-
-
 def write_csv(rows: list[dict], path, columns) -> None:
     """Write ``rows`` (dicts) with the given column order to ``path``, atomically."""
-    def write(tmp):
-        with open(tmp, "w", newline="", encoding="utf-8") as f:
-            writer = csv.DictWriter(f, fieldnames=list(columns))
-            writer.writeheader()
-            writer.writerows(rows)
-    _atomic_write(Path(path), write)
+    with atomic_path(path) as temporary, open(temporary, "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=list(columns))
+        writer.writeheader()
+        writer.writerows(rows)
 
 
 def plot_summary(summary: list[dict], path) -> None:
@@ -235,7 +220,8 @@ def plot_summary(summary: list[dict], path) -> None:
     grids = sorted({e["grids"] for e in summary})
     fig.suptitle(f"Exact planners on random grids (mean +- 1 std over {'/'.join(map(str, grids))} "
                  "grids per size)")
-    _atomic_write(Path(path), lambda tmp: fig.savefig(tmp, format="png", dpi=120))
+    with atomic_path(path) as temporary:
+        fig.savefig(temporary, format="png", dpi=120)
 
 
 def format_summary(summary: list[dict]) -> str:

@@ -34,7 +34,6 @@ import argparse
 import csv
 import io
 import math
-import os
 import statistics
 import time
 from collections.abc import Callable
@@ -47,6 +46,7 @@ matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
+from jaxswarm.atomic import write_atomically
 from jaxswarm.exact import astar, dijkstra
 from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import PAPER_MAPS, PaperMap, paper_map
@@ -263,19 +263,6 @@ def csv_text(rows: list[dict]) -> str:
     writer.writeheader()
     writer.writerows(rows)
     return buffer.getvalue()
-
-
-def write_atomically(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same directory and
-    ``os.replace``, so ``path`` is never half-written; the temporary file never stays behind."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def main(argv: list[str] | None = None) -> int:

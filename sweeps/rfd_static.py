@@ -3,8 +3,8 @@
 For every map, each algorithm runs once per seed (``--seeds``, default 20) for at most 100
 iterations (``--iterations``; a run also stops when every drop follows the same path, and, if
 ``--patience`` is given, after that many iterations without improvement). Each run is jitted once
-per map and algorithm and then timed on its own (compile excluded). Printed per map: the optimum (Dijkstra),
-each algorithm's mean best length over the seeds, its success count (relative gap < 1e-4 to the
+per map and algorithm and then timed on its own (compile excluded). Printed per map: the optimum
+(Dijkstra), each algorithm's mean best length over the seeds, its success count (relative gap < 1e-4 to the
 optimum) and the median wall time of one run. Written to ``--out`` (default ``out/rfd_static``):
 ``runs.csv`` (one row per map, algorithm and seed) and ``table.md``.
 
@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
 import statistics
 import time
 from pathlib import Path
 
 import jax
 
+from jaxswarm.atomic import atomic_path, write_atomically
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.swarm import make, make_task, run
@@ -86,21 +86,12 @@ def table(rows: list[dict], maps: list[str]) -> str:
     return "\n".join(lines)
 
 
-def write_atomically(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
-
-
 def write_csv(path: Path, rows: list[dict]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    with open(tmp, "w", newline="") as f:
+    """The rows (columns COLUMNS) as a CSV file, written atomically."""
+    with atomic_path(path) as temporary, open(temporary, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS)
         writer.writeheader()
         writer.writerows(rows)
-    os.replace(tmp, path)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -13,15 +13,13 @@ for the same spec finds the finished chunks (resume); a different spec is refuse
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-TEMP_PREFIX = ".tmp-"
+from jaxswarm.atomic import TEMPORARY_GLOB, atomic_path, write_atomically
 
 
 class StoreMismatchError(ValueError):
@@ -45,15 +43,14 @@ class ResultsStore:
         self.runs = self.root / "runs"
         self.runs.mkdir(parents=True, exist_ok=True)
         if writer:
-            for stale in self.runs.glob(TEMP_PREFIX + "*"):
+            for stale in self.runs.glob(TEMPORARY_GLOB):
                 stale.unlink()
         existing = self.read_metadata(self.root)
         as_stored = json.loads(json.dumps(spec, default=str))  # the spec as JSON gives it back
         if existing is None:
             if writer:
-                _write_atomically(self.root / "metadata.json",
-                                  json.dumps(dict(metadata, spec=spec), indent=2,
-                                             default=str).encode())
+                write_atomically(self.root / "metadata.json",
+                                 json.dumps(dict(metadata, spec=spec), indent=2, default=str))
         elif existing.get("spec") != as_stored:
             before = existing.get("spec", {})
             differ = sorted(k for k in set(as_stored) | set(before)
@@ -72,16 +69,9 @@ class ResultsStore:
 
     def write_chunk(self, map_index: int, chunk_index: int, rows: dict) -> Path:
         """Write one chunk's rows (column name -> list or array, equal lengths) atomically."""
-        table = pa.table(rows)
         path = self.chunk_path(map_index, chunk_index)
-        handle, temporary = tempfile.mkstemp(prefix=TEMP_PREFIX, dir=self.runs)
-        os.close(handle)
-        try:
-            pq.write_table(table, temporary)
-            os.replace(temporary, path)
-        except BaseException:
-            os.unlink(temporary)
-            raise
+        with atomic_path(path) as temporary:
+            pq.write_table(pa.table(rows), temporary)
         return path
 
     @staticmethod
@@ -98,15 +88,3 @@ def read_results(root) -> pd.DataFrame:
         return pd.DataFrame()
     return pd.read_parquet(runs).sort_values(["map_index", "run"], kind="stable").reset_index(
         drop=True)
-
-
-def _write_atomically(path: Path, data: bytes) -> None:
-    handle, temporary = tempfile.mkstemp(prefix=TEMP_PREFIX, dir=path.parent)
-    try:
-        with os.fdopen(handle, "wb") as file:
-            file.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise

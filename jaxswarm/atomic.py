@@ -1,0 +1,40 @@
+"""Atomic file writes: a hidden temporary file beside the target, moved over it with os.replace.
+
+A reader never sees a half-written file, an existing file stays intact until its replacement is
+complete, and an interrupted write leaves at most a hidden ``.NAME.*.tmp`` file (which readers of
+Parquet datasets skip) instead of a damaged ``NAME``.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+from collections.abc import Iterator
+from pathlib import Path
+
+TEMPORARY_GLOB = ".*.tmp"
+"""Matches the temporary files :func:`atomic_path` creates (for cleaning up after a crash)."""
+
+
+@contextlib.contextmanager
+def atomic_path(path) -> Iterator[Path]:
+    """Yield a fresh temporary path beside ``path`` (parent directories are created); if the
+    block ends without an exception the file written there replaces ``path``, otherwise it is
+    deleted. Files are created by the caller, so they get the usual umask permissions."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)  # gone already after a successful replace
+
+
+def write_atomically(path, data: str | bytes) -> None:
+    """Write text (UTF-8) or bytes to ``path`` atomically (see :func:`atomic_path`)."""
+    with atomic_path(path) as temporary:
+        if isinstance(data, str):
+            temporary.write_text(data, encoding="utf-8")
+        else:
+            temporary.write_bytes(data)

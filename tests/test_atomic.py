@@ -1,0 +1,24 @@
+"""Atomic writes: the target is replaced whole or not at all, and no temporary file stays."""
+import pytest
+
+from jaxswarm.atomic import atomic_path, write_atomically
+
+
+def test_a_write_replaces_the_file_and_leaves_nothing_behind(tmp_path):
+    target = tmp_path / "deep" / "table.md"
+    write_atomically(target, "first")
+    write_atomically(target, b"second")
+    assert target.read_text() == "second"
+    assert [p.name for p in target.parent.iterdir()] == ["table.md"]
+
+
+def test_a_failed_write_keeps_the_old_file_and_removes_the_temporary(tmp_path):
+    target = tmp_path / "runs.csv"
+    write_atomically(target, "old")
+    with pytest.raises(RuntimeError, match="interrupted"):
+        with atomic_path(target) as temporary:
+            temporary.write_text("half")
+            assert temporary.name.startswith(".runs.csv.") and temporary.parent == tmp_path
+            raise RuntimeError("interrupted")
+    assert target.read_text() == "old"
+    assert [p.name for p in tmp_path.iterdir()] == ["runs.csv"]
