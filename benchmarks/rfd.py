@@ -22,13 +22,9 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.maps.paper import PAPER_MAPS
+from jaxswarm.maps.paper import PAPER_MAPS, PAPER_TABLE1_MS
 
-PAPER_RFD_STAR_MS = {
-    "mosaic20": 59.548, "alley20": 103.421, "maze20": 84.211,
-    "mosaic50": 268.349, "alley50": 291.77, "maze50": 337.529,
-    "mosaic100": 4172.388, "alley100": 5934.1, "maze100": 5108.49,
-}
+PAPER_RFD_STAR_MS = PAPER_TABLE1_MS["RFD*"]
 """The paper's Table 1, RFD* computation time [ms], static environment."""
 
 

@@ -49,7 +49,8 @@ from matplotlib.figure import Figure
 from jaxswarm.atomic import write_atomically
 from jaxswarm.exact import astar, dijkstra
 from jaxswarm.graph import Graph
-from jaxswarm.maps.paper import PAPER_MAPS, PaperMap, paper_map
+from jaxswarm.maps.paper import (
+    PAPER_MAPS, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, PaperMap, paper_map)
 from jaxswarm.paths import Solution
 from jaxswarm.plot import draw_map, draw_paths, save_png
 from jaxswarm.swarm import make, make_task, run
@@ -65,33 +66,6 @@ COLORS = {"Dijkstra": "tab:blue", "A*": "tab:cyan", "ACO": "tab:orange", "ACO*":
 """Path colour of each algorithm in the figure."""
 COLUMNS = ("map", "algorithm", "seed", "optimum", "cost", "gap", "found", "iterations", "seconds")
 """Columns of runs.csv."""
-
-
-def _paper_rows(rows: dict[str, tuple]) -> dict[str, dict[str, float | None]]:
-    """algorithm -> map -> value, from one tuple per algorithm in the order of PAPER_MAPS."""
-    return {algorithm: dict(zip(PAPER_MAPS, values, strict=True))
-            for algorithm, values in rows.items()}
-
-
-PAPER_LENGTH = _paper_rows({
-    "Dijkstra": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
-    "A*": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
-    "ACO": (51.68, 138.98, None, 450.65, 1158.61, None, 2749.60, 5435.08, None),
-    "ACO*": (18.65, 87.49, None, 55.16, 181.56, None, 211.98, 379.15, None),
-    "RFD": (30.21, 117.12, None, 383.1, 839.24, None, 2196.57, 4070.42, None),
-    "RFD*": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
-})
-"""The paper's Table 1, averaged path length; None where the paper says n/a (no path found)."""
-
-PAPER_MS = _paper_rows({
-    "Dijkstra": (6.051, 5.787, 6.534, 57.876, 59.333, 46.316, 542.385, 753.503, 445.556),
-    "A*": (1.601, 4.453, 6.265, 24.173, 56.662, 48.895, 335.751, 661.118, 448.542),
-    "ACO": (650.16, 681.82, None, 10118.72, 10086.02, None, 131071.05, 132445.70, None),
-    "ACO*": (71.481, 662.063, None, 4005.241, 6078.251, None, 38630.724, 29628.093, None),
-    "RFD": (1213.59, 1279.466, None, 8121.88, 8704.5, None, 33653.09, 46341.6, None),
-    "RFD*": (59.548, 103.421, 84.211, 268.349, 291.77, 337.529, 4172.388, 5934.1, 5108.49),
-})
-"""The paper's Table 1, computation time [ms]; None where the paper says n/a."""
 
 
 def make_row(name: str, algorithm: str, seed: int, optimum: float, solution: Solution,
@@ -218,11 +192,11 @@ def table(rows: list[dict], maps: list[str], *, seeds: int, iterations: int,
         "",
         "## Path length: mean over the seeds that found a path (seeds that found one)",
         "",
-        *half_table(rows, maps, length_cell, PAPER_LENGTH, lambda v: f"{v:.2f}"),
+        *half_table(rows, maps, length_cell, PAPER_TABLE1_LENGTH, lambda v: f"{v:.2f}"),
         "",
         "## Time per run [ms]: median over the seeds (compile excluded)",
         "",
-        *half_table(rows, maps, time_cell, PAPER_MS, str),
+        *half_table(rows, maps, time_cell, PAPER_TABLE1_MS, str),
     ]) + "\n"
 
 

@@ -8,7 +8,8 @@ import pytest
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, PaperMap, paper_map
+from jaxswarm.maps.paper import (PAPER_MAPS, PAPER_OPTIMA, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS,
+                                 PaperMap, paper_map)
 
 # The paper's start and goal cells, (x, y), written out again from its section 3.
 PAPER_ENDPOINTS = {
@@ -112,3 +113,19 @@ def test_deterministic_and_read_only(name):
 def test_unknown_name(name):
     with pytest.raises(ValueError, match="maze20"):
         paper_map(name)
+
+
+def test_table1_transcription():
+    for table in (PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS):
+        assert list(table) == ["Dijkstra", "A*", "ACO", "ACO*", "RFD", "RFD*"]
+        for algorithm, values in table.items():
+            assert list(values) == list(PAPER_MAPS)
+            missing = {m for m, v in values.items() if v is None}
+            # The paper's ACO, ACO* and RFD found no path on any maze.
+            expected = {"maze20", "maze50", "maze100"} if algorithm in ("ACO", "ACO*", "RFD") \
+                else set()
+            assert missing == expected, algorithm
+    # Dijkstra, A* and RFD* share the optimal lengths; spot checks of the times.
+    assert PAPER_TABLE1_LENGTH["A*"] == PAPER_TABLE1_LENGTH["RFD*"] == PAPER_OPTIMA
+    assert PAPER_TABLE1_MS["RFD*"]["alley100"] == 5934.1
+    assert PAPER_TABLE1_MS["ACO"]["mosaic100"] == 131071.05

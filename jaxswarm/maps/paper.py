@@ -41,11 +41,35 @@ PAPER_MAPS: tuple[str, ...] = (
 )
 """The nine maps in the column order of the paper's Table 1."""
 
-PAPER_OPTIMA: dict[str, float] = {
-    "mosaic20": 18.65, "alley20": 33.48, "maze20": 78.62,
-    "mosaic50": 50.62, "alley50": 81.97, "maze50": 228.52,
-    "mosaic100": 116.94, "alley100": 170.42, "maze100": 510.56,
-}
+
+def _by_map(rows: dict[str, tuple]) -> dict[str, dict[str, float | None]]:
+    """algorithm -> map -> value, from one tuple per algorithm in the order of PAPER_MAPS."""
+    return {algorithm: dict(zip(PAPER_MAPS, values, strict=True))
+            for algorithm, values in rows.items()}
+
+
+PAPER_TABLE1_LENGTH: dict[str, dict[str, float | None]] = _by_map({
+    "Dijkstra": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
+    "A*": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
+    "ACO": (51.68, 138.98, None, 450.65, 1158.61, None, 2749.60, 5435.08, None),
+    "ACO*": (18.65, 87.49, None, 55.16, 181.56, None, 211.98, 379.15, None),
+    "RFD": (30.21, 117.12, None, 383.1, 839.24, None, 2196.57, 4070.42, None),
+    "RFD*": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
+})
+"""The paper's Table 1 (static environment), mean path length per algorithm and map; None where
+the paper says n/a (no path found)."""
+
+PAPER_TABLE1_MS: dict[str, dict[str, float | None]] = _by_map({
+    "Dijkstra": (6.051, 5.787, 6.534, 57.876, 59.333, 46.316, 542.385, 753.503, 445.556),
+    "A*": (1.601, 4.453, 6.265, 24.173, 56.662, 48.895, 335.751, 661.118, 448.542),
+    "ACO": (650.16, 681.82, None, 10118.72, 10086.02, None, 131071.05, 132445.70, None),
+    "ACO*": (71.481, 662.063, None, 4005.241, 6078.251, None, 38630.724, 29628.093, None),
+    "RFD": (1213.59, 1279.466, None, 8121.88, 8704.5, None, 33653.09, 46341.6, None),
+    "RFD*": (59.548, 103.421, 84.211, 268.349, 291.77, 337.529, 4172.388, 5934.1, 5108.49),
+})
+"""The paper's Table 1, computation time [ms] (C#, Intel i7-3770); None where it says n/a."""
+
+PAPER_OPTIMA: dict[str, float] = PAPER_TABLE1_LENGTH["Dijkstra"]
 """The paper's published Dijkstra path lengths (Table 1) on its own, unpublished maps."""
 
 # (start, goal) of each map as (x, y), from the paper's section 3.
