@@ -11,7 +11,7 @@ SEEDS = 20
 NEEDED = 19  # the bar: the optimum (gap < 1e-4) in at least 19 of 20 seeds
 # Maps where the current RFD* misses the bar (see sweeps/rfd_static.py for its figures): strict
 # xfails, so a change that fixes one of them fails here until the marker is removed.
-SHORT_OF_THE_BAR = {"mosaic50", "alley50", "mosaic100", "alley100", "maze100"}
+SHORT_OF_THE_BAR = {"mosaic100", "alley100"}
 
 
 def successes(name: str) -> int:

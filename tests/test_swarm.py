@@ -1,4 +1,5 @@
 """Protocol conformance of every registered swarm, and RFD's own rules."""
+import dataclasses
 import math
 
 import jax
@@ -12,6 +13,7 @@ from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.walk import Walk
 
 ITERATIONS = 8
 SMALL = dict(num_agents=32)
@@ -192,7 +194,61 @@ def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corrido
     np.testing.assert_allclose(state.altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
 
 
-def test_graded_drops_climb_out_of_a_carved_bed_at_most_climb_steep():
+def test_graded_carving_drains_into_a_river_without_arriving():
+    # Nodes 3 and 4 of a 1 x 6 corridor are carved; the drops may walk 3 steps, so they stop on
+    # node 3 without reaching the goal and carve 0-2 to slope x (walked to 3 + depth of 3).
+    graph = grid_graph(np.zeros((1, 6), bool))
+    task = make_task(graph, (0, 0), (5, 0))
+    swarm = make("rfd_star", num_agents=4, max_steps=3)
+    params = swarm.default_params._replace(erosion=jnp.float32(0.5))
+    plateau = float(params.initial_height)
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    state = dataclasses.replace(state, altitude=jnp.array([plateau] * 3 + [1.0, 0.5, 0.0]))
+    state, info = swarm.step(state, graph, task, params)
+    assert float(info.arrived) == 0.0
+    np.testing.assert_allclose(state.altitude, [2.5, 2.0, 1.5, 1.0, 0.5, 0.0])
+
+
+def fake_walk(graph, cells, stuck=True):
+    """A one-drop Walk along ``cells`` ((x, y) pairs) that stopped at the last one."""
+    width = graph.shape[1]
+    nodes = [y * width + x for x, y in cells]
+    path = np.full((1, len(nodes) + 2), -1, np.int32)
+    path[0, :len(nodes)] = nodes
+    return Walk(path=jnp.asarray(path), slots=jnp.full((1, path.shape[1] - 1), -1, jnp.int16),
+                length=jnp.zeros(1), arrived=jnp.zeros(1, bool), stuck=jnp.array([stuck]),
+                position=jnp.array([nodes[-1]]), steps=jnp.int32(len(nodes) - 1))
+
+
+def filled_cells(graph, task, walk_):
+    from jaxswarm.swarm import rfd
+    swarm = make("rfd_star", num_agents=1)
+    altitude = swarm.init(jax.random.key(0), graph, task, swarm.default_params).altitude
+    table = rfd.transition_rule(swarm.config, graph, task, altitude, swarm.default_params)
+    filled = np.flatnonzero(np.asarray(rfd.blind_alleys(graph, table, walk_)))
+    return sorted((int(v) % graph.shape[1], int(v) // graph.shape[1]) for v in filled)
+
+
+def test_a_stuck_drop_fills_its_blind_alley_back_to_the_junction():
+    obstacles = np.array([[0, 0, 0, 0, 0],
+                          [1, 1, 0, 1, 1],
+                          [1, 1, 0, 1, 1]], bool)  # a dead end hangs below (2, 0)
+    graph = grid_graph(obstacles)
+    task = make_task(graph, (0, 0), (4, 0))
+    into_the_alley = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2)]
+    assert filled_cells(graph, task, fake_walk(graph, into_the_alley)) == [(2, 1), (2, 2)]
+    # (2, 0) leads on to (3, 0). A drop that ran out of steps in the alley fills nothing.
+    assert filled_cells(graph, task, fake_walk(graph, into_the_alley, stuck=False)) == []
+
+
+def test_a_drop_trapped_by_its_own_trail_fills_only_where_it_stopped():
+    graph = grid_graph(np.zeros((3, 3), bool))
+    task = make_task(graph, (0, 0), (2, 2))
+    spiral = [(0, 0), (1, 0), (2, 0), (2, 1), (1, 2), (0, 2), (0, 1), (1, 1)]
+    assert filled_cells(graph, task, fake_walk(graph, spiral)) == [(1, 1)]
+
+
+def test_graded_gradients_between_bed_and_plateau_are_clipped():
     from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((2, 3), bool))  # nodes 0 1 2 / 3 4 5, goal 2
     task = make_task(graph, (0, 0), (2, 0))
@@ -211,6 +267,9 @@ def test_graded_drops_climb_out_of_a_carved_bed_at_most_climb_steep():
     expected = -float(params.climb) * log_p - alpha * math.log(math.hypot(2, 1))
     assert logw(0, 3) == pytest.approx(expected, rel=1e-5)
     assert logw(0, 1) == pytest.approx(1.0 * log_p - alpha * math.log(1.0), rel=1e-5)
+    # Plateau node 3 -> carved node 0 (a plateau-high drop): seen no steeper than the bed's slope.
+    assert logw(3, 0) == pytest.approx(float(params.erosion) * log_p - alpha * math.log(2.0),
+                                       rel=1e-5)
     # Uncarved node 3 -> the deposit hill at 4 (5 higher): too steep, banned.
     assert logw(3, 4) == -np.inf
     # Uncarved 5 -> the hill at 4 is banned too; the goal is forced whenever adjacent.

@@ -10,35 +10,42 @@ choosing among admissible neighbours ``j`` of their node ``i`` by the gradient
 * RFD* (eq. 6): weight ``p_base ** gradient / d_j ** alpha`` for every admissible neighbour, with
   ``d_j`` the straight-line distance from ``j`` to the goal; the goal is taken whenever adjacent.
 
-After the walk the drops that reached the goal erode their paths, by one of three laws
-(``erosion_law``; the original RFD always uses ``"linear"``):
+After the walk the drops erode their paths, by one of three laws (``erosion_law``; the original
+RFD always uses ``"linear"``):
 
-* ``"linear"`` (eq. 4): each edge ``i -> j`` of an arrived path erodes node ``i`` by
+* ``"linear"`` (eq. 4): each edge ``i -> j`` of a path that reached the goal erodes node ``i`` by
   ``E / ((N - 1) * D) * gradient(i, j)`` (negative gradients erode nothing); then every node gains
   ``erosionProduced / (N - 1)`` (eq. 5).
 * ``"exponential"``: the same with ``p_base ** gradient`` in place of ``gradient`` (the exponential
   form the paper suggests for erosion too; it also erodes flat ground), and eq. 5.
-* ``"graded"`` (RFD*'s default, our law): a river cuts its bed down to a graded profile, so a
-  drop that arrived lowers every node of its path to ``E * (length still to walk to the goal)``
-  when that is lower than the node's altitude. The altitude of a carved node is then ``E`` times
-  the shortest route to the goal any drop has walked from it, and at a fork the branch with the
-  shorter remainder is the steeper one, whichever drop found it. Ground that no drop has carved
-  stays at ``initial_height`` (keep it above ``E`` times the longest walk); a drop standing in a
-  carved bed climbs onto it as if the slope were at most ``climb`` steep, so it keeps looking
-  for shortcuts beside its river (weight ``p_base ** -climb`` at worst). No eq. 5 sediment: the
-  profile is not levelled.
+* ``"graded"`` (RFD*'s default, our law): a river cuts its bed down to a graded profile. A drop
+  lowers every node ``i`` of its path to ``E * r(i)`` when that is lower, where ``r(i)`` is the
+  shortest way its own walk offers from ``i`` to water: to the goal, or to any node ``m`` later
+  on its path that a river already carved, plus ``altitude(m) / E`` (a tributary: the drop need
+  not arrive, only drain into a bed). The altitude of a carved node is then ``E`` times the
+  shortest route to the goal the swarm has walked from it, refined one walked edge at a time
+  (an asynchronous Bellman-Ford over the walks), and at a fork the branch with the shorter
+  remainder is the steeper one. Ground that no drop has carved stays at ``initial_height`` (keep
+  it above ``E`` times the longest walk). Between bed and plateau the transition sees clipped
+  gradients: a drop in a bed climbs out as if the slope were at most ``climb`` steep, so it
+  keeps looking for shortcuts beside its river, and a drop on the plateau sees a bed as no
+  steeper than ``E``, the bed's own slope, so a river does not swallow every drop that passes
+  beside it and other routes keep being walked. No eq. 5 sediment: the profile is not levelled.
 
 Why a third law: with eqs. 4 and 5 an altitude difference has to travel back from the goal one
 node per iteration and reflects how often an edge was used rather than how short the paths
 through it were; on the paper's 50 x 50 and 100 x 100 maps this converged to long paths within
 100 iterations for every setting we tried (``sweeps/rfd_static.py`` reports both laws).
 
-A drop that got stuck deposits ``sediment`` where it stands. RFD* drops do not climb slopes
-steeper than ``climb`` on uncarved ground: a drop whose only moves are steeper is stuck too, so
-deposits fill a blind alley from its end back to its entrance and later drops avoid it (the
-paper's "reduces the likelihood of transition to blind alleys"; without it a one-cell-wide dead
-end never fills). Altitudes are kept non-negative and the goal is reset to 0. Drops that run out
-of steps simply evaporate.
+Sediment. An original RFD drop that got stuck deposits ``sediment`` where it stands. An RFD*
+drop that got stuck fills the blind alley it ran into: the sediment settles where it stopped
+and flows back along its trail as long as the trail node has no other way out (every admissible
+move from it leads back or into the alley); each node filled in an iteration gains ``sediment``
+once. RFD* drops do not climb slopes steeper than ``climb`` on uncarved ground, so a filled
+alley is closed to later drops (the paper's "reduces the likelihood of transition to blind
+alleys"; filled one node per iteration, a maze's long dead ends stayed open for most of the 100
+iterations). Altitudes are kept non-negative and the goal is reset to 0. Drops that run out of
+steps simply evaporate.
 """
 from __future__ import annotations
 
@@ -51,7 +58,7 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
-from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, walk
+from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, Walk, edge_table, step_budget, walk
 
 
 EROSION_LAWS = ("linear", "exponential", "graded")
@@ -113,11 +120,11 @@ class RFDStarParams(NamedTuple):
       initial_height: altitude of every node but the goal at the start (graded law: the
         uncarved plateau, above ``erosion`` times the longest walk).
       erosion: E in eq. 4 (linear and exponential laws); the graded law's slope, altitude per
-        unit of path still to walk.
-      sediment: what a stuck drop deposits where it stands.
+        unit of path still to walk (and the steepest a bed looks from the plateau).
+      sediment: what each node of a blind alley gains when a stuck drop fills it.
       climb: the steepest uphill gradient a drop on uncarved ground will take; a drop whose only
-        moves are steeper is stuck (so deposits fill blind alleys from their end back to their
-        entrance). Graded law: from a carved node, uphill moves count as at most this steep.
+        moves are steeper is stuck (so a filled blind alley is closed to later drops). Graded
+        law: from a carved node, uphill moves count as at most this steep.
     """
 
     p_base: jax.Array
@@ -138,8 +145,8 @@ def _f32(**values):
 
 DEFAULT_RFD = RFDParams(**_f32(initial_height=1.0, erosion=1.0, sediment=0.1, omega=0.1,
                                delta=0.1))
-DEFAULT_RFD_STAR = RFDStarParams(**_f32(p_base=10.0, alpha=7.0, initial_height=1e4,
-                                        erosion=1.0, sediment=0.3, climb=1.0))
+DEFAULT_RFD_STAR = RFDStarParams(**_f32(p_base=100.0, alpha=12.0, initial_height=1e4,
+                                        erosion=1.0, sediment=0.3, climb=0.0))
 """Defaults for the graded law (tuned on the nine paper maps, see ``sweeps/rfd_static.py``)."""
 DEFAULT_RFD_STAR_EQ4 = RFDStarParams(**_f32(p_base=50.0, alpha=50.0, initial_height=1.0,
                                             erosion=50.0, sediment=0.3, climb=0.3))
@@ -182,7 +189,8 @@ def _build(config: RFDConfig, name: str) -> Swarm:
         drops = walk(walk_key, graph, log_weights, task.start, task.goal,
                      num_agents=config.num_agents,
                     max_steps=step_budget(graph, config.max_steps))
-        altitude = _erode_and_deposit(config, graph, task, state.altitude, drops, params)
+        altitude = _erode_and_deposit(config, graph, task, state.altitude, log_weights, drops,
+                                      params)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         return RFDState(key=key, altitude=altitude, best_path=best_path,
                         best_cost=best_cost), info
@@ -218,8 +226,9 @@ def rfd_star(num_agents: int = 256, max_steps: int | None = None,
 def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, params):
     """f32[N, K] log-weight of every edge for altitudes f32[N] (the walker's table, see
     :func:`jaxswarm.swarm.walk.edge_table`): eq. 1 for RFD; eq. 6 for RFD*, plus its climb limit
-    (a floor on the uphill gradient out of a carved bed, under the graded law) and the goal taken
-    whenever adjacent."""
+    and the goal taken whenever adjacent. Under the graded law, gradients between a carved bed
+    and the uncarved plateau are clipped: at least -climb out of the bed, at most ``erosion``
+    (the bed's own slope) into it."""
     heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
     gradient = (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
     if config.modified:
@@ -229,9 +238,14 @@ def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, param
         log_distance = jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
         too_steep = gradient < -params.climb
         if config.erosion_law == "graded":
-            carved = (altitude < params.initial_height)[:, None]
-            too_steep = too_steep & ~carved
-            gradient = jnp.where(carved, jnp.maximum(gradient, -params.climb), gradient)
+            carved = altitude < params.initial_height
+            from_bed, into_bed = carved[:, None], carved[heads]
+            too_steep = too_steep & ~from_bed
+            # Between a bed and the plateau: out of it at most climb steep, into it at most as
+            # steep as the bed itself (E), so a river does not drain every drop beside it.
+            gradient = jnp.where(from_bed, jnp.maximum(gradient, -params.climb), gradient)
+            gradient = jnp.where(~from_bed & into_bed, jnp.minimum(gradient, params.erosion),
+                                 gradient)
         logw = gradient * jnp.log(params.p_base) - params.alpha * log_distance[heads]
         logw = jnp.where(too_steep, -jnp.inf, logw)
         logw = jnp.where(heads == task.goal, FORCED, logw)
@@ -242,26 +256,34 @@ def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, param
     return edge_table(graph, logw)
 
 
-def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, drops: Walk,
-                       params):
-    """One iteration's erosion (by ``config.erosion_law``) and the sediment of stuck drops."""
+def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, log_weights,
+                       drops: Walk, params):
+    """One iteration's sediment of stuck drops, then its erosion (by ``config.erosion_law``), for
+    altitudes f32[N] and the walk's transition table f32[N, K]."""
     n = graph.num_nodes
-    moved = (drops.slots >= 0) & drops.arrived[:, None]
-    here = jnp.where(moved, drops.path[:, :-1], 0)
-    distance = jnp.where(moved, graph.cost[here, jnp.maximum(drops.slots, 0).astype(jnp.int32)],
-                         0.0)
-    if config.erosion_law == "graded":
-        altitude = _carve_graded(altitude, here, moved, distance, drops.length, params)
+    if config.modified:
+        altitude = altitude + jnp.where(blind_alleys(graph, log_weights, drops), params.sediment,
+                                        0.0)
     else:
-        altitude = _erode_eq4(config, altitude, drops, here, moved, distance, params)
-    stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
-    altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
+        stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
+        altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
+    if config.erosion_law == "graded":
+        altitude = _carve_graded(graph, altitude, drops, params)
+    else:
+        moved = drops.slots >= 0
+        here = jnp.where(moved, drops.path[:, :-1], 0)
+        distance = jnp.where(moved, graph.cost[here, jnp.maximum(drops.slots, 0).astype(jnp.int32)],
+                             0.0)
+        altitude = _erode_eq4(config, altitude, drops, here, distance, params)
     return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
 
 
-def _erode_eq4(config: RFDConfig, altitude, drops: Walk, here, moved, distance, params):
-    """Eqs. 4 and 5 (or the exponential form of eq. 4): f32[N] altitudes after erosion."""
+def _erode_eq4(config: RFDConfig, altitude, drops: Walk, here, distance, params):
+    """Eqs. 4 and 5 (or the exponential form of eq. 4) along the paths of the drops that
+    arrived (nodes ``here`` i32[A, L - 1], edge lengths ``distance`` f32[A, L - 1]): f32[N]
+    altitudes after erosion."""
     n = altitude.shape[0]
+    moved = (drops.slots >= 0) & drops.arrived[:, None]
     there = jnp.where(moved, drops.path[:, 1:], 0)
     gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
     if config.erosion_law == "exponential":
@@ -274,15 +296,78 @@ def _erode_eq4(config: RFDConfig, altitude, drops: Walk, here, moved, distance, 
     return altitude + jnp.sum(amount) / (n - 1)
 
 
-def _carve_graded(altitude, here, moved, distance, length, params):
-    """The graded law: f32[N] altitudes after each arrived path (nodes ``here`` i32[A, L - 1],
-    edge lengths ``distance`` f32[A, L - 1], path lengths ``length`` f32[A]) lowered its nodes to
-    ``erosion`` times the length still to walk from them."""
+def _carve_graded(graph: Graph, altitude, drops: Walk, params):
+    """The graded law: f32[N] altitudes after every drop lowered each node of its path to
+    ``erosion`` times the shortest way its walk offers from there to water: the goal, or a later
+    node of the path carved before this iteration (below ``initial_height``) plus its depth.
+
+    Works backwards over the walked part of the paths, ``STEPS_PER_CHECK`` columns at a time,
+    carrying per drop the length walked after the block and the best way to water found there.
+    """
     n = altitude.shape[0]
-    to_walk = length[:, None] - jnp.cumsum(distance, axis=1) + distance
-    bed = jnp.full((n,), jnp.inf, altitude.dtype).at[jnp.where(moved, here, n)].min(
-        params.erosion * to_walk, mode="drop")
-    return jnp.minimum(altitude, bed)
+    num_agents, width = drops.path.shape
+    blocks = -(-width // STEPS_PER_CHECK)
+    pad = blocks * STEPS_PER_CHECK - width
+    path = jnp.pad(drops.path, ((0, 0), (0, pad)), constant_values=-1)
+    slots = jnp.pad(drops.slots, ((0, 0), (0, pad + 1)), constant_values=-1).astype(jnp.int32)
+    walked_blocks = (drops.steps + STEPS_PER_CHECK) // STEPS_PER_CHECK  # blocks holding nodes
+
+    def one_block(carry):
+        block, after, best, carved = carry
+        first = block * STEPS_PER_CHECK
+        nodes = jax.lax.dynamic_slice_in_dim(path, first, STEPS_PER_CHECK, axis=1)
+        slot = jax.lax.dynamic_slice_in_dim(slots, first, STEPS_PER_CHECK, axis=1)
+        on_path = nodes >= 0
+        node = jnp.where(on_path, nodes, 0)
+        edge = jnp.where(slot >= 0, graph.cost[node, jnp.maximum(slot, 0)], 0.0)
+        # to_end[a, k]: length drop a walks from this node to where it stopped.
+        to_end = after[:, None] + jax.lax.cumsum(edge, axis=1, reverse=True)
+        depth = altitude[node]
+        water = jnp.where(on_path & (depth < params.initial_height),
+                          depth / params.erosion - to_end, jnp.inf)
+        reach = jnp.minimum(jax.lax.cummin(water, axis=1, reverse=True), best[:, None])
+        carves = on_path & jnp.isfinite(reach)
+        carved = carved.at[jnp.where(carves, node, n)].min(params.erosion * (reach + to_end),
+                                                           mode="drop")
+        return block - 1, to_end[:, 0], reach[:, 0], carved
+
+    _, _, _, carved = jax.lax.while_loop(
+        lambda carry: carry[0] >= 0, one_block,
+        (jnp.minimum(walked_blocks, blocks) - 1, jnp.zeros((num_agents,), jnp.float32),
+         jnp.full((num_agents,), jnp.inf, jnp.float32), altitude))
+    return carved
+
+
+def blind_alleys(graph: Graph, log_weights, drops: Walk):
+    """bool[N]: the blind alleys the stuck drops of a walk ran into.
+
+    For each stuck drop: the node where it stopped, and back along its trail every node from
+    which each admissible move (finite ``log_weights`` f32[N, K]) leads either back to where the
+    drop came from or into a node already filled; the first node with another way out, and the
+    start, end the alley.
+    """
+    n = graph.num_nodes
+    num_agents = drops.path.shape[0]
+    agents = jnp.arange(num_agents)
+    last = jnp.sum(drops.path >= 0, axis=1) - 1  # index of the node where each drop stopped
+    filled = jnp.zeros((n,), bool).at[jnp.where(drops.stuck, drops.position, n)].set(
+        True, mode="drop")
+
+    def filling(carry):
+        return jnp.any(carry[1])
+
+    def one_back(carry):
+        back, filling, filled = carry
+        index = jnp.maximum(last - back, 1)
+        node, came_from = drops.path[agents, index], drops.path[agents, index - 1]
+        heads = graph.nbr[node]
+        way_out = ((log_weights[node] > -jnp.inf) & (heads != came_from[:, None])
+                   & ~filled[jnp.where(heads >= 0, heads, 0)])
+        dead = filling & (last - back >= 1) & ~jnp.any(way_out, axis=1)
+        return back + 1, dead, filled.at[jnp.where(dead, node, n)].set(True, mode="drop")
+
+    _, _, filled = jax.lax.while_loop(filling, one_back, (jnp.int32(1), drops.stuck, filled))
+    return filled
 
 
 def _check_rfd(params: RFDParams) -> None:
