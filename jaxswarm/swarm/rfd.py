@@ -339,7 +339,8 @@ def _carve_graded(graph: Graph, altitude, drops: Walk, params):
 
 
 def blind_alleys(graph: Graph, log_weights, drops: Walk):
-    """bool[N]: the blind alleys the stuck drops of a walk ran into.
+    """bool[N]: the blind alleys the stuck drops of a walk (``drops``, A agents) ran into, given
+    the walk's transition table ``log_weights`` f32[N, K].
 
     For each stuck drop: the node where it stopped, and back along its trail every node from
     which each admissible move (finite ``log_weights`` f32[N, K]) leads either back to where the
@@ -353,7 +354,7 @@ def blind_alleys(graph: Graph, log_weights, drops: Walk):
     filled = jnp.zeros((n,), bool).at[jnp.where(drops.stuck, drops.position, n)].set(
         True, mode="drop")
 
-    def filling(carry):
+    def any_filling(carry):
         return jnp.any(carry[1])
 
     def one_back(carry):
@@ -366,7 +367,8 @@ def blind_alleys(graph: Graph, log_weights, drops: Walk):
         dead = filling & (last - back >= 1) & ~jnp.any(way_out, axis=1)
         return back + 1, dead, filled.at[jnp.where(dead, node, n)].set(True, mode="drop")
 
-    _, _, filled = jax.lax.while_loop(filling, one_back, (jnp.int32(1), drops.stuck, filled))
+    _, _, filled = jax.lax.while_loop(any_filling, one_back,
+                                      (jnp.int32(1), drops.stuck, filled))
     return filled
 
 
