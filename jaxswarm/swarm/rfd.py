@@ -21,7 +21,7 @@ RFD always uses ``"linear"``):
 * ``"graded"`` (RFD*'s default, our law): a river cuts its bed down to a graded profile. A drop
   lowers every node ``i`` of its path to ``E * r(i)`` when that is lower, where ``r(i)`` is the
   shortest way its own walk offers from ``i`` to water: to the goal, or to any node ``m`` later
-  on its path that a river already carved, plus ``altitude(m) / E`` (a tributary: the drop need
+  on its path carved before this iteration, plus ``altitude(m) / E`` (a tributary: the drop need
   not arrive, only drain into a bed). The altitude of a carved node is then ``E`` times the
   shortest route to the goal the swarm has walked from it, refined one walked edge at a time
   (an asynchronous Bellman-Ford over the walks), and at a fork the branch with the shorter
