@@ -267,7 +267,7 @@ def test_graded_gradients_between_bed_and_plateau_are_clipped():
     expected = -float(params.climb) * log_p - alpha * math.log(math.hypot(2, 1))
     assert logw(0, 3) == pytest.approx(expected, rel=1e-5)
     assert logw(0, 1) == pytest.approx(1.0 * log_p - alpha * math.log(1.0), rel=1e-5)
-    # Plateau node 3 -> carved node 0 (a plateau-high drop): seen no steeper than the bed's slope.
+    # Plateau node 3 -> carved node 0: the bank looks no steeper than the bed itself (erosion).
     assert logw(3, 0) == pytest.approx(float(params.erosion) * log_p - alpha * math.log(2.0),
                                        rel=1e-5)
     # Uncarved node 3 -> the deposit hill at 4 (5 higher): too steep, banned.
