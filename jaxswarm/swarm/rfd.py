@@ -58,7 +58,8 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
-from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, Walk, edge_table, step_budget, walk
+from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, Walk, edge_table, step_budget,
+                                 step_lengths, walk)
 
 
 EROSION_LAWS = ("linear", "exponential", "graded")
@@ -270,21 +271,18 @@ def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, lo
     if config.erosion_law == "graded":
         altitude = _carve_graded(graph, altitude, drops, params)
     else:
-        moved = drops.slots >= 0
-        here = jnp.where(moved, drops.path[:, :-1], 0)
-        distance = jnp.where(moved, graph.cost[here, jnp.maximum(drops.slots, 0).astype(jnp.int32)],
-                             0.0)
-        altitude = _erode_eq4(config, altitude, drops, here, distance, params)
+        altitude = _erode_eq4(config, graph, altitude, drops, params)
     return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
 
 
-def _erode_eq4(config: RFDConfig, altitude, drops: Walk, here, distance, params):
+def _erode_eq4(config: RFDConfig, graph: Graph, altitude, drops: Walk, params):
     """Eqs. 4 and 5 (or the exponential form of eq. 4) along the paths of the drops that
-    arrived (nodes ``here`` i32[A, L - 1], edge lengths ``distance`` f32[A, L - 1]): f32[N]
-    altitudes after erosion."""
+    arrived: f32[N] altitudes after erosion."""
     n = altitude.shape[0]
     moved = (drops.slots >= 0) & drops.arrived[:, None]
+    here = jnp.where(moved, drops.path[:, :-1], 0)
     there = jnp.where(moved, drops.path[:, 1:], 0)
+    distance = step_lengths(graph, here, drops.slots)
     gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
     if config.erosion_law == "exponential":
         # p_base ** gradient, capped so that a cliff cannot overflow float32.
@@ -309,7 +307,7 @@ def _carve_graded(graph: Graph, altitude, drops: Walk, params):
     blocks = -(-width // STEPS_PER_CHECK)
     pad = blocks * STEPS_PER_CHECK - width
     path = jnp.pad(drops.path, ((0, 0), (0, pad)), constant_values=-1)
-    slots = jnp.pad(drops.slots, ((0, 0), (0, pad + 1)), constant_values=-1).astype(jnp.int32)
+    slots = jnp.pad(drops.slots, ((0, 0), (0, pad + 1)), constant_values=-1)
     walked_blocks = (drops.steps + STEPS_PER_CHECK) // STEPS_PER_CHECK  # blocks holding nodes
 
     def one_block(carry):
@@ -319,7 +317,7 @@ def _carve_graded(graph: Graph, altitude, drops: Walk, params):
         slot = jax.lax.dynamic_slice_in_dim(slots, first, STEPS_PER_CHECK, axis=1)
         on_path = nodes >= 0
         node = jnp.where(on_path, nodes, 0)
-        edge = jnp.where(slot >= 0, graph.cost[node, jnp.maximum(slot, 0)], 0.0)
+        edge = step_lengths(graph, node, slot)
         # to_end[a, k]: length drop a walks from this node to where it stopped.
         to_end = after[:, None] + jax.lax.cumsum(edge, axis=1, reverse=True)
         depth = altitude[node]

@@ -101,6 +101,12 @@ def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
     return jnp.where(graph.valid_edges(), log_weights, -jnp.inf)
 
 
+def step_lengths(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
+    """f32[...]: the length of each recorded move, edge ``slots`` (i8/i16/i32) out of ``nodes``
+    (i32, same shape); 0 where the slot is -1 (no move)."""
+    return jnp.where(slots >= 0, graph.cost[nodes, jnp.maximum(slots, 0).astype(jnp.int32)], 0.0)
+
+
 def _mark(bits: jax.Array, agents: jax.Array, nodes: jax.Array) -> jax.Array:
     """Set bit ``nodes[a]`` in row ``agents[a]`` of a packed u32[A, ceil(N / 32)] bit set."""
     words = nodes >> 5
