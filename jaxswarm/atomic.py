@@ -7,9 +7,10 @@ Parquet datasets skip) instead of a damaged ``NAME``.
 from __future__ import annotations
 
 import contextlib
+import csv
 import os
 import secrets
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 
 TEMPORARY_GLOB = ".*.tmp"
@@ -38,3 +39,12 @@ def write_atomically(path, data: str | bytes) -> None:
             temporary.write_text(data, encoding="utf-8")
         else:
             temporary.write_bytes(data)
+
+
+def write_csv(path, rows: Iterable[Mapping], columns: Sequence[str]) -> None:
+    """Write ``rows`` (dicts) as a UTF-8 CSV file with a header, columns in the order given,
+    atomically (see :func:`atomic_path`)."""
+    with atomic_path(path) as temporary, open(temporary, "w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=list(columns))
+        writer.writeheader()
+        writer.writerows(rows)

@@ -22,14 +22,13 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import csv
 import statistics
 import time
 from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import atomic_path
+from jaxswarm.atomic import write_csv
 from jaxswarm.exact import dijkstra
 from jaxswarm.graph import path_map_graph
 from jaxswarm.maps.random import random_path_map
@@ -98,11 +97,7 @@ def main(argv: list[str] | None = None) -> int:
                   f"{row['min_length']:8.2f} {row['mean_length']:8.2f} {row['min_ratio']:8.3f} "
                   f"{row['mean_ratio']:9.3f} {row['found']:>3}/{row['runs']:<2} "
                   f"{row['mean_populations']:12.1f} {row['mean_seconds']:7.3f}", flush=True)
-    with atomic_path(args.out / "results.csv") as temporary:
-        with open(temporary, "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=COLUMNS)
-            writer.writeheader()
-            writer.writerows(rows)
+    write_csv(args.out / "results.csv", rows, COLUMNS)
     print(f"written to {args.out / 'results.csv'}")
     return 0
 

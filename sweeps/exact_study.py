@@ -37,7 +37,6 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import csv
 import math
 import sys
 import time
@@ -47,7 +46,7 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import atomic_path
+from jaxswarm.atomic import atomic_path, write_csv
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
@@ -187,14 +186,6 @@ def summarise(rows: list[dict]) -> list[dict]:
     return summary
 
 
-def write_csv(rows: list[dict], path, columns) -> None:
-    """Write ``rows`` (dicts) with the given column order to ``path``, atomically."""
-    with atomic_path(path) as temporary, open(temporary, "w", newline="", encoding="utf-8") as f:
-        writer = csv.DictWriter(f, fieldnames=list(columns))
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def plot_summary(summary: list[dict], path) -> None:
     """Three panels (iterations, visited nodes, time in ms vs grid size): mean line and a shaded
     +-1 std band per planner. Saved as PNG to ``path``, atomically."""
@@ -261,8 +252,8 @@ def main(argv: list[str] | None = None) -> int:
     began = time.perf_counter()
     rows = run_study(sizes, args.grids, args.density, args.seed)
     summary = summarise(rows)
-    write_csv(rows, args.out / "runs.csv", RUN_COLUMNS)
-    write_csv(summary, args.out / "summary.csv", SUMMARY_COLUMNS)
+    write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
+    write_csv(args.out / "summary.csv", summary, SUMMARY_COLUMNS)
     plot_summary(summary, args.out / "exact_study.png")
 
     print("\n" + format_summary(summary))

@@ -31,8 +31,6 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import math
 import statistics
 import time
@@ -46,7 +44,7 @@ matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import write_atomically
+from jaxswarm.atomic import write_atomically, write_csv
 from jaxswarm.exact import astar, dijkstra
 from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import (
@@ -230,15 +228,6 @@ def figure(best: dict[str, dict[str, Solution]]) -> Figure:
     return fig
 
 
-def csv_text(rows: list[dict]) -> str:
-    """The rows as CSV text with a header (columns COLUMNS)."""
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    return buffer.getvalue()
-
-
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -260,7 +249,7 @@ def main(argv: list[str] | None = None) -> int:
         mine, best[name] = solve_map(name, args.seeds, iterations=args.iterations,
                                      agents=args.agents)
         rows += mine
-    write_atomically(args.out / "runs.csv", csv_text(rows))
+    write_csv(args.out / "runs.csv", rows, COLUMNS)
     markdown = table(rows, maps, seeds=args.seeds, iterations=args.iterations, agents=args.agents)
     write_atomically(args.out / "table.md", markdown)
     fig = figure(best)

@@ -16,14 +16,13 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import csv
 import statistics
 import time
 from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import atomic_path, write_atomically
+from jaxswarm.atomic import write_atomically, write_csv
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.swarm import make, make_task, run
@@ -86,14 +85,6 @@ def table(rows: list[dict], maps: list[str]) -> str:
     return "\n".join(lines)
 
 
-def write_csv(path: Path, rows: list[dict]) -> None:
-    """The rows (columns COLUMNS) as a CSV file, written atomically."""
-    with atomic_path(path) as temporary, open(temporary, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
-        writer.writeheader()
-        writer.writerows(rows)
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", default=",".join(PAPER_MAPS), help="comma-separated paper maps")
@@ -118,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
             rows += mine
             print(f"{name:10} {algorithm:9} success {sum(r['success'] for r in mine):2d}/"
                   f"{args.seeds} ({time.perf_counter() - began:.0f} s)", flush=True)
-    write_csv(args.out / "runs.csv", rows)
+    write_csv(args.out / "runs.csv", rows, COLUMNS)
     markdown = table(rows, maps)
     write_atomically(args.out / "table.md", markdown + "\n")
     print("\n" + markdown)

@@ -1,7 +1,9 @@
 """Atomic writes: the target is replaced whole or not at all, and no temporary file stays."""
+import csv
+
 import pytest
 
-from jaxswarm.atomic import atomic_path, write_atomically
+from jaxswarm.atomic import atomic_path, write_atomically, write_csv
 
 
 def test_a_write_replaces_the_file_and_leaves_nothing_behind(tmp_path):
@@ -22,3 +24,11 @@ def test_a_failed_write_keeps_the_old_file_and_removes_the_temporary(tmp_path):
             raise RuntimeError("interrupted")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["runs.csv"]
+
+
+def test_write_csv_keeps_the_column_order_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "out" / "rows.csv"
+    write_csv(target, [dict(b=1, a="x"), dict(b=2, a="y,z")], columns=["b", "a"])
+    with open(target, newline="", encoding="utf-8") as f:
+        assert list(csv.reader(f)) == [["b", "a"], ["1", "x"], ["2", "y,z"]]
+    assert [p.name for p in target.parent.iterdir()] == ["rows.csv"]
