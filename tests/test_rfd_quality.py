@@ -9,9 +9,6 @@ from jaxswarm.swarm import make, make_task, run
 
 SEEDS = 20
 NEEDED = 19  # the bar: the optimum (gap < 1e-4) in at least 19 of 20 seeds
-# Maps where the current RFD* misses the bar (see sweeps/rfd_static.py for its figures): strict
-# xfails, so a change that fixes one of them fails here until the marker is removed.
-SHORT_OF_THE_BAR = {"mosaic100", "alley100"}
 
 
 def successes(name: str) -> int:
@@ -28,17 +25,12 @@ def successes(name: str) -> int:
     return int((gaps < 1e-4).sum())
 
 
-def marked(names):
-    return [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="RFD* short of 19/20"))
-            if n in SHORT_OF_THE_BAR else n for n in names]
-
-
-@pytest.mark.parametrize("name", marked([n for n in PAPER_MAPS if n.endswith("20")]))
+@pytest.mark.parametrize("name", [n for n in PAPER_MAPS if n.endswith("20")])
 def test_rfd_star_reaches_the_optimum_on_20x20_maps(name):
     assert successes(name) >= NEEDED
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", marked([n for n in PAPER_MAPS if not n.endswith("20")]))
+@pytest.mark.parametrize("name", [n for n in PAPER_MAPS if not n.endswith("20")])
 def test_rfd_star_reaches_the_optimum_on_larger_maps(name):
     assert successes(name) >= NEEDED

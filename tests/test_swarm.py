@@ -276,6 +276,81 @@ def test_graded_gradients_between_bed_and_plateau_are_clipped():
     assert logw(5, 4) == -np.inf and logw(1, 2) > 1e29
 
 
+def test_settling_leaves_no_filled_pit():
+    from jaxswarm.swarm import rfd
+    obstacles = np.zeros((3, 7), bool)
+    obstacles[:, 6] = True
+    obstacles[1, 6] = False  # (6, 1) is free but walled in on the east
+    obstacles[[0, 2], :] = True
+    graph = grid_graph(obstacles)  # a corridor (0, 1)..(5, 1), and (6, 1) joined to (5, 1)
+    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+                                                       repose=jnp.float32(0.25))
+    altitude = jnp.full((graph.num_nodes,), 100.0)
+    row = 7  # node of (x, 1) is 7 + x
+    altitude = altitude.at[row + jnp.arange(7)].set(
+        jnp.array([101.0, 100.5, 101.0, 100.0, 99.0, 0.0, 102.0]))
+    settled = np.asarray(rfd.settle(graph, altitude, params))[row: row + 7]
+    # (1, 1) is a pit between two 101s: raised to 101.25, which makes (0, 1) a pit in turn.
+    # (2, 1) drains to the unfilled (3, 1); unfilled and carved nodes and (6, 1), which drains
+    # into the bed at (5, 1), keep their altitude.
+    np.testing.assert_allclose(settled, [101.5, 101.25, 101.0, 100.0, 99.0, 0.0, 102.0])
+    # A filled node without any edge has nowhere to settle to and keeps its altitude.
+    alone = np.ones((3, 3), bool)
+    alone[1, 1] = False
+    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((9,), 101.0), params))
+    assert lone[4] == 101.0
+
+
+def test_a_drop_erodes_the_banks_it_visits():
+    from jaxswarm.swarm import rfd
+    graph = grid_graph(np.zeros((1, 5), bool))
+    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+                                                       erosion=jnp.float32(1.0))
+    altitude = jnp.array([100.0, 7.0, 9.0, 0.5, 0.0])
+    visited = jnp.array([True, True, True, False, False])
+    eroded = np.asarray(rfd.erode_banks(graph, altitude, visited, params))
+    # (2, 0) sees the bed at (3, 0): 0.5 + 1. (1, 0) looks once, at the old 9 and the uncarved
+    # plateau, and keeps its 7; the plateau node and the unvisited nodes are left alone.
+    np.testing.assert_allclose(eroded, [100.0, 7.0, 1.5, 0.5, 0.0])
+
+
+def test_ground_explored_in_vain_rises_towards_the_frontier():
+    # The drops run out of steps on (2, 0) of a 1 x 6 corridor: their trail gains sediment and
+    # settles so that it slopes down to the unexplored (3, 0).
+    graph = grid_graph(np.zeros((1, 6), bool))
+    task = make_task(graph, (0, 0), (5, 0))
+    swarm = make("rfd_star", num_agents=4, max_steps=2)
+    params = swarm.default_params._replace(initial_height=jnp.float32(100.0),
+                                           sediment=jnp.float32(0.5), repose=jnp.float32(0.25))
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    state, info = swarm.step(state, graph, task, params)
+    assert float(info.arrived) == 0.0
+    np.testing.assert_allclose(state.altitude, [101.0, 100.75, 100.5, 100.0, 100.0, 0.0])
+
+
+def test_with_exact_altitudes_the_greedy_drop_walks_a_shortest_path():
+    from jaxswarm.exact.field import distance_field
+    chosen = paper_map("mosaic50")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    optimum = dijkstra(graph, chosen.start, chosen.goal).cost
+    swarm = make("rfd_star", num_agents=4, greedy_drops=1)
+    params = swarm.default_params
+    field = distance_field(graph, task.goal) * params.erosion
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    for seed in range(3):
+        state = dataclasses.replace(state, altitude=field, key=jax.random.key(seed))
+        stepped, _ = swarm.step(state, graph, task, params)
+        assert float(stepped.best_cost) == pytest.approx(optimum, rel=1e-5)
+
+
+def test_greedy_drops_are_checked():
+    with pytest.raises(ValueError, match=r"greedy_drops must be between 0 and num_agents \(4\)"):
+        make("rfd_star", num_agents=4, greedy_drops=5)
+    with pytest.raises(ValueError, match="greedy_drops must be between 0 and num_agents"):
+        make("rfd_star", greedy_drops=-1)
+
+
 def test_erosion_law_is_checked():
     with pytest.raises(ValueError, match="unknown erosion_law 'sideways'; choose one of linear"):
         make("rfd_star", erosion_law="sideways")
@@ -307,6 +382,7 @@ def test_unreachable_goal_is_a_clean_not_found_result():
     ("alpha", float("inf"), "alpha must be finite"),
     ("sediment", -1.0, "sediment must be non-negative"),
     ("erosion", 0.0, "erosion must be positive"),  # the graded law's slope
+    ("repose", -0.1, "repose must be non-negative"),
 ])
 def test_bad_params_are_named(maze, field, value, message):
     graph, task, _ = maze

@@ -32,6 +32,19 @@ def test_forced_slot_always_wins():
     assert (np.asarray(choice) == 1).all()
 
 
+def test_greedy_rows_take_the_most_likely_slot_and_draw_among_ties():
+    log_weights = jnp.log(jnp.array([[1.0, 3.0, 2.0, 3.0, 9.0]] * 4000))
+    mask = jnp.array([[True, True, True, True, False]] * 4000)  # slot 4 is heaviest but masked
+    greedy = jnp.arange(4000) < 2000
+    choice, has = sample_masked(jax.random.key(5), log_weights, mask, greedy)
+    assert bool(has.all())
+    greedy_counts = np.bincount(np.asarray(choice[:2000]), minlength=5)
+    assert greedy_counts[[0, 2, 4]].sum() == 0  # only the tied best slots 1 and 3
+    assert 900 < greedy_counts[1] < 1100
+    drawn = np.bincount(np.asarray(choice[2000:]), minlength=5)
+    assert drawn[0] > 0 and drawn[2] > 0  # the other rows still draw
+
+
 def uniform(graph):
     return edge_table(graph, jnp.zeros(graph.nbr.shape))
 
@@ -72,6 +85,21 @@ def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
     assert int(result.steps) == min(STEPS_PER_CHECK, 10)  # one chunk, capped by the budget
     at_goal = walk(jax.random.key(0), graph, uniform(graph), 6, 6, num_agents=2, max_steps=5)
     assert bool(at_goal.arrived.all()) and int(at_goal.steps) == 0
+
+
+def test_greedy_agents_descend_deterministically_and_the_others_do_not():
+    graph = grid_graph(np.zeros((8, 8), bool))
+    goal = 63
+    closer = -jnp.linalg.norm(graph.xy - graph.xy[goal], axis=-1)  # prefer moves towards the goal
+    logw = edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)], graph.nbr.shape))
+    walks = [walk(jax.random.key(k), graph, logw, 0, goal, num_agents=16, max_steps=20,
+                  greedy_agents=2) for k in range(3)]
+    for result in walks:
+        np.testing.assert_array_equal(result.path[0], [0, 9, 18, 27, 36, 45, 54, 63] + [-1] * 13)
+        np.testing.assert_array_equal(result.path[1], result.path[0])
+        assert float(result.length[0]) == pytest.approx(7 * np.sqrt(2), rel=1e-6)
+    drawn = np.stack([np.asarray(result.path[2:]) for result in walks])
+    assert (drawn != drawn[0]).any()  # drawing agents vary with the key
 
 
 def test_excluded_and_invalid_edges_are_never_taken():

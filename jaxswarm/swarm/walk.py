@@ -4,7 +4,8 @@
 ``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
 heuristics do not change while the agents walk). Each step, every still-walking agent gathers
 its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
-has not visited in this walk), and draws one slot through :func:`sample_masked`. An agent stops
+has not visited in this walk), and draws one slot through :func:`sample_masked` (a greedy
+agent takes its most likely slot instead, ties drawn at random). An agent stops
 when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
 runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped.
 
@@ -55,7 +56,8 @@ class Walk(NamedTuple):
     steps: jax.Array
 
 
-def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
+def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array,
+                  greedy: jax.Array | None = None):
     """Draw one slot per row among the masked-in slots, by inverse CDF (one uniform per row).
 
     Args:
@@ -63,6 +65,7 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
       log_weights: f32[A, K] unnormalised log-probabilities; ``-inf`` means probability 0 and
         ``FORCED`` makes a slot certain.
       mask: bool[A, K] slots that may be chosen.
+      greedy: optional bool[A]; a greedy row takes its most likely slot (ties drawn uniformly).
 
     Returns:
       ``(choice i32[A], has_choice bool[A])``. Rows with no admissible slot of positive weight get
@@ -73,6 +76,8 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array):
     top = jnp.max(masked, axis=-1, keepdims=True)
     has_choice = jnp.isfinite(top[..., 0])  # False for no slot, all -inf, or NaN weights
     weights = jnp.exp(masked - jnp.where(has_choice[..., None], top, 0.0))
+    if greedy is not None:
+        weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
     cdf = _cumsum_last(weights)
     total = cdf[..., -1:]
     u = jax.random.uniform(key, has_choice.shape)[..., None] * total
@@ -130,7 +135,7 @@ def _cumsum_last(x: jax.Array) -> jax.Array:
 
 
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
-         max_steps: int) -> Walk:
+         max_steps: int, greedy_agents: int = 0) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal`` in lockstep.
 
     Args:
@@ -142,12 +147,15 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       start, goal: i32[] node indices (may be traced).
       num_agents: A (static).
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
+      greedy_agents: how many agents (the first ones; static) always take their most likely
+        admissible move, ties drawn at random, instead of sampling.
 
     Returns:
       A :class:`Walk`.
     """
     n = graph.num_nodes
     agents = jnp.arange(num_agents)
+    greedy = agents < greedy_agents if greedy_agents else None
     start = jnp.asarray(start, jnp.int32)
     goal = jnp.asarray(goal, jnp.int32)
     position = jnp.full((num_agents,), start)
@@ -195,7 +203,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         row = log_weights[here]
         seen = _is_marked(c["visited"], jnp.where(neighbours >= 0, neighbours, 0))
         admissible = (row > -jnp.inf) & ~seen & c["walking"][:, None]
-        choice, has_choice = sample_masked(draw_key, row, admissible)
+        choice, has_choice = sample_masked(draw_key, row, admissible, greedy)
         moving = c["walking"] & has_choice & (c["step"] < max_steps)
         slot = jnp.maximum(choice, 0)
         target = jnp.take_along_axis(neighbours, slot[:, None], axis=1)[:, 0]
