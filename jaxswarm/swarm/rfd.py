@@ -144,7 +144,8 @@ class RFDStarParams(NamedTuple):
         uncarved plateau, above ``erosion`` times the longest walk).
       erosion: E in eq. 4 (linear and exponential laws); the graded law's slope, altitude per
         unit of path still to walk (and the steepest a bed looks from the plateau).
-      sediment: what each node of a blind alley gains when a stuck drop fills it.
+      sediment: what each node of a blind alley gains when a stuck drop fills it; graded law:
+        also what each uncarved node on the trail of a drop that did not arrive gains.
       climb: the steepest uphill gradient a drop on uncarved ground will take; a drop whose only
         moves are steeper is stuck (so a filled blind alley is closed to later drops). Graded
         law: from a carved node, uphill moves count as at most this steep.
