@@ -300,18 +300,18 @@ def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, lo
         stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
         altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
     if config.erosion_law == "graded":
-        failed = visited_nodes(n, drops, ~drops.arrived)
+        failed = _visited_nodes(n, drops, ~drops.arrived)
         plateau = altitude >= params.initial_height
         altitude = settle(graph, altitude + jnp.where(failed & plateau, params.sediment, 0.0),
                           params)
         altitude = _carve_graded(graph, altitude, drops, params)
-        altitude = erode_banks(graph, altitude, visited_nodes(n, drops), params)
+        altitude = erode_banks(graph, altitude, _visited_nodes(n, drops), params)
     else:
         altitude = _erode_eq4(config, graph, altitude, drops, params)
     return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
 
 
-def visited_nodes(num_nodes: int, drops: Walk, which=None) -> jax.Array:
+def _visited_nodes(num_nodes: int, drops: Walk, which=None) -> jax.Array:
     """bool[N]: the nodes on the paths of the drops selected by ``which`` (bool[A]; all drops
     when None)."""
     on_path = drops.path >= 0
