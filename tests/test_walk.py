@@ -8,10 +8,15 @@ from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, edge_table, sample_masked, walk
 
 
+def _uniform(seed, mask):
+    """f32[A]: one seeded uniform per row of a bool[A, K] mask."""
+    return jax.random.uniform(jax.random.key(seed), mask.shape[:1])
+
+
 def test_sampler_follows_weights_and_never_picks_masked_slots():
     log_weights = jnp.log(jnp.array([[1.0, 2.0, 0.0, 5.0]] * 20000))
     mask = jnp.array([[True, True, True, False]] * 20000)  # slot 3 is heavy but masked
-    choice, has = jax.jit(sample_masked)(jax.random.key(0), log_weights, mask)
+    choice, has = jax.jit(sample_masked)(_uniform(0, mask), log_weights, mask)
     assert bool(has.all())
     counts = np.bincount(np.asarray(choice), minlength=4)
     assert counts[2] == 0 and counts[3] == 0  # zero weight and masked
@@ -21,14 +26,15 @@ def test_sampler_follows_weights_and_never_picks_masked_slots():
 def test_sampler_reports_no_choice_instead_of_slot_zero():
     log_weights = jnp.array([[0.0, 0.0], [jnp.nan, jnp.nan], [-jnp.inf, -jnp.inf], [0.0, 1.0]])
     mask = jnp.array([[False, False], [True, True], [True, True], [True, True]])
-    choice, has = sample_masked(jax.random.key(1), log_weights, mask)
+    choice, has = sample_masked(_uniform(1, mask), log_weights, mask)
     np.testing.assert_array_equal(has, [False, False, False, True])
     np.testing.assert_array_equal(choice[:3], [-1, -1, -1])
 
 
 def test_forced_slot_always_wins():
     log_weights = jnp.array([[3.0, FORCED, 50.0]] * 1000)
-    choice, _ = sample_masked(jax.random.key(2), log_weights, jnp.ones((1000, 3), bool))
+    choice, _ = sample_masked(jax.random.uniform(jax.random.key(2), (1000,)), log_weights,
+                              jnp.ones((1000, 3), bool))
     assert (np.asarray(choice) == 1).all()
 
 
@@ -36,7 +42,7 @@ def test_greedy_rows_take_the_most_likely_slot_and_draw_among_ties():
     log_weights = jnp.log(jnp.array([[1.0, 3.0, 2.0, 3.0, 9.0]] * 4000))
     mask = jnp.array([[True, True, True, True, False]] * 4000)  # slot 4 is heaviest but masked
     greedy = jnp.arange(4000) < 2000
-    choice, has = sample_masked(jax.random.key(5), log_weights, mask, greedy)
+    choice, has = sample_masked(_uniform(5, mask), log_weights, mask, greedy)
     assert bool(has.all())
     greedy_counts = np.bincount(np.asarray(choice[:2000]), minlength=5)
     assert greedy_counts[[0, 2, 4]].sum() == 0  # only the tied best slots 1 and 3

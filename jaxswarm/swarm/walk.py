@@ -56,12 +56,12 @@ class Walk(NamedTuple):
     steps: jax.Array
 
 
-def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array,
+def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
                   greedy: jax.Array | None = None):
-    """Draw one slot per row among the masked-in slots, by inverse CDF (one uniform per row).
+    """Draw one slot per row among the masked-in slots, by inverse CDF.
 
     Args:
-      key: PRNG key.
+      uniform: f32[A] one uniform draw in [0, 1) per row (e.g. ``jax.random.uniform``).
       log_weights: f32[A, K] unnormalised log-probabilities; ``-inf`` means probability 0 and
         ``FORCED`` makes a slot certain.
       mask: bool[A, K] slots that may be chosen.
@@ -80,7 +80,7 @@ def sample_masked(key: jax.Array, log_weights: jax.Array, mask: jax.Array,
         weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
     cdf = _cumsum_last(weights)
     total = cdf[..., -1:]
-    u = jax.random.uniform(key, has_choice.shape)[..., None] * total
+    u = uniform[..., None] * total
     # The first slot whose cumulative weight exceeds u (a slot of positive weight), capped at the
     # last slot of positive weight in case rounding made u reach the total. Counting is cheaper
     # than argmax (a variadic reduce) on CPU.
@@ -139,7 +139,9 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     """Walk ``num_agents`` agents from ``start`` towards ``goal`` in lockstep.
 
     Args:
-      key: PRNG key (one split per step; the same key gives the same walk).
+      key: PRNG key (split once per ``STEPS_PER_CHECK`` steps, which draw their uniforms in one
+        batch: generating them one step at a time cost a third of a step; the same key gives the
+        same walk).
       graph: the map.
       log_weights: f32[N, K] unnormalised log-probability of each edge (see
         :func:`edge_table`); ``-inf`` where the edge may not be taken (no neighbour, not valid
@@ -183,27 +185,28 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         """STEPS_PER_CHECK steps; their slots and nodes go to small blocks (cheap writes at the
         static loop index) that are copied into the buffers once per chunk."""
         first = c["step"]
+        key, draw_key = jax.random.split(c["key"])
+        draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
 
         def step_into_blocks(i, inner):
             c, slots, nodes = inner
-            c, slot, node = one_step(c)
+            c, slot, node = one_step(c, draws[i])
             return c, slots.at[:, i].set(slot), nodes.at[:, i].set(node)
 
         slots = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
         nodes = jnp.full((num_agents, STEPS_PER_CHECK), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
-                                            (c, slots, nodes))
+                                            (dict(c, key=key), slots, nodes))
         return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots, (0, first)),
                     nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes, (0, first)))
 
-    def one_step(c):
-        key, draw_key = jax.random.split(c["key"])
+    def one_step(c, uniform):
         here = c["position"]
         neighbours = graph.nbr[here]
         row = log_weights[here]
         seen = _is_marked(c["visited"], jnp.where(neighbours >= 0, neighbours, 0))
         admissible = (row > -jnp.inf) & ~seen & c["walking"][:, None]
-        choice, has_choice = sample_masked(draw_key, row, admissible, greedy)
+        choice, has_choice = sample_masked(uniform, row, admissible, greedy)
         moving = c["walking"] & has_choice & (c["step"] < max_steps)
         slot = jnp.maximum(choice, 0)
         target = jnp.take_along_axis(neighbours, slot[:, None], axis=1)[:, 0]
@@ -211,7 +214,6 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         arrived_now = moving & (there == goal)
         c = dict(
             c,
-            key=key,
             position=there,
             visited=_mark(c["visited"], agents, there),
             length=c["length"] + jnp.where(moving, graph.cost[here, slot], 0.0),
