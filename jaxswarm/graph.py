@@ -101,6 +101,42 @@ class Graph:
         return dense
 
 
+def lowest_neighbour(graph: Graph, values: jax.Array, extra: jax.Array) -> jax.Array:
+    """f32[N]: ``min_k values[nbr[:, k]] + extra[:, k]``, the cheapest way to a neighbour.
+
+    Args:
+      graph: the map.
+      values: f32[N] a value per node.
+      extra: f32[N, K] a cost per edge slot; put ``inf`` where a slot must not count (no
+        neighbour, or an edge not valid now), since ``values`` is read there arbitrarily.
+
+    Returns:
+      f32[N]; ``inf`` for a node whose slots are all ``inf``.
+
+    On grids and path maps the neighbour of slot ``k`` is the cell shifted by ``DIRECTIONS[k]``,
+    so the values are read by slicing the [H, W] array; on general graphs by one gather per
+    slot. Both are several times faster on CPU than gathering the f32[N, K] table at once.
+    """
+    num_slots = graph.max_degree
+    if graph.is_grid:
+        height, width = graph.shape
+        padded = jnp.pad(values.reshape(height, width), 1)
+
+        def at_slot(k):
+            dx, dy = DIRECTIONS[k]
+            return padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width].reshape(-1)
+    else:
+        heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
+
+        def at_slot(k):
+            return values[heads[:, k]]
+
+    lowest = at_slot(0) + extra[:, 0]
+    for k in range(1, num_slots):
+        lowest = jnp.minimum(lowest, at_slot(k) + extra[:, k])
+    return lowest
+
+
 @jax.jit
 def _valid_edges(graph: Graph) -> jax.Array:
     has_nbr = graph.nbr >= 0

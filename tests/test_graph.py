@@ -4,7 +4,10 @@ import numpy as np
 import pytest
 import scipy.sparse.csgraph as csgraph
 
-from jaxswarm.graph import DIRECTIONS, OPPOSITE, dense_graph, grid_graph, path_map_graph
+import jax.numpy as jnp
+
+from jaxswarm.graph import (DIRECTIONS, OPPOSITE, dense_graph, grid_graph, lowest_neighbour,
+                            path_map_graph)
 from oracle import grid_adjacency
 
 
@@ -77,6 +80,25 @@ def test_dense_graph_round_trip_and_shortest_paths_match_scipy():
     ours = csgraph.shortest_path(np.where(np.isfinite(dense), dense, 0), directed=True)
     theirs = csgraph.shortest_path(np.where(np.isfinite(weights), weights, 0), directed=True)
     np.testing.assert_allclose(ours, theirs, rtol=1e-6)
+
+
+@pytest.mark.parametrize("make", [
+    lambda rng: grid_graph(rng.random((6, 11)) < 0.3),
+    lambda rng: grid_graph(rng.random((9, 4)) < 0.3, connectivity=4),
+    lambda rng: path_map_graph(rng.random((5, 7, 8)) < 0.7),
+    lambda rng: dense_graph(np.where(rng.random((12, 12)) < 0.4, rng.random((12, 12)) + 0.5,
+                                     np.inf)),
+], ids=["grid8", "grid4", "path_map", "dense"])
+def test_lowest_neighbour_is_the_cheapest_valid_edge(make):
+    rng = np.random.default_rng(11)
+    graph = make(rng)
+    values = rng.random(graph.num_nodes).astype(np.float32) * 10
+    lengths = jnp.where(graph.valid_edges(), graph.cost, jnp.inf)
+    expected = np.full(graph.num_nodes, np.inf)
+    for (u, v), length in edges_of(graph).items():
+        expected[u] = min(expected[u], values[v] + length)
+    np.testing.assert_allclose(lowest_neighbour(graph, jnp.asarray(values), lengths), expected,
+                               rtol=1e-6)
 
 
 def test_graph_is_a_pytree_with_static_shape():

@@ -10,7 +10,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
+from jaxswarm.graph import Graph, lowest_neighbour
 
 SWEEPS_PER_CHECK = 4
 """Relaxation sweeps between two convergence tests (amortises the loop's overhead)."""
@@ -30,12 +30,11 @@ def distance_field(graph: Graph, goal) -> jax.Array:
     """
     n = graph.num_nodes
     valid = graph.valid_edges()
-    heads = jnp.where(valid, graph.nbr, 0)
     lengths = jnp.where(valid, graph.cost, jnp.inf)
     d0 = jnp.where(jnp.arange(n) == goal, 0.0, jnp.inf).astype(jnp.float32)
 
     def relax(d):
-        return jnp.minimum(d, jnp.min(lengths + d[heads], axis=-1))
+        return jnp.minimum(d, lowest_neighbour(graph, d, lengths))
 
     def body(carry):
         d, _, sweeps = carry

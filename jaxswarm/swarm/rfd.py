@@ -71,7 +71,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
+from jaxswarm.graph import Graph, lowest_neighbour
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
 from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, Walk, edge_table, step_budget,
@@ -331,7 +331,7 @@ def settle(graph: Graph, altitude, params):
 
     def sweep(carry):
         altitude, sweeps, _ = carry
-        lowest = _lowest_neighbour(graph, altitude, rise)  # inf for a node without edges
+        lowest = lowest_neighbour(graph, altitude, rise)  # inf for a node without edges
         pit = (altitude > params.initial_height) & (lowest > altitude) & jnp.isfinite(lowest)
         return jnp.where(pit, lowest, altitude), sweeps + 1, jnp.any(pit)
 
@@ -342,17 +342,6 @@ def settle(graph: Graph, altitude, params):
     return jax.lax.while_loop(unsettled, sweep, (altitude, 0, True))[0]
 
 
-def _lowest_neighbour(graph: Graph, values, extra):
-    """f32[N]: min over slots k of ``values[nbr[:, k]] + extra[:, k]`` (f32[N] values, f32[N, K]
-    extra; put inf in ``extra`` where a slot must not count). One gather per slot: on CPU this
-    is about ten times faster than gathering the f32[N, K] table at once."""
-    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-    lowest = values[heads[:, 0]] + extra[:, 0]
-    for k in range(1, graph.max_degree):
-        lowest = jnp.minimum(lowest, values[heads[:, k]] + extra[:, k])
-    return lowest
-
-
 def erode_banks(graph: Graph, altitude, visited, params):
     """f32[N] altitudes after every carved node a drop visited (``visited`` bool[N]) was lowered
     to its lowest carved neighbour plus ``erosion`` times the edge length, where that is lower:
@@ -361,7 +350,7 @@ def erode_banks(graph: Graph, altitude, visited, params):
     bed = jnp.where(carved, altitude, jnp.inf)
     run = jnp.where(graph.valid_edges(), params.erosion * graph.cost, jnp.inf)
     return jnp.where(visited & carved,
-                     jnp.minimum(altitude, _lowest_neighbour(graph, bed, run)), altitude)
+                     jnp.minimum(altitude, lowest_neighbour(graph, bed, run)), altitude)
 
 
 def _erode_eq4(config: RFDConfig, graph: Graph, altitude, drops: Walk, params):
