@@ -101,6 +101,12 @@ class Graph:
         return dense
 
 
+def straight_line(graph: Graph, node) -> jax.Array:
+    """f32[N]: the straight-line (Cartesian) distance from every node's ``xy`` to that of
+    ``node`` (i32[], may be traced): the goal-distance heuristic of RFD* and ACO*."""
+    return jnp.linalg.norm(graph.xy - graph.xy[node], axis=-1)
+
+
 def lowest_neighbour(graph: Graph, values: jax.Array, extra: jax.Array) -> jax.Array:
     """f32[N]: ``min_k values[nbr[:, k]] + extra[:, k]``, the cheapest way to a neighbour.
 

@@ -28,7 +28,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
+from jaxswarm.graph import Graph, straight_line
 from jaxswarm.paths import Solution, step_slots
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
 from jaxswarm.swarm.bug2 import bug2_path, direction_cosine
@@ -124,7 +124,7 @@ def transition_rule(config: ACOConfig, graph: Graph, task: Task, pheromone, para
         eta = 1.0 / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
     logw = params.alpha * jnp.log(pheromone) + params.beta * jnp.log(eta)
     if config.goal_heuristic:
-        to_goal = jnp.linalg.norm(graph.xy - graph.xy[task.goal], axis=-1)
+        to_goal = straight_line(graph, task.goal)
         logw = logw - params.alpha_goal * jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))[heads]
         logw = jnp.where(heads == task.goal, FORCED, logw)
     return edge_table(graph, logw)

@@ -71,7 +71,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, lowest_neighbour
+from jaxswarm.graph import Graph, lowest_neighbour, straight_line
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
 from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, Walk, edge_table, step_budget,
@@ -264,7 +264,7 @@ def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, param
     heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
     gradient = (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
     if config.modified:
-        to_goal = jnp.linalg.norm(graph.xy - graph.xy[task.goal], axis=-1)
+        to_goal = straight_line(graph, task.goal)
         # Nodes at distance 0 from the goal other than the goal (general graphs without
         # coordinates) get a neutral heuristic instead of log(0).
         log_distance = jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
