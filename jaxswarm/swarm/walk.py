@@ -16,6 +16,8 @@ Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
 
+import functools
+import operator
 from typing import NamedTuple
 
 import jax
@@ -78,13 +80,20 @@ def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
     weights = jnp.exp(masked - jnp.where(has_choice[..., None], top, 0.0))
     if greedy is not None:
         weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
-    cdf = _cumsum_last(weights)
-    total = cdf[..., -1:]
-    u = uniform[..., None] * total
     # The first slot whose cumulative weight exceeds u (a slot of positive weight), capped at the
-    # last slot of positive weight in case rounding made u reach the total. Counting is cheaper
-    # than argmax (a variadic reduce) on CPU.
-    choice = jnp.minimum(jnp.sum(cdf <= u, axis=-1), jnp.sum(cdf < total, axis=-1))
+    # last slot of positive weight in case rounding made u reach the total. The cumulative sums
+    # are unrolled over the (small, static) slots and counted on the fly: on CPU this fuses into
+    # one loop, cheaper than a cumsum (a reduce-window) and argmax (a variadic reduce).
+    columns = [weights[..., k] for k in range(weights.shape[-1])]
+    total = functools.reduce(operator.add, columns)
+    u = uniform * total
+    below_u = below_total = jnp.zeros(total.shape, jnp.int32)
+    running = jnp.zeros_like(total)
+    for column in columns:
+        running = running + column
+        below_u = below_u + (running <= u)
+        below_total = below_total + (running < total)
+    choice = jnp.minimum(below_u, below_total)
     return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
 
 
@@ -123,15 +132,6 @@ def _is_marked(bits: jax.Array, nodes: jax.Array) -> jax.Array:
     """bool[A, K]: whether node ``nodes[a, k]`` is in agent ``a``'s packed bit set."""
     words = jnp.take_along_axis(bits, nodes >> 5, axis=1)
     return ((words >> (nodes & 31).astype(jnp.uint32)) & 1).astype(bool)
-
-
-def _cumsum_last(x: jax.Array) -> jax.Array:
-    """Cumulative sum over the (small, static) last axis, unrolled: XLA's cumsum lowers to a
-    reduce-window that is about twice as slow on CPU for K = 8."""
-    columns = [x[..., 0]]
-    for k in range(1, x.shape[-1]):
-        columns.append(columns[-1] + x[..., k])
-    return jnp.stack(columns, axis=-1)
 
 
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
