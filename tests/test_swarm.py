@@ -11,8 +11,9 @@ from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.paths import Solution, is_valid_path, path_length
+from jaxswarm.swarm import Swarm, make, make_task, run
+from jaxswarm.swarm.core import StepInfo
 from jaxswarm.swarm.walk import Walk
 
 ITERATIONS = 8
@@ -371,8 +372,46 @@ def test_unreachable_goal_is_a_clean_not_found_result():
         solution = swarm.best(state)
         assert not bool(solution.found) and math.isinf(float(solution.cost))
         assert (np.asarray(solution.path) == -1).all()
-        assert int(trace.iterations) == 5  # patience ran out: nothing ever improved
-        assert (np.asarray(trace.arrived)[:5] == 0).all()
+        assert int(trace.iterations) == 20  # no path, so patience never started counting
+        assert (np.asarray(trace.arrived) == 0).all()
+
+
+def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) -> Swarm:
+    """A stand-in swarm (no walking): its first path, of cost 100, appears at iteration
+    ``first_path_at`` (1-based), and the cost drops by one at each of ``improvements``."""
+    def init(key, graph, task, params):
+        return jnp.int32(0), jnp.float32(jnp.inf)
+
+    def step(state, graph, task, params):
+        count = state[0] + 1
+        cost = jnp.where(count >= first_path_at, 100.0, jnp.inf)
+        cost = cost - sum(jnp.where(count >= t, 1.0, 0.0) for t in improvements)
+        info = StepInfo(iteration_cost=cost, arrived=jnp.float32(0),
+                               converged=jnp.array(False))
+        return (count, cost.astype(jnp.float32)), info
+
+    def best(state):
+        return Solution(path=jnp.zeros((1,), jnp.int32), cost=state[1],
+                        found=jnp.isfinite(state[1]))
+
+    return Swarm(name="late", config=None, init=init, step=step, best=best,
+                        default_params=None, check_params=lambda params: None,
+                        memory=lambda state: jnp.zeros(1), memory_label="")
+
+
+@pytest.mark.parametrize("first_path_at, improvements, stops_after", [
+    (1, (), 1 + 5),          # patience counts from the first path ...
+    (12, (), 12 + 5),        # ... however late it comes
+    (12, (15, 19), 19 + 5),  # and restarts at every improvement
+])
+def test_patience_counts_iterations_without_gain_since_the_first_path(first_path_at,
+                                                                       improvements, stops_after):
+    graph = grid_graph(np.zeros((2, 2), bool))
+    swarm = _late_arrival_swarm(first_path_at, improvements)
+    state, trace = run(swarm, jax.random.key(0), graph, make_task(graph, (0, 0), (1, 1)), None,
+                       iterations=40, patience=5)
+    assert int(trace.iterations) == stops_after
+    assert float(trace.best_cost[stops_after - 1]) == 100.0 - len(improvements)
 
 
 @pytest.mark.parametrize("field, value, message", [

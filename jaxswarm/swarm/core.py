@@ -122,7 +122,11 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
     """Iterate a swarm until a stop condition holds.
 
     Stops after ``iterations`` iterations, or when the best cost has not improved for ``patience``
-    iterations (if given), or when every agent of an iteration followed the same path.
+    iterations (if given) since a first path was found, or when every agent of an iteration
+    followed the same path. Iterations before the first path do not count towards patience (the
+    RFD paper's "solution not improved in the last n loops" needs a solution): a swarm that needs
+    40 iterations to reach the goal is not stopped at 30, and an unreachable goal uses the whole
+    budget.
 
     Args:
       swarm: the algorithm (static).
@@ -131,7 +135,8 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
       task: start and goal (see :func:`make_task`).
       params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
       iterations: the iteration budget T (static).
-      patience: stop after this many iterations without improvement (static; None = never).
+      patience: stop after this many iterations without improvement of a path found
+        (static; None = never).
 
     Returns:
       ``(state, trace)``: the final State and a :class:`Trace`.
@@ -169,7 +174,7 @@ def _run(swarm, key, graph, task, params, iterations, patience):
                       iteration_cost=trace.iteration_cost.at[t].set(info.iteration_cost),
                       arrived=trace.arrived.at[t].set(info.arrived),
                       iterations=t + 1)
-        stale = jnp.where(after < before, 0, stale + 1)
+        stale = jnp.where((after < before) | ~jnp.isfinite(after), 0, stale + 1)
         return state, trace, stale, info.converged
 
     state, trace, _, _ = jax.lax.while_loop(

@@ -11,7 +11,7 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
             { movingai = "mapf/maze-32-32-2.map", scenario = 5 }]
     seeds = 20                          # range(20), or an explicit list [0, 4, 9]
     iterations = 100
-    patience = 30                       # optional: stop a run after 30 iterations without gain
+    patience = 30                       # optional: stop a run 30 iterations after its last gain
     chunk_size = 64                     # optional: runs per compiled batch (bounds memory)
 
     [config]                            # static: sizes and switches of the swarm factory
@@ -66,7 +66,8 @@ class SweepSpec:
       maps: map entries as written (str or dict), resolved by :mod:`jaxswarm.sweep.maps`.
       seeds: the integer seeds; run ``s`` uses ``jax.random.key(s)``.
       iterations: iteration budget of each run.
-      patience: stop after this many iterations without improvement (None = never).
+      patience: stop after this many iterations without improvement since the first path
+        (None = never; see :func:`jaxswarm.swarm.run`).
       chunk_size: runs per compiled batch.
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).
