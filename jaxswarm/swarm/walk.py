@@ -182,8 +182,8 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         return (c["step"] < max_steps) & jnp.any(c["walking"])
 
     def chunk(c):
-        """STEPS_PER_CHECK steps; their slots and nodes go to small blocks (cheap writes at the
-        static loop index) that are copied into the buffers once per chunk."""
+        """STEPS_PER_CHECK steps; their slots and nodes go to small step-major blocks (each step
+        writes one contiguous row) that are transposed into the buffers once per chunk."""
         first = c["step"]
         key, draw_key = jax.random.split(c["key"])
         draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
@@ -191,14 +191,14 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         def step_into_blocks(i, inner):
             c, slots, nodes = inner
             c, slot, node = one_step(c, draws[i])
-            return c, slots.at[:, i].set(slot), nodes.at[:, i].set(node)
+            return c, slots.at[i].set(slot), nodes.at[i].set(node)
 
-        slots = jnp.full((num_agents, STEPS_PER_CHECK), -1, slot_dtype)
-        nodes = jnp.full((num_agents, STEPS_PER_CHECK), NO_NODE, node_dtype)
+        slots = jnp.full((STEPS_PER_CHECK, num_agents), -1, slot_dtype)
+        nodes = jnp.full((STEPS_PER_CHECK, num_agents), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
                                             (dict(c, key=key), slots, nodes))
-        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots, (0, first)),
-                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes, (0, first)))
+        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, first)),
+                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, first)))
 
     def one_step(c, uniform):
         here = c["position"]
