@@ -1,10 +1,9 @@
 import math
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 import scipy.sparse.csgraph as csgraph
-
-import jax.numpy as jnp
 
 from jaxswarm.graph import (DIRECTIONS, OPPOSITE, dense_graph, grid_graph, lowest_neighbour,
                             path_map_graph)

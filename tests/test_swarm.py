@@ -386,8 +386,7 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
         count = state[0] + 1
         cost = jnp.where(count >= first_path_at, 100.0, jnp.inf)
         cost = cost - sum(jnp.where(count >= t, 1.0, 0.0) for t in improvements)
-        info = StepInfo(iteration_cost=cost, arrived=jnp.float32(0),
-                               converged=jnp.array(False))
+        info = StepInfo(iteration_cost=cost, arrived=jnp.float32(0), converged=jnp.array(False))
         return (count, cost.astype(jnp.float32)), info
 
     def best(state):
@@ -395,8 +394,8 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
                         found=jnp.isfinite(state[1]))
 
     return Swarm(name="late", config=None, init=init, step=step, best=best,
-                        default_params=None, check_params=lambda params: None,
-                        memory=lambda state: jnp.zeros(1), memory_label="")
+                 default_params=None, check_params=lambda params: None,
+                 memory=lambda state: jnp.zeros(1), memory_label="")
 
 
 @pytest.mark.parametrize("first_path_at, improvements, stops_after", [

@@ -3,7 +3,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import grid_graph
+from jaxswarm.graph import grid_graph, straight_line
 from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, edge_table, sample_masked, walk
 
@@ -96,7 +96,7 @@ def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
 def test_greedy_agents_descend_deterministically_and_the_others_do_not():
     graph = grid_graph(np.zeros((8, 8), bool))
     goal = 63
-    closer = -jnp.linalg.norm(graph.xy - graph.xy[goal], axis=-1)  # prefer moves towards the goal
+    closer = -straight_line(graph, goal)  # prefer moves towards the goal
     logw = edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)], graph.nbr.shape))
     walks = [walk(jax.random.key(k), graph, logw, 0, goal, num_agents=16, max_steps=20,
                   greedy_agents=2) for k in range(3)]
