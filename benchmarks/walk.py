@@ -8,7 +8,8 @@ runs:
 
 * ``lockstep steps``: iterations of the walk's ``while_loop`` (under ``vmap`` every lane runs
   until the slowest lane's agents have all stopped),
-* ``agent-steps/s``: total agents x lockstep steps / wall time (the work the machine does),
+* ``agent-steps/s``: total agents x lockstep steps / wall time (the rate at which the batch
+  steps; the last steps of a walk run on a compacted batch once few agents still walk),
 * ``moves/s``: moves actually made by agents / wall time (agents that stopped early idle),
 * ``peak MiB``: XLA's buffer estimate for the compiled walk (arguments + outputs + temporaries),
   and the process's peak resident memory so far.

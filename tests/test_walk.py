@@ -116,3 +116,26 @@ def test_excluded_and_invalid_edges_are_never_taken():
     slots = np.asarray(result.slots)
     assert slots.max() <= 3 and (slots[slots >= 0] >= 0).all()
     assert bool(result.arrived.any())
+
+
+def test_compacting_the_last_walkers_changes_no_walk(monkeypatch):
+    import jaxswarm.swarm.walk as walk_module
+
+    graph = grid_graph(np.zeros((16, 16), bool))
+    closer = -0.6 * straight_line(graph, 255)  # most agents arrive early, a few wander on
+    logw = edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)], graph.nbr.shape))
+
+    def walks():
+        return jax.jit(lambda key: walk(key, graph, logw, 0, 255, num_agents=64, max_steps=255,
+                                        greedy_agents=2))(jax.random.key(0))
+
+    compacted = walks()
+    moves = np.asarray((compacted.slots >= 0).sum(axis=1))
+    # The case under test: after the first chunk at most 64 / COMPACT_SHARE agents still walk,
+    # and one of them needs two more chunks.
+    assert 0 < (moves > STEPS_PER_CHECK).sum() <= 64 // walk_module.COMPACT_SHARE
+    assert (moves > 2 * STEPS_PER_CHECK).any() and int(compacted.steps) == 3 * STEPS_PER_CHECK
+    monkeypatch.setattr(walk_module, "COMPACT_SHARE", 10 ** 9)  # no compaction
+    whole = walks()
+    for name, value in compacted._asdict().items():
+        np.testing.assert_array_equal(value, getattr(whole, name), err_msg=name)

@@ -7,7 +7,8 @@ its node's row, keeps the admissible slots (an edge with a finite log-weight to 
 has not visited in this walk), and draws one slot through :func:`sample_masked` (a greedy
 agent takes its most likely slot instead, ties drawn at random). An agent stops
 when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
-runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped.
+runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
+at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch of just those.
 
 Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
 ``i8[A, L - 1]`` and the nodes ``i16[A, L - 1]`` (i32 above 32,767 nodes; ``L = max_steps + 1``),
@@ -29,6 +30,12 @@ STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
 the old and new carry of every lane at each iteration, copying the buffers; testing every 64
 steps amortises that copy (agents that stopped simply idle in between)."""
+
+COMPACT_SHARE = 8
+"""When at most ``A // COMPACT_SHARE`` agents still walk, the walk goes on with only them, in a
+batch of that many lanes: in a formed river most agents arrive together and a few stragglers
+would otherwise keep the whole batch stepping. The uniforms stay those of the full batch, so
+compaction does not change any walk."""
 
 FORCED = 1e30
 """A log-weight that wins every draw: use it for moves that must be taken (e.g. into the goal)."""
@@ -177,30 +184,37 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         stuck=jnp.zeros((num_agents,), bool),
         step=jnp.array(0, jnp.int32),
     )
+    per_agent = [name for name in carry if name not in ("key", "step")]
 
     def keep_walking(c):
         return (c["step"] < max_steps) & jnp.any(c["walking"])
 
-    def chunk(c):
-        """STEPS_PER_CHECK steps; their slots and nodes go to small step-major blocks (each step
-        writes one contiguous row) that are transposed into the buffers once per chunk."""
+    def chunk(c, lanes, greedy):
+        """STEPS_PER_CHECK steps of the agents ``lanes`` (None: all of them); their slots and
+        nodes go to small step-major blocks (each step writes one contiguous row) that are
+        transposed into the buffers once per chunk."""
         first = c["step"]
         key, draw_key = jax.random.split(c["key"])
+        # Every agent's uniforms are drawn whether or not it still walks, so that a walk does
+        # not depend on when (or whether) it was compacted.
         draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
+        if lanes is not None:
+            draws = draws[:, lanes]
+        rows = lanes.shape[0] if lanes is not None else num_agents
 
         def step_into_blocks(i, inner):
             c, slots, nodes = inner
-            c, slot, node = one_step(c, draws[i])
+            c, slot, node = one_step(c, draws[i], greedy)
             return c, slots.at[i].set(slot), nodes.at[i].set(node)
 
-        slots = jnp.full((STEPS_PER_CHECK, num_agents), -1, slot_dtype)
-        nodes = jnp.full((STEPS_PER_CHECK, num_agents), NO_NODE, node_dtype)
+        slots = jnp.full((STEPS_PER_CHECK, rows), -1, slot_dtype)
+        nodes = jnp.full((STEPS_PER_CHECK, rows), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
                                             (dict(c, key=key), slots, nodes))
         return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, first)),
                     nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, first)))
 
-    def one_step(c, uniform):
+    def one_step(c, uniform, greedy):
         here = c["position"]
         neighbours = graph.nbr[here]
         row = log_weights[here]
@@ -215,7 +229,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         c = dict(
             c,
             position=there,
-            visited=_mark(c["visited"], agents, there),
+            visited=_mark(c["visited"], jnp.arange(here.shape[0]), there),
             length=c["length"] + jnp.where(moving, graph.cost[here, slot], 0.0),
             walking=moving & ~arrived_now,
             arrived=c["arrived"] | arrived_now,
@@ -225,7 +239,22 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
                 jnp.where(moving, there, NO_NODE).astype(node_dtype))
 
-    c = jax.lax.while_loop(keep_walking, chunk, carry)
+    lanes = num_agents // COMPACT_SHARE
+    if lanes == 0:
+        c = jax.lax.while_loop(keep_walking, lambda c: chunk(c, None, greedy), carry)
+    else:
+        c = jax.lax.while_loop(
+            lambda c: keep_walking(c) & (jnp.sum(c["walking"]) > lanes),
+            lambda c: chunk(c, None, greedy), carry)
+        # At most ``lanes`` agents still walk: they go on in a batch of that size.
+        ids = jnp.nonzero(c["walking"], size=lanes, fill_value=num_agents)[0]
+        held = jnp.minimum(ids, num_agents - 1)  # padding lanes hold a copy, never walk
+        few = {name: c[name][held] for name in per_agent}
+        few = jax.lax.while_loop(
+            keep_walking, lambda f: chunk(f, held, None if greedy is None else greedy[held]),
+            dict(few, walking=few["walking"] & (ids < num_agents), key=c["key"], step=c["step"]))
+        c = dict(c, step=few["step"], **{name: c[name].at[ids].set(few[name], mode="drop")
+                                         for name in per_agent})
     path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
                            axis=1)
     return Walk(path=path, slots=c["slots"][:, :max_steps].astype(jnp.int16),
