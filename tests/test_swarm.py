@@ -1,6 +1,11 @@
 """Protocol conformance of every registered swarm, and RFD's own rules."""
 import dataclasses
 import math
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
 
 import jax
 import jax.numpy as jnp
@@ -439,3 +444,53 @@ def test_bad_sizes_and_endpoints_are_named(maze):
             iterations=0)
     with pytest.raises(ValueError, match="goal .* is blocked"):
         make_task(graph, (0, 0), (1, 1))
+    with pytest.raises(ValueError, match=r"devices \(3\) must divide num_agents \(32\)"):
+        make("rfd_star", num_agents=32, devices=3)
+    with pytest.raises(ValueError, match="devices must be at least 1, got 0"):
+        make("aco_star", num_agents=32, devices=0)
+    too_many = len(jax.devices()) + 1
+    swarm = make("rfd_star", num_agents=32 * too_many, devices=too_many)
+    with pytest.raises(ValueError, match=f"devices={too_many} but JAX sees {too_many - 1} cpu"):
+        run(swarm, jax.random.key(0), graph, task, swarm.default_params, iterations=2)
+
+
+SPREAD = textwrap.dedent("""
+    import jax
+    jax.config.update("jax_num_cpu_devices", 2)
+    import numpy as np
+    from jaxswarm.maps.paper import paper_map
+    from jaxswarm.swarm import make, make_task, run
+
+    def leaves(tree):
+        return [np.asarray(jax.random.key_data(x) if jax.dtypes.issubdtype(
+                    x.dtype, jax.dtypes.prng_key) else x) for x in jax.tree_util.tree_leaves(tree)]
+
+    def same(a, b):
+        return all(np.array_equal(x, y, equal_nan=x.dtype.kind == "f")
+                   for x, y in zip(leaves(a), leaves(b)))
+
+    chosen = paper_map("alley20")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    keys = jax.random.split(jax.random.key(3), 2)
+    for name, agents in (("rfd_star", 64), ("improved_max_min_aco", 50)):
+        one, two = (make(name, num_agents=agents, devices=d) for d in (1, 2))
+        alone = [run(one, key, graph, task, one.default_params, iterations=25) for key in keys]
+        spread = [run(two, key, graph, task, two.default_params, iterations=25) for key in keys]
+        batched = jax.jit(jax.vmap(lambda k: run(two, k, graph, task, two.default_params,
+                                                 iterations=25)))(keys)
+        assert all(same(a, b) for a, b in zip(alone, spread)), name
+        assert all(same(a, jax.tree_util.tree_map(lambda x: x[i], batched))
+                   for i, a in enumerate(alone)), name
+        assert float(alone[0][0].best_cost) < float("inf"), name
+        print(name, "identical on", len(jax.devices()), "devices")
+""")
+
+
+def test_spreading_the_agents_over_two_cpu_devices_changes_no_result():
+    done = subprocess.run([sys.executable, "-c", SPREAD], capture_output=True, text=True,
+                          timeout=600, cwd=Path(__file__).resolve().parents[1],
+                          env=dict(os.environ, JAX_PLATFORMS="cpu"))
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[:2] == ["rfd_star identical on 2 devices",
+                                           "improved_max_min_aco identical on 2 devices"]

@@ -50,6 +50,8 @@ class ACOConfig:
       max_min: Max-Min ACO (best ant deposits, pheromone bounds) instead of Ant System.
       global_best: Max-Min only: the best path so far deposits instead of this iteration's best.
       improved: Improved Max-Min ACO (direction heuristic, Bug2-like first ant, floor only).
+      devices: spread each walk's ants over this many devices (see
+        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
     """
 
     num_agents: int = 256
@@ -58,9 +60,10 @@ class ACOConfig:
     max_min: bool = False
     global_best: bool = False
     improved: bool = False
+    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps)
+        check_sizes(self.num_agents, self.max_steps, self.devices)
         if self.global_best and not self.max_min:
             raise ValueError("global_best is a Max-Min ACO switch (max_min=True)")
 
@@ -171,7 +174,7 @@ def _build(config: ACOConfig, name: str) -> Swarm:
         table = transition_rule(config, graph, task, state.pheromone, params)
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
-                    max_steps=step_budget(graph, config.max_steps))
+                    max_steps=step_budget(graph, config.max_steps), devices=config.devices)
         # The Improved Max-Min ACO keeps the latest of equally short paths (its "<=").
         best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
                                                ties=config.improved)
@@ -204,32 +207,35 @@ def _build(config: ACOConfig, name: str) -> Swarm:
 
 
 @register("ant_system")
-def ant_system(num_agents: int = 256, max_steps: int | None = None) -> Swarm:
+def ant_system(num_agents: int = 256, max_steps: int | None = None, devices: int = 1) -> Swarm:
     """Ant System (RFD paper eqs. 7-9)."""
-    return _build(ACOConfig(num_agents, max_steps), "ant_system")
+    return _build(ACOConfig(num_agents, max_steps, devices=devices), "ant_system")
 
 
 @register("aco_star")
-def aco_star(num_agents: int = 256, max_steps: int | None = None) -> Swarm:
+def aco_star(num_agents: int = 256, max_steps: int | None = None, devices: int = 1) -> Swarm:
     """ACO*: Ant System with the goal-distance heuristic ``1 / d_j ** alpha_goal``."""
-    return _build(ACOConfig(num_agents, max_steps, goal_heuristic=True), "aco_star")
+    return _build(ACOConfig(num_agents, max_steps, goal_heuristic=True, devices=devices),
+                  "aco_star")
 
 
 @register("max_min_aco")
 def max_min_aco(num_agents: int = 256, max_steps: int | None = None,
-                global_best: bool = False) -> Swarm:
+                global_best: bool = False, devices: int = 1) -> Swarm:
     """Max-Min ACO: only the iteration-best (or, with ``global_best``, the best-so-far) path
     deposits, and pheromone stays within [tau_min, tau_max]."""
-    return _build(ACOConfig(num_agents, max_steps, max_min=True, global_best=global_best),
-                  "max_min_aco")
+    return _build(ACOConfig(num_agents, max_steps, max_min=True, global_best=global_best,
+                            devices=devices), "max_min_aco")
 
 
 @register("improved_max_min_aco")
-def improved_max_min_aco(num_agents: int = 50, max_steps: int | None = None) -> Swarm:
+def improved_max_min_aco(num_agents: int = 50, max_steps: int | None = None,
+                         devices: int = 1) -> Swarm:
     """Improved Max-Min ACO (the Max-Min ACO paper): direction heuristic, Bug2-like first ant,
     evaporation floored at ``tau_min`` and ``q`` added on the best path after each population
     of ``num_agents`` ants (50 in the paper)."""
-    return _build(ACOConfig(num_agents, max_steps, improved=True), "improved_max_min_aco")
+    return _build(ACOConfig(num_agents, max_steps, improved=True, devices=devices),
+                  "improved_max_min_aco")
 
 
 def _check(params: ACOParams) -> None:

@@ -182,12 +182,18 @@ def _run(swarm, key, graph, task, params, iterations, patience):
     return state, trace
 
 
-def check_sizes(num_agents: int, max_steps: int | None) -> None:
-    """Static config check shared by the swarms: at least one agent and one step."""
+def check_sizes(num_agents: int, max_steps: int | None, devices: int = 1) -> None:
+    """Static config check shared by the swarms: at least one agent and one step, and a
+    device count that divides the agents (whether JAX has that many is checked when the
+    swarm first walks)."""
     if num_agents < 1:
         raise ValueError(f"num_agents must be at least 1, got {num_agents}")
     if max_steps is not None and max_steps < 1:
         raise ValueError(f"max_steps must be at least 1, got {max_steps}")
+    if devices < 1:
+        raise ValueError(f"devices must be at least 1, got {devices}")
+    if num_agents % devices:
+        raise ValueError(f"devices ({devices}) must divide num_agents ({num_agents})")
 
 
 def keep_best(walk, best_path, best_cost, *, ties: bool = False):

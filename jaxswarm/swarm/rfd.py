@@ -94,6 +94,8 @@ class RFDConfig:
         has ``"linear"``.
       greedy_drops: how many of the drops always take their most likely move instead of
         drawing one (see the module docstring); 0 for the original RFD.
+      devices: spread each walk's drops over this many devices (see
+        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
     """
 
     num_agents: int = 256
@@ -101,9 +103,10 @@ class RFDConfig:
     modified: bool = True
     erosion_law: str = "graded"
     greedy_drops: int = 0
+    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps)
+        check_sizes(self.num_agents, self.max_steps, self.devices)
         if not 0 <= self.greedy_drops <= self.num_agents:
             raise ValueError(f"greedy_drops must be between 0 and num_agents "
                              f"({self.num_agents}), got {self.greedy_drops}")
@@ -223,7 +226,7 @@ def _build(config: RFDConfig, name: str) -> Swarm:
         log_weights = transition_rule(config, graph, task, state.altitude, params)
         drops = walk(walk_key, graph, log_weights, task.start, task.goal,
                      num_agents=config.num_agents,
-                     max_steps=step_budget(graph, config.max_steps),
+                     max_steps=step_budget(graph, config.max_steps), devices=config.devices,
                      greedy_agents=config.greedy_drops)
         altitude = _erode_and_deposit(config, graph, task, state.altitude, log_weights, drops,
                                       params)
@@ -247,16 +250,18 @@ def _build(config: RFDConfig, name: str) -> Swarm:
 
 
 @register("rfd")
-def rfd(num_agents: int = 256, max_steps: int | None = None) -> Swarm:
+def rfd(num_agents: int = 256, max_steps: int | None = None, devices: int = 1) -> Swarm:
     """The original River Formation Dynamics (eqs. 1-5), with RFDParams."""
-    return _build(RFDConfig(num_agents, max_steps, modified=False, erosion_law="linear"), "rfd")
+    return _build(RFDConfig(num_agents, max_steps, modified=False, erosion_law="linear",
+                            devices=devices), "rfd")
 
 
 @register("rfd_star")
 def rfd_star(num_agents: int = 256, max_steps: int | None = None,
-             erosion_law: str = "graded", greedy_drops: int = 1) -> Swarm:
+             erosion_law: str = "graded", greedy_drops: int = 1, devices: int = 1) -> Swarm:
     """The modified RFD* (eq. 6), with RFDStarParams; ``erosion_law`` one of EROSION_LAWS."""
-    return _build(RFDConfig(num_agents, max_steps, True, erosion_law, greedy_drops), "rfd_star")
+    return _build(RFDConfig(num_agents, max_steps, True, erosion_law, greedy_drops, devices),
+                  "rfd_star")
 
 
 def transition_rule(config: RFDConfig, graph: Graph, task: Task, altitude, params):

@@ -9,6 +9,9 @@ agent takes its most likely slot instead, ties drawn at random). An agent stops
 when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
 runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
 at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch of just those.
+With ``devices > 1`` the agents are shared out over that many devices, each running its own
+loop (``shard_map``); every agent draws the same uniforms either way, so neither compaction nor
+the number of devices changes a walk.
 
 Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
 ``i8[A, L - 1]`` and the nodes ``i16[A, L - 1]`` (i32 above 32,767 nodes; ``L = max_steps + 1``),
@@ -23,6 +26,8 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
+from jax.sharding import Mesh, PartitionSpec as P
 
 from jaxswarm.graph import NO_NODE, Graph
 
@@ -36,6 +41,9 @@ COMPACT_SHARE = 8
 batch of that many lanes: in a formed river most agents arrive together and a few stragglers
 would otherwise keep the whole batch stepping. The uniforms stay those of the full batch, so
 compaction does not change any walk."""
+
+AGENT_AXIS = "agents"
+"""The mesh axis over which :func:`walk` spreads its agents (``devices > 1``)."""
 
 FORCED = 1e30
 """A log-weight that wins every draw: use it for moves that must be taken (e.g. into the goal)."""
@@ -141,8 +149,24 @@ def _is_marked(bits: jax.Array, nodes: jax.Array) -> jax.Array:
     return ((words >> (nodes & 31).astype(jnp.uint32)) & 1).astype(bool)
 
 
+def agent_mesh(devices: int, num_agents: int) -> Mesh:
+    """A 1-D mesh (axis ``AGENT_AXIS``) of the first ``devices`` devices for ``num_agents``
+    agents, or a ValueError naming what does not fit."""
+    available = jax.devices()
+    if devices < 1:
+        raise ValueError(f"devices must be at least 1, got {devices}")
+    if devices > len(available):
+        raise ValueError(
+            f"devices={devices} but JAX sees {len(available)} {jax.default_backend()} "
+            "device(s); on CPU call jax.config.update('jax_num_cpu_devices', n) before JAX's "
+            "first use")
+    if num_agents % devices:
+        raise ValueError(f"devices={devices} must divide num_agents ({num_agents})")
+    return Mesh(np.array(available[:devices]), (AGENT_AXIS,))
+
+
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
-         max_steps: int, greedy_agents: int = 0) -> Walk:
+         max_steps: int, greedy_agents: int = 0, devices: int = 1) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal`` in lockstep.
 
     Args:
@@ -158,16 +182,43 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
       greedy_agents: how many agents (the first ones; static) always take their most likely
         admissible move, ties drawn at random, instead of sampling.
+      devices: spread the agents evenly over the first ``devices`` of ``jax.devices()``
+        (static), each walking its share in its own loop; the result, replicated on those
+        devices, is bit-identical to ``devices=1``. On CPU this uses several cores for one
+        walk (set ``jax.config.update("jax_num_cpu_devices", n)`` before JAX's first use).
 
     Returns:
       A :class:`Walk`.
+
+    Raises:
+      ValueError: ``devices`` below 1, more than JAX has, or not dividing ``num_agents``.
     """
+    args = (key, graph, log_weights, jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32))
+    shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
+    if devices == 1:
+        return _walk_share(*args, first=0, share=num_agents, **shape)
+    mesh = agent_mesh(devices, num_agents)
+    share = num_agents // devices
+
+    def walk_share(*args):
+        first = jax.lax.axis_index(AGENT_AXIS) * share
+        part = _walk_share(*args, first=first, share=share, **shape)
+        gathered = {name: jax.lax.all_gather(getattr(part, name), AGENT_AXIS, tiled=True)
+                    for name in part._fields if name != "steps"}
+        return Walk(steps=jax.lax.pmax(part.steps, AGENT_AXIS), **gathered)
+
+    return jax.shard_map(walk_share, mesh=mesh, in_specs=P(), out_specs=P(),
+                         check_vma=False)(*args)
+
+
+def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: int,
+                num_agents: int, max_steps: int, greedy_agents: int) -> Walk:
+    """Walk agents ``first .. first + share - 1`` (``first`` may be traced) of a batch of
+    ``num_agents``: their uniforms are their columns of the batch's draws."""
     n = graph.num_nodes
-    agents = jnp.arange(num_agents)
-    greedy = agents < greedy_agents if greedy_agents else None
-    start = jnp.asarray(start, jnp.int32)
-    goal = jnp.asarray(goal, jnp.int32)
-    position = jnp.full((num_agents,), start)
+    agents = jnp.arange(share)
+    greedy = first + agents < greedy_agents if greedy_agents else None
+    position = jnp.full((share,), start)
     # The buffers get one spare chunk of columns so that a chunk's block always fits.
     columns = max_steps + STEPS_PER_CHECK
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
@@ -175,13 +226,13 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     carry = dict(
         key=key,
         position=position,
-        visited=_mark(jnp.zeros((num_agents, (n + 31) // 32), jnp.uint32), agents, position),
-        slots=jnp.full((num_agents, columns), -1, slot_dtype),
-        nodes=jnp.full((num_agents, columns), NO_NODE, node_dtype),
-        length=jnp.zeros((num_agents,), jnp.float32),
-        walking=jnp.full((num_agents,), start != goal),
-        arrived=jnp.full((num_agents,), start == goal),
-        stuck=jnp.zeros((num_agents,), bool),
+        visited=_mark(jnp.zeros((share, (n + 31) // 32), jnp.uint32), agents, position),
+        slots=jnp.full((share, columns), -1, slot_dtype),
+        nodes=jnp.full((share, columns), NO_NODE, node_dtype),
+        length=jnp.zeros((share,), jnp.float32),
+        walking=jnp.full((share,), start != goal),
+        arrived=jnp.full((share,), start == goal),
+        stuck=jnp.zeros((share,), bool),
         step=jnp.array(0, jnp.int32),
     )
     per_agent = [name for name in carry if name not in ("key", "step")]
@@ -190,17 +241,19 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         return (c["step"] < max_steps) & jnp.any(c["walking"])
 
     def chunk(c, lanes, greedy):
-        """STEPS_PER_CHECK steps of the agents ``lanes`` (None: all of them); their slots and
-        nodes go to small step-major blocks (each step writes one contiguous row) that are
-        transposed into the buffers once per chunk."""
-        first = c["step"]
+        """STEPS_PER_CHECK steps of the agents ``lanes`` (i32[a] ids within the share; None:
+        the whole share); their slots and nodes go to small step-major blocks (each step writes
+        one contiguous row) that are transposed into the buffers once per chunk."""
+        start_column = c["step"]
         key, draw_key = jax.random.split(c["key"])
-        # Every agent's uniforms are drawn whether or not it still walks, so that a walk does
-        # not depend on when (or whether) it was compacted.
+        # The whole batch's uniforms are drawn and each agent takes its own column, so that a
+        # walk does not depend on how the batch was shared out or compacted.
         draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
+        if share < num_agents:
+            draws = jax.lax.dynamic_slice_in_dim(draws, first, share, axis=1)
         if lanes is not None:
             draws = draws[:, lanes]
-        rows = lanes.shape[0] if lanes is not None else num_agents
+        rows = share if lanes is None else lanes.shape[0]
 
         def step_into_blocks(i, inner):
             c, slots, nodes = inner
@@ -211,8 +264,8 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         nodes = jnp.full((STEPS_PER_CHECK, rows), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
                                             (dict(c, key=key), slots, nodes))
-        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, first)),
-                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, first)))
+        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, start_column)),
+                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, start_column)))
 
     def one_step(c, uniform, greedy):
         here = c["position"]
@@ -239,7 +292,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
                 jnp.where(moving, there, NO_NODE).astype(node_dtype))
 
-    lanes = num_agents // COMPACT_SHARE
+    lanes = share // COMPACT_SHARE
     if lanes == 0:
         c = jax.lax.while_loop(keep_walking, lambda c: chunk(c, None, greedy), carry)
     else:
@@ -247,12 +300,12 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
             lambda c: keep_walking(c) & (jnp.sum(c["walking"]) > lanes),
             lambda c: chunk(c, None, greedy), carry)
         # At most ``lanes`` agents still walk: they go on in a batch of that size.
-        ids = jnp.nonzero(c["walking"], size=lanes, fill_value=num_agents)[0]
-        held = jnp.minimum(ids, num_agents - 1)  # padding lanes hold a copy, never walk
+        ids = jnp.nonzero(c["walking"], size=lanes, fill_value=share)[0]
+        held = jnp.minimum(ids, share - 1)  # padding lanes hold a copy, never walk
         few = {name: c[name][held] for name in per_agent}
         few = jax.lax.while_loop(
             keep_walking, lambda f: chunk(f, held, None if greedy is None else greedy[held]),
-            dict(few, walking=few["walking"] & (ids < num_agents), key=c["key"], step=c["step"]))
+            dict(few, walking=few["walking"] & (ids < share), key=c["key"], step=c["step"]))
         c = dict(c, step=few["step"], **{name: c[name].at[ids].set(few[name], mode="drop")
                                          for name in per_agent})
     path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
