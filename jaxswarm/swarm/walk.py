@@ -149,7 +149,7 @@ def _is_marked(bits: jax.Array, nodes: jax.Array) -> jax.Array:
     return ((words >> (nodes & 31).astype(jnp.uint32)) & 1).astype(bool)
 
 
-def agent_mesh(devices: int, num_agents: int) -> Mesh:
+def _agent_mesh(devices: int, num_agents: int) -> Mesh:
     """A 1-D mesh (axis ``AGENT_AXIS``) of the first ``devices`` devices for ``num_agents``
     agents, or a ValueError naming what does not fit."""
     available = jax.devices()
@@ -197,7 +197,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
     if devices == 1:
         return _walk_share(*args, first=0, share=num_agents, **shape)
-    mesh = agent_mesh(devices, num_agents)
+    mesh = _agent_mesh(devices, num_agents)
     share = num_agents // devices
 
     def walk_share(*args):
