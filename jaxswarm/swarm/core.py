@@ -26,6 +26,7 @@ import numpy as np
 
 from jaxswarm.graph import Graph
 from jaxswarm.paths import as_node
+from jaxswarm.swarm.walk import check_devices
 
 
 class Task(NamedTuple):
@@ -190,10 +191,7 @@ def check_sizes(num_agents: int, max_steps: int | None, devices: int = 1) -> Non
         raise ValueError(f"num_agents must be at least 1, got {num_agents}")
     if max_steps is not None and max_steps < 1:
         raise ValueError(f"max_steps must be at least 1, got {max_steps}")
-    if devices < 1:
-        raise ValueError(f"devices must be at least 1, got {devices}")
-    if num_agents % devices:
-        raise ValueError(f"devices ({devices}) must divide num_agents ({num_agents})")
+    check_devices(devices, num_agents)
 
 
 def keep_best(walk, best_path, best_cost, *, ties: bool = False):

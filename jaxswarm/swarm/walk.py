@@ -149,19 +149,25 @@ def _is_marked(bits: jax.Array, nodes: jax.Array) -> jax.Array:
     return ((words >> (nodes & 31).astype(jnp.uint32)) & 1).astype(bool)
 
 
+def check_devices(devices: int, num_agents: int) -> None:
+    """Static check of a device count for ``num_agents`` agents: at least one, dividing the
+    agents (whether JAX has that many devices is checked when the walk is traced)."""
+    if devices < 1:
+        raise ValueError(f"devices must be at least 1, got {devices}")
+    if num_agents % devices:
+        raise ValueError(f"devices ({devices}) must divide num_agents ({num_agents})")
+
+
 def _agent_mesh(devices: int, num_agents: int) -> Mesh:
     """A 1-D mesh (axis ``AGENT_AXIS``) of the first ``devices`` devices for ``num_agents``
     agents, or a ValueError naming what does not fit."""
+    check_devices(devices, num_agents)
     available = jax.devices()
-    if devices < 1:
-        raise ValueError(f"devices must be at least 1, got {devices}")
     if devices > len(available):
         raise ValueError(
             f"devices={devices} but JAX sees {len(available)} {jax.default_backend()} "
             "device(s); on CPU call jax.config.update('jax_num_cpu_devices', n) before JAX's "
             "first use")
-    if num_agents % devices:
-        raise ValueError(f"devices={devices} must divide num_agents ({num_agents})")
     return Mesh(np.array(available[:devices]), (AGENT_AXIS,))
 
 
