@@ -298,15 +298,15 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
         return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
                 jnp.where(moving, there, NO_NODE).astype(node_dtype))
 
-    lanes = share // COMPACT_SHARE
-    if lanes == 0:
+    compact_lanes = share // COMPACT_SHARE
+    if compact_lanes == 0:
         c = jax.lax.while_loop(keep_walking, lambda c: chunk(c, None, greedy), carry)
     else:
         c = jax.lax.while_loop(
-            lambda c: keep_walking(c) & (jnp.sum(c["walking"]) > lanes),
+            lambda c: keep_walking(c) & (jnp.sum(c["walking"]) > compact_lanes),
             lambda c: chunk(c, None, greedy), carry)
-        # At most ``lanes`` agents still walk: they go on in a batch of that size.
-        ids = jnp.nonzero(c["walking"], size=lanes, fill_value=share)[0]
+        # At most ``compact_lanes`` agents still walk: they go on in a batch of that size.
+        ids = jnp.nonzero(c["walking"], size=compact_lanes, fill_value=share)[0]
         held = jnp.minimum(ids, share - 1)  # padding lanes hold a copy, never walk
         few = {name: c[name][held] for name in per_agent}
         few = jax.lax.while_loop(
