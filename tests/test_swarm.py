@@ -455,19 +455,15 @@ def test_bad_sizes_and_endpoints_are_named(maze):
 
 
 SPREAD = textwrap.dedent("""
-    import jax
+    import sys, jax
     jax.config.update("jax_num_cpu_devices", 2)
-    import numpy as np
+    sys.path.insert(0, {tests!r})
+    from test_swarm import key_data, leaves_equal
     from jaxswarm.maps.paper import paper_map
     from jaxswarm.swarm import make, make_task, run
 
-    def leaves(tree):
-        return [np.asarray(jax.random.key_data(x) if jax.dtypes.issubdtype(
-                    x.dtype, jax.dtypes.prng_key) else x) for x in jax.tree_util.tree_leaves(tree)]
-
     def same(a, b):
-        return all(np.array_equal(x, y, equal_nan=x.dtype.kind == "f")
-                   for x, y in zip(leaves(a), leaves(b)))
+        return leaves_equal(key_data(a), key_data(b))
 
     chosen = paper_map("alley20")
     graph = chosen.graph()
@@ -488,8 +484,9 @@ SPREAD = textwrap.dedent("""
 
 
 def test_spreading_the_agents_over_two_cpu_devices_changes_no_result():
-    done = subprocess.run([sys.executable, "-c", SPREAD], capture_output=True, text=True,
-                          timeout=600, cwd=Path(__file__).resolve().parents[1],
+    tests = Path(__file__).resolve().parent
+    done = subprocess.run([sys.executable, "-c", SPREAD.format(tests=str(tests))],
+                          capture_output=True, text=True, timeout=600, cwd=tests.parent,
                           env=dict(os.environ, JAX_PLATFORMS="cpu"))
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[:2] == ["rfd_star identical on 2 devices",

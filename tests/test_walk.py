@@ -55,6 +55,13 @@ def uniform(graph):
     return edge_table(graph, jnp.zeros(graph.nbr.shape))
 
 
+def towards(graph, goal, strength=1.0):
+    """A table whose log-weight of a move is ``-strength`` times its head's distance to goal."""
+    closer = -strength * straight_line(graph, goal)
+    return edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)],
+                                              graph.nbr.shape))
+
+
 def test_walks_are_valid_self_avoiding_and_measured():
     obstacles = np.random.default_rng(0).random((10, 10)) < 0.25
     obstacles[0, 0] = obstacles[9, 9] = False
@@ -96,8 +103,7 @@ def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
 def test_greedy_agents_descend_deterministically_and_the_others_do_not():
     graph = grid_graph(np.zeros((8, 8), bool))
     goal = 63
-    closer = -straight_line(graph, goal)  # prefer moves towards the goal
-    logw = edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)], graph.nbr.shape))
+    logw = towards(graph, goal)  # prefer moves towards the goal
     walks = [walk(jax.random.key(k), graph, logw, 0, goal, num_agents=16, max_steps=20,
                   greedy_agents=2) for k in range(3)]
     for result in walks:
@@ -122,8 +128,7 @@ def test_compacting_the_last_walkers_changes_no_walk(monkeypatch):
     import jaxswarm.swarm.walk as walk_module
 
     graph = grid_graph(np.zeros((16, 16), bool))
-    closer = -0.6 * straight_line(graph, 255)  # most agents arrive early, a few wander on
-    logw = edge_table(graph, jnp.broadcast_to(closer[jnp.maximum(graph.nbr, 0)], graph.nbr.shape))
+    logw = towards(graph, 255, 0.6)  # most agents arrive early, a few wander on
 
     def walks():
         return jax.jit(lambda key: walk(key, graph, logw, 0, 255, num_agents=64, max_steps=255,
