@@ -6,7 +6,7 @@ import pytest
 import scipy.sparse.csgraph as csgraph
 
 from jaxswarm.graph import (DIRECTIONS, OPPOSITE, dense_graph, grid_graph, lowest_neighbour,
-                            path_map_graph)
+                            path_map_graph, relax)
 from oracle import grid_adjacency
 
 
@@ -81,13 +81,16 @@ def test_dense_graph_round_trip_and_shortest_paths_match_scipy():
     np.testing.assert_allclose(ours, theirs, rtol=1e-6)
 
 
-@pytest.mark.parametrize("make", [
+SMALL_MAPS = pytest.mark.parametrize("make", [
     lambda rng: grid_graph(rng.random((6, 11)) < 0.3),
     lambda rng: grid_graph(rng.random((9, 4)) < 0.3, connectivity=4),
     lambda rng: path_map_graph(rng.random((5, 7, 8)) < 0.7),
     lambda rng: dense_graph(np.where(rng.random((12, 12)) < 0.4, rng.random((12, 12)) + 0.5,
                                      np.inf)),
 ], ids=["grid8", "grid4", "path_map", "dense"])
+
+
+@SMALL_MAPS
 def test_lowest_neighbour_is_the_cheapest_valid_edge(make):
     rng = np.random.default_rng(11)
     graph = make(rng)
@@ -98,6 +101,50 @@ def test_lowest_neighbour_is_the_cheapest_valid_edge(make):
         expected[u] = min(expected[u], values[v] + length)
     np.testing.assert_allclose(lowest_neighbour(graph, jnp.asarray(values), lengths), expected,
                                rtol=1e-6)
+
+
+@SMALL_MAPS
+@pytest.mark.parametrize("per_check", [1, 3])
+def test_relax_matches_jacobi_sweeps_over_the_edge_list(make, per_check):
+    # Sweeps of "raise a node with value above 1 to its cheapest neighbour, if that is higher"
+    # (RFD*'s settling), against plain Python sweeps over the edge list.
+    rng = np.random.default_rng(5)
+    graph = make(rng)
+    # Filled ground at 2, about a tenth of the nodes unfilled (below 1): the outlets.
+    start = np.where(rng.random(graph.num_nodes) < 0.1, rng.random(graph.num_nodes),
+                     2.0).astype(np.float32)
+    # One outlet in every connected part, else filled ground there rises at every sweep.
+    dense = graph.to_dense()
+    _, part = csgraph.connected_components(np.isfinite(dense) & (dense > 0), directed=False)
+    start[np.unique(part, return_index=True)[1]] = 0.5
+    rise = (jnp.where(graph.valid_edges(), graph.cost, jnp.inf) * 0.25).astype(jnp.float32)
+    edges = edges_of(graph)
+
+    def python_sweeps(values, most):
+        for sweep in range(most):
+            lowest = np.full(graph.num_nodes, np.inf, np.float32)
+            for (u, v), length in edges.items():
+                lowest[u] = min(lowest[u], values[v] + np.float32(length * 0.25))
+            pit = (values > 1) & (lowest > values) & np.isfinite(lowest)
+            if not pit.any():
+                return values, sweep + 1
+            values = np.where(pit, lowest, values)
+        return values, most
+
+    def raise_pits(here, lowest):
+        pit = (here > 1) & (lowest > here) & jnp.isfinite(lowest)
+        return jnp.where(pit, lowest, here), pit
+
+    expected, sweeps = python_sweeps(start, 10_000)
+    assert sweeps >= 2  # some ground rose
+    settled, ran = relax(graph, jnp.asarray(start), rise, raise_pits, max_sweeps=10_000,
+                         sweeps_per_check=per_check)
+    np.testing.assert_allclose(settled, expected, rtol=1e-6)
+    raising = sweeps - 1  # the last Python sweep found nothing to raise
+    assert int(ran) == (-(-raising // per_check) + 1) * per_check  # stops after a quiet check
+    capped, ran = relax(graph, jnp.asarray(start), rise, raise_pits, max_sweeps=2)
+    np.testing.assert_allclose(capped, python_sweeps(start, 2)[0], rtol=1e-6)
+    assert int(ran) == 2
 
 
 def test_graph_is_a_pytree_with_static_shape():

@@ -307,6 +307,19 @@ def test_settling_leaves_no_filled_pit():
     assert lone[4] == 101.0
 
 
+def test_sediment_settles_all_the_way_in_one_call():
+    # Filled ground (101) along a 200-cell corridor drains only through its east end (100): it
+    # settles to a slope of repose down to there, which takes about 200 sweeps.
+    from jaxswarm.swarm import rfd
+    graph = grid_graph(np.zeros((1, 200), bool))
+    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+                                                       repose=jnp.float32(0.25))
+    altitude = jnp.full((200,), 101.0).at[199].set(100.0)
+    settled = np.asarray(rfd.settle(graph, altitude, params))
+    np.testing.assert_allclose(settled[:199], 101.0 + 0.25 * (198 - np.arange(199)))
+    assert settled[199] == 100.0
+
+
 def test_a_drop_erodes_the_banks_it_visits():
     from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((1, 5), bool))

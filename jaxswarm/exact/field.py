@@ -10,7 +10,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, lowest_neighbour
+from jaxswarm.graph import Graph, relax
 
 SWEEPS_PER_CHECK = 4
 """Relaxation sweeps between two convergence tests (amortises the loop's overhead)."""
@@ -29,26 +29,15 @@ def distance_field(graph: Graph, goal) -> jax.Array:
       f32[N] distances; ``d[goal] == 0``.
     """
     n = graph.num_nodes
-    valid = graph.valid_edges()
-    lengths = jnp.where(valid, graph.cost, jnp.inf)
+    lengths = jnp.where(graph.valid_edges(), graph.cost, jnp.inf)
     d0 = jnp.where(jnp.arange(n) == goal, 0.0, jnp.inf).astype(jnp.float32)
 
-    def relax(d):
-        return jnp.minimum(d, lowest_neighbour(graph, d, lengths))
+    def shorten(d, lowest):
+        shorter = lowest < d
+        return jnp.where(shorter, lowest, d), shorter
 
-    def body(carry):
-        d, _, sweeps = carry
-        new = d
-        for _ in range(SWEEPS_PER_CHECK):
-            new = relax(new)
-        return new, jnp.any(new < d), sweeps + SWEEPS_PER_CHECK
-
-    def keep_going(carry):
-        _, changed, sweeps = carry
-        return changed & (sweeps < n)
-
-    d, _, _ = jax.lax.while_loop(keep_going, body, (d0, jnp.array(True), jnp.array(0)))
-    return d
+    return relax(graph, d0, lengths, shorten, max_sweeps=n,
+                 sweeps_per_check=SWEEPS_PER_CHECK)[0]
 
 
 @jax.jit
