@@ -337,10 +337,9 @@ def settle(graph: Graph, altitude, params):
     """Sediment slides into pits: f32[N] altitudes, for altitudes f32[N], after sweeps that raise
     every filled node (above ``initial_height``) to at least its lowest neighbour plus
     ``repose`` times the edge length, until no filled node is a pit (or ``SETTLE_SWEEPS`` sweeps
-    have run). Settled, a drop on filled ground (which does not climb) always has a way down to
-    unfilled ground or a bed. The settled ground does not depend on the order of the sweeps:
-    each filled node ends at the lowest altitude that is no pit, reached from the unfilled
-    ground it drains to."""
+    have run). Then a drop on filled ground (which does not climb) always has a way down to
+    unfilled ground or a bed. The result is the lowest ground at or above the given altitudes on
+    which no filled node is a pit, whatever the order of the sweeps."""
     rise = jnp.where(graph.valid_edges(), params.repose * graph.cost, jnp.inf)
 
     def raise_pits(here, lowest):  # lowest is inf for a node without edges
