@@ -167,7 +167,7 @@ class RFDStarParams(NamedTuple):
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
 down; it stops as soon as nothing moves). Sediment may have to slide far: at one maze100
-iteration we measured, settling took 188 sweeps (about 5.5 ms). Settling at most 64 sweeps per
+iteration we measured, settling took 188 sweeps (5.5-7 ms). Settling at most 64 sweeps per
 iteration, and the rest in later ones, made RFD* find the maze100 optimum later: in two sets of
 20 seeds at median iterations 67 and 26.5, against 22.5 and 19 when settled fully."""
 
