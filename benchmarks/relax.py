@@ -27,6 +27,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.exact import distance_field
+from jaxswarm.cli import paper_maps_argument
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
@@ -65,8 +66,9 @@ def settling_input(iterations: int):
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--maps", default="maze50,maze100,mosaic100,alley100",
-                        help="comma-separated paper maps for the distance field")
+    parser.add_argument("--maps", type=paper_maps_argument,
+                        default="maze50,maze100,mosaic100,alley100",
+                        help="comma-separated paper maps for the distance field, or all")
     parser.add_argument("--iterations", type=int, default=40,
                         help="RFD* iterations before the settled one")
     parser.add_argument("--repeats", type=int, default=30)
@@ -74,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | python "
           f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()})")
     print(f"{'what':32} {'median ms':>10}")
-    for name in args.maps.split(","):
+    for name in args.maps:
         chosen = paper_map(name)
         graph = chosen.graph()
         goal = node_index(graph, *chosen.goal)

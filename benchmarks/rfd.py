@@ -46,7 +46,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     # Before JAX's first use (the package creates arrays when imported).
     jax.config.update("jax_num_cpu_devices", args.devices)
-    from jaxswarm.maps.paper import PAPER_MAPS, PAPER_TABLE1_MS
+    from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
+
+    try:
+        maps = paper_map_names(args.maps)
+    except ValueError as error:
+        parser.error(f"--maps: {error}")
 
     paper_ms = PAPER_TABLE1_MS["RFD*"]  # the paper's Table 1, RFD* time [ms], static
     solve_map = _rfd_static().solve_map
@@ -54,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
           f"({jax.default_backend()}, drops spread over {args.devices} device(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
           f"{'mean iterations':>16}")
-    for name in PAPER_MAPS if args.maps == "all" else args.maps.split(","):
+    for name in maps:
         rows = solve_map(name, "rfd_star", args.seeds, iterations=100, patience=args.patience,
                          num_agents=args.agents, devices=args.devices)
         ours = 1e3 * statistics.median(r["seconds"] for r in rows)

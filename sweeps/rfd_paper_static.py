@@ -45,10 +45,11 @@ from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
 from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.cli import paper_maps_argument
 from jaxswarm.exact import astar, dijkstra
 from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import (
-    PAPER_MAPS, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, PaperMap, paper_map)
+    PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, PaperMap, paper_map)
 from jaxswarm.paths import Solution
 from jaxswarm.plot import draw_map, draw_paths, save_png
 from jaxswarm.swarm import make, make_task, run
@@ -159,7 +160,7 @@ def time_cell(runs: list[dict]) -> str:
     return f"{1e3 * statistics.median(r['seconds'] for r in runs):.2f}"
 
 
-def half_table(rows: list[dict], maps: list[str], ours: Callable[[list[dict]], str],
+def half_table(rows: list[dict], maps: tuple[str, ...], ours: Callable[[list[dict]], str],
                paper: dict[str, dict[str, float | None]],
                paper_format: Callable[[float], str]) -> list[str]:
     """Markdown lines of one half of Table 1: per algorithm a row of ours and one of the paper's.
@@ -178,7 +179,7 @@ def half_table(rows: list[dict], maps: list[str], ours: Callable[[list[dict]], s
     return lines
 
 
-def table(rows: list[dict], maps: list[str], *, seeds: int, iterations: int,
+def table(rows: list[dict], maps: tuple[str, ...], *, seeds: int, iterations: int,
           agents: int) -> str:
     """The Markdown report: path length and time per run, ours beside the paper's Table 1."""
     return "\n".join([
@@ -231,26 +232,22 @@ def figure(best: dict[str, dict[str, Solution]]) -> Figure:
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--maps", default=",".join(PAPER_MAPS), help="comma-separated paper maps")
+    parser.add_argument("--maps", type=paper_maps_argument, default="all",
+                        help="comma-separated paper maps, or all")
     parser.add_argument("--seeds", type=int, default=20, help="runs per map and algorithm")
     parser.add_argument("--iterations", type=int, default=100, help="iterations per swarm run")
     parser.add_argument("--agents", type=int, default=256, help="drops or ants per iteration")
     parser.add_argument("--out", type=Path, default=Path("out/rfd_paper_static"))
     args = parser.parse_args(argv)
-    maps = [m for m in args.maps.split(",") if m]
-    unknown = sorted(set(maps) - set(PAPER_MAPS))
-    if unknown or not maps:
-        parser.error(f"--maps: unknown {unknown or 'none given'}; choose from "
-                     f"{', '.join(PAPER_MAPS)}")
     if args.seeds < 1:
         parser.error("--seeds must be at least 1")
     rows, best = [], {}
-    for name in maps:
+    for name in args.maps:
         mine, best[name] = solve_map(name, args.seeds, iterations=args.iterations,
                                      agents=args.agents)
         rows += mine
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    markdown = table(rows, maps, seeds=args.seeds, iterations=args.iterations, agents=args.agents)
+    markdown = table(rows, args.maps, seeds=args.seeds, iterations=args.iterations, agents=args.agents)
     write_atomically(args.out / "table.md", markdown)
     fig = figure(best)
     save_png(fig, args.out / "best_paths.png")

@@ -24,7 +24,8 @@ import jax
 
 from jaxswarm.atomic import write_atomically, write_csv
 from jaxswarm.exact import dijkstra
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map
+from jaxswarm.cli import paper_maps_argument
+from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
 
 ALGORITHMS = ("rfd", "rfd_star")
@@ -65,7 +66,7 @@ def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patienc
     return rows
 
 
-def table(rows: list[dict], maps: list[str]) -> str:
+def table(rows: list[dict], maps: tuple[str, ...]) -> str:
     """Markdown table: per map, the optimum and each algorithm's mean length, success, time."""
     header = "| map | optimum | " + " | ".join(
         f"{a} mean length | {a} success | {a} median ms" for a in ALGORITHMS) + " |"
@@ -88,7 +89,8 @@ def table(rows: list[dict], maps: list[str]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--maps", default=",".join(PAPER_MAPS), help="comma-separated paper maps")
+    parser.add_argument("--maps", type=paper_maps_argument, default="all",
+                        help="comma-separated paper maps, or all")
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--iterations", type=int, default=100)
     parser.add_argument("--patience", type=int, default=None,
@@ -97,12 +99,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--agents", type=int, default=256, help="drops per iteration")
     parser.add_argument("--out", type=Path, default=Path("out/rfd_static"))
     args = parser.parse_args(argv)
-    maps = [m for m in args.maps.split(",") if m]
-    unknown = sorted(set(maps) - set(PAPER_MAPS))
-    if unknown:
-        parser.error(f"unknown maps {unknown}; choose from {', '.join(PAPER_MAPS)}")
+    if args.seeds < 1:
+        parser.error("--seeds must be at least 1")
     rows = []
-    for name in maps:
+    for name in args.maps:
         for algorithm in ALGORITHMS:
             began = time.perf_counter()
             mine = solve_map(name, algorithm, args.seeds, iterations=args.iterations,
@@ -111,7 +111,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{name:10} {algorithm:9} success {sum(r['success'] for r in mine):2d}/"
                   f"{args.seeds} ({time.perf_counter() - began:.0f} s)", flush=True)
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    markdown = table(rows, maps)
+    markdown = table(rows, args.maps)
     write_atomically(args.out / "table.md", markdown + "\n")
     print("\n" + markdown)
     return 0

@@ -9,7 +9,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from jaxswarm.maps.paper import (PAPER_MAPS, PAPER_OPTIMA, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS,
-                                 PaperMap, paper_map)
+                                 PaperMap, paper_map, paper_map_names)
 
 # The paper's start and goal cells, (x, y), written out again from its section 3.
 PAPER_ENDPOINTS = {
@@ -113,6 +113,24 @@ def test_deterministic_and_read_only(name):
 def test_unknown_name(name):
     with pytest.raises(ValueError, match="maze20"):
         paper_map(name)
+
+
+@pytest.mark.parametrize("text, names", [
+    ("all", PAPER_MAPS),
+    ("maze100,mosaic20", ("maze100", "mosaic20")),
+    (" alley50 , alley50,", ("alley50",)),
+])
+def test_map_names_from_a_command_line_list(text, names):
+    assert paper_map_names(text) == names
+
+
+@pytest.mark.parametrize("text, message", [
+    ("mosaic20,maze30,Alley20", r"unknown paper maps \['maze30', 'Alley20'\]; choose from all or"),
+    (" , ", "no paper map named"),
+])
+def test_bad_map_lists_name_the_problem(text, message):
+    with pytest.raises(ValueError, match=message):
+        paper_map_names(text)
 
 
 def test_table1_transcription():

@@ -120,6 +120,23 @@ class PaperMap:
         return grid_graph(self.obstacles, **grid_options)
 
 
+def paper_map_names(text: str) -> tuple[str, ...]:
+    """The paper maps named by a command-line list: ``"all"`` or comma-separated names
+    (``"mosaic20,maze100"``), in the order given, repeats dropped.
+
+    Raises:
+      ValueError: naming the unknown maps, or if the list names none.
+    """
+    if text.strip() == "all":
+        return PAPER_MAPS
+    names = tuple(dict.fromkeys(name.strip() for name in text.split(",") if name.strip()))
+    unknown = [name for name in names if name not in PAPER_MAPS]
+    if unknown or not names:
+        problem = f"unknown paper maps {unknown}" if unknown else "no paper map named"
+        raise ValueError(f"{problem}; choose from all or {', '.join(PAPER_MAPS)}")
+    return names
+
+
 def paper_map(name: str) -> PaperMap:
     """The paper's map ``name`` (one of ``PAPER_MAPS``), built afresh, deterministically.
 
