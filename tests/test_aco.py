@@ -8,6 +8,7 @@ from jaxswarm.exact import dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
+from repo_scripts import load_script
 
 
 def corridor():
@@ -116,13 +117,7 @@ def test_improved_max_min_starts_from_the_bug2_path_and_keeps_the_floor():
 
 
 def test_path_map_study_reproduces_the_papers_ordering_on_a_small_map():
-    import importlib.util
-    from pathlib import Path
-
-    script = Path(__file__).resolve().parents[1] / "sweeps" / "aco_pathmaps.py"
-    spec = importlib.util.spec_from_file_location("aco_pathmaps", script)
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
+    study = load_script("sweeps/aco_pathmaps.py")
     rows = {row["algorithm"]: row for row in study.compare(10, 10, seed=0, runs=3, ants=50,
                                                             max_ants=1500, patience=10)}
     assert set(rows) == set(study.ALGORITHMS)

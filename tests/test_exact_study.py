@@ -3,10 +3,8 @@ properties its figures rely on."""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import math
 from collections import defaultdict
-from pathlib import Path
 
 import matplotlib.image
 import numpy as np
@@ -15,21 +13,13 @@ from scipy.sparse.csgraph import shortest_path
 
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
+from repo_scripts import load_script
 
-SCRIPT = Path(__file__).resolve().parents[1] / "sweeps" / "exact_study.py"
 SIZES = (10, 15)
 GRIDS = 3
 PLANNERS = ("dijkstra", "astar", "bidirectional_astar")
 
-
-def _load_study():
-    spec = importlib.util.spec_from_file_location("exact_study", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-study = _load_study()
+study = load_script("sweeps/exact_study.py")
 
 
 def _read_csv(path):

@@ -3,31 +3,21 @@ costs it reports, the best paths it draws, and its transcription of the paper.""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import math
-from pathlib import Path
 
 import matplotlib.image
 import numpy as np
 import pytest
 
-from jaxswarm.maps.paper import PAPER_MAPS, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, paper_map
+from jaxswarm.maps.paper import PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, paper_map
 from jaxswarm.paths import as_node, is_valid_path, path_length
+from repo_scripts import load_script
 
-ROOT = Path(__file__).resolve().parents[1]
 MAP, SEEDS, ITERATIONS, AGENTS = "mosaic20", 2, 3, 16
 EXACT = ("Dijkstra", "A*")
 SWARMS = ("ACO", "ACO*", "RFD", "RFD*")
 
-
-def _load(name: str, relative: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / relative)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-script = _load("rfd_paper_static", "sweeps/rfd_paper_static.py")
+script = load_script("sweeps/rfd_paper_static.py")
 
 
 @pytest.fixture(scope="module")

@@ -3,21 +3,17 @@ agree with Dijkstra and with each other, and its table summarises them."""
 from __future__ import annotations
 
 import csv
-import importlib.util
 import math
-from pathlib import Path
 
 import pytest
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
+from repo_scripts import load_script
 
-ROOT = Path(__file__).resolve().parents[1]
 MAP, SEEDS, ITERATIONS, AGENTS = "maze20", 2, 4, 16
 
-spec = importlib.util.spec_from_file_location("rfd_static", ROOT / "sweeps" / "rfd_static.py")
-script = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(script)
+script = load_script("sweeps/rfd_static.py")
 
 
 @pytest.fixture(scope="module")
