@@ -26,8 +26,8 @@ import time
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.exact import distance_field
 from jaxswarm.cli import paper_maps_argument
+from jaxswarm.exact import distance_field
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
