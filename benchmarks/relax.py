@@ -31,7 +31,7 @@ from jaxswarm.exact import distance_field
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
-from jaxswarm.swarm.walk import step_budget, walk
+from jaxswarm.swarm.walk import step_budget, visited_nodes, walk
 
 
 def median_ms(function, *args, repeats: int) -> float:
@@ -59,7 +59,7 @@ def settling_input(iterations: int):
                  num_agents=swarm.config.num_agents,
                  max_steps=step_budget(graph, swarm.config.max_steps),
                  greedy_agents=swarm.config.greedy_drops)
-    failed = rfd._visited_nodes(graph.num_nodes, drops, ~drops.arrived)
+    failed = visited_nodes(drops, graph.num_nodes, ~drops.arrived)
     plateau = state.altitude >= params.initial_height
     return graph, params, state.altitude + jnp.where(failed & plateau, params.sediment, 0.0)
 

@@ -28,6 +28,9 @@ DIRECTIONS = np.array(
 )
 """i32[8, 2]: the (dx, dy) of each grid direction slot."""
 DIRECTION_NAMES = ("E", "S", "W", "N", "SE", "SW", "NW", "NE")
+ORTHOGONAL_SLOTS = 4
+"""The first four slots are the orthogonal moves (length 1), the rest diagonal (sqrt 2)."""
+SQRT2 = np.float32(math.sqrt(2.0))
 OPPOSITE = np.array([2, 3, 0, 1, 6, 7, 4, 5], dtype=np.int32)
 """i32[8]: ``OPPOSITE[k]`` is the slot of the move that undoes move ``k``."""
 NO_NODE = -1
@@ -41,8 +44,9 @@ class Graph:
 
     Attributes:
       nbr: i32[N, K] neighbour node of each slot, ``NO_NODE`` (-1) where the lattice has none.
-      cost: f32[N, K] edge length (1 or sqrt 2 on grids; any positive weight on dense graphs);
-        0 where ``nbr`` is -1.
+      cost: f32[N, K] edge length (on grids and path maps the length of the slot's move, 1 or
+        sqrt 2, see :func:`slot_lengths`; any positive weight on dense graphs); 0 where ``nbr``
+        is -1.
       xy: f32[N, 2] node coordinates, x = column, y = row for grids.
       free: bool[N] passable nodes (edited at run time).
       open: bool[N, K] passable edges, i.e. no thin wall (edited at run time).
@@ -105,6 +109,50 @@ def straight_line(graph: Graph, node) -> jax.Array:
     """f32[N]: the straight-line (Cartesian) distance from every node's ``xy`` to that of
     ``node`` (i32[], may be traced): the goal-distance heuristic of RFD* and ACO*."""
     return jnp.linalg.norm(graph.xy - graph.xy[node], axis=-1)
+
+
+def slot_offsets(graph: Graph) -> np.ndarray:
+    """i32[K] (static, host side): on a grid or path map, how far along the node numbering
+    each slot's neighbour lies, ``dx + W dy``: node ``i``'s slot-``k`` neighbour, when the
+    lattice has one, is node ``i + offsets[k]``."""
+    _require_lattice(graph)
+    return (DIRECTIONS[:graph.max_degree] @ np.array([1, graph.shape[1]])).astype(np.int32)
+
+
+def slot_lengths(graph: Graph) -> np.ndarray:
+    """f32[K] (static, host side): on a grid or path map, the length of a move in each slot
+    (1 orthogonal, sqrt 2 diagonal), the value of ``cost`` wherever the slot has a neighbour."""
+    _require_lattice(graph)
+    return np.hypot(*DIRECTIONS[:graph.max_degree].T).astype(np.float32)
+
+
+def move_lengths(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
+    """f32[...]: the length of each move, edge ``slots`` (i8/i16/i32, -1 for no move) out of
+    ``nodes`` (i32, same shape); 0 where the slot is -1. On grids and path maps the length is
+    looked up by slot alone (see :func:`slot_lengths`)."""
+    slot = jnp.maximum(slots, 0).astype(jnp.int32)
+    if graph.is_grid:
+        length = jnp.asarray(slot_lengths(graph))[slot]
+    else:
+        length = graph.cost[nodes, slot]
+    return jnp.where(slots >= 0, length, 0.0)
+
+
+def total_length(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
+    """f32[...]: the summed length of the moves along the last axis of ``slots`` (i8/i16/i32
+    [..., M], -1 for no move) out of ``nodes`` (i32[..., M]).
+
+    On grids and path maps the orthogonal and the diagonal moves are counted (the orthogonal
+    slots come first, see ``DIRECTIONS``) and the counts weighted by their lengths, so walks
+    that make the same moves in another order (on an 8-connected grid, many shortest paths do)
+    get bit-identical lengths, and a swarm never takes float rounding for an improvement. On
+    general graphs the lengths are summed.
+    """
+    if not graph.is_grid:
+        return jnp.sum(move_lengths(graph, nodes, slots), axis=-1)
+    moves = jnp.sum(slots >= 0, axis=-1)
+    diagonal = jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=-1)
+    return (moves - diagonal).astype(jnp.float32) + diagonal.astype(jnp.float32) * SQRT2
 
 
 def lowest_neighbour(graph: Graph, values: jax.Array, extra: jax.Array) -> jax.Array:
@@ -214,6 +262,12 @@ def _lowest(graph: Graph, packed, by_slot):
 
 
 @jax.jit
+def _require_lattice(graph: Graph) -> None:
+    if not graph.is_grid:
+        raise ValueError("this map is a general graph, not a grid or path map: its slots have "
+                         "no fixed offsets or lengths")
+
+
 def _valid_edges(graph: Graph) -> jax.Array:
     has_nbr = graph.nbr >= 0
     target_free = jnp.take(graph.free, jnp.where(has_nbr, graph.nbr, 0), axis=-1)

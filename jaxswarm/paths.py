@@ -13,7 +13,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import NO_NODE, Graph
+from jaxswarm.graph import NO_NODE, Graph, total_length
 
 
 @dataclasses.dataclass(frozen=True)
@@ -128,7 +128,8 @@ def step_slots(graph: Graph, path) -> jax.Array:
 
 @jax.jit
 def path_length(graph: Graph, path) -> jax.Array:
-    """f32[]: sum of the edge lengths along a padded path; inf if a step is not an edge.
+    """f32[]: sum of the edge lengths along a padded path (by :func:`jaxswarm.graph.total_length`,
+    as the swarms' walks are measured); inf if a step is not an edge.
 
     A path of one node (start == goal) has length 0; an all-padding path has length inf.
     """
@@ -136,9 +137,8 @@ def path_length(graph: Graph, path) -> jax.Array:
     slots = step_slots(graph, path)
     is_step = (path[:-1] >= 0) & (path[1:] >= 0)
     here = jnp.where(path[:-1] >= 0, path[:-1], 0)
-    step_cost = graph.cost[here, jnp.where(slots >= 0, slots, 0)]
     broken = jnp.any(is_step & (slots < 0)) | (path[0] < 0)
-    return jnp.where(broken, jnp.inf, jnp.sum(jnp.where(is_step, step_cost, 0.0)))
+    return jnp.where(broken, jnp.inf, total_length(graph, here, jnp.where(is_step, slots, -1)))
 
 
 @jax.jit

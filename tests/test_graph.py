@@ -6,7 +6,8 @@ import pytest
 import scipy.sparse.csgraph as csgraph
 
 from jaxswarm.graph import (DIRECTIONS, OPPOSITE, dense_graph, grid_graph, lowest_neighbour,
-                            path_map_graph, relax)
+                            move_lengths, path_map_graph, relax, slot_lengths, slot_offsets,
+                            total_length)
 from oracle import grid_adjacency
 
 
@@ -55,6 +56,47 @@ def test_directions_and_reverse_slots_are_consistent():
                 continue
             np.testing.assert_array_equal(xy[j] - xy[i], DIRECTIONS[k])
             assert rev[i, k] == OPPOSITE[k] and nbr[j, rev[i, k]] == i
+
+
+@pytest.mark.parametrize("make", [lambda: grid_graph(np.zeros((4, 5), bool), connectivity=4),
+                                  lambda: grid_graph(np.zeros((4, 5), bool)),
+                                  lambda: path_map_graph(np.ones((4, 5, 8)))])
+def test_slot_offsets_and_lengths_describe_the_lattice(make):
+    graph = make()
+    nbr, cost = np.asarray(graph.nbr), np.asarray(graph.cost)
+    rows, slots = np.nonzero(nbr >= 0)
+    np.testing.assert_array_equal(nbr[rows, slots], rows + slot_offsets(graph)[slots])
+    np.testing.assert_array_equal(cost[rows, slots], slot_lengths(graph)[slots])
+    assert slot_offsets(graph).shape == slot_lengths(graph).shape == (graph.max_degree,)
+
+
+def test_total_length_does_not_depend_on_the_order_of_the_moves():
+    graph = grid_graph(np.zeros((30, 30), bool))
+    rng = np.random.default_rng(0)
+    moves = rng.integers(0, 8, 200)
+    orders = np.stack([moves, rng.permutation(moves), np.sort(moves)])
+    slots = np.concatenate([orders, np.full((3, 20), -1)], axis=1).astype(np.int16)
+    nodes = np.zeros(slots.shape, np.int32)  # grid lengths do not depend on the node
+    lengths = np.asarray(total_length(graph, nodes, slots))
+    assert lengths[0] == lengths[1] == lengths[2]
+    expected = np.sum((moves < 4) * 1.0 + (moves >= 4) * math.sqrt(2))
+    assert lengths[0] == pytest.approx(expected, rel=1e-6)
+    np.testing.assert_allclose(np.asarray(move_lengths(graph, nodes, slots)).sum(axis=1), lengths,
+                               rtol=1e-6)
+
+
+def test_total_length_on_a_general_graph_sums_the_edge_costs():
+    weights = np.array([[0, 1.5, np.inf], [np.inf, 0, 0.25], [2.0, np.inf, 0]])
+    graph = dense_graph(weights)
+    nbr = np.asarray(graph.nbr)
+    slot = {(u, int(v)): k for u in range(3) for k, v in enumerate(nbr[u]) if v >= 0}
+    nodes = np.array([[0, 1, 2, 0]], np.int32)
+    slots = np.array([[slot[0, 1], slot[1, 2], slot[2, 0], -1]], np.int16)
+    assert float(total_length(graph, nodes, slots)[0]) == pytest.approx(1.5 + 0.25 + 2.0)
+    with pytest.raises(ValueError, match="general graph"):
+        slot_offsets(graph)
+    with pytest.raises(ValueError, match="general graph"):
+        slot_lengths(graph)
 
 
 def test_path_map_walls_close_both_ways_unless_directed():

@@ -221,9 +221,13 @@ def fake_walk(graph, cells, stuck=True):
     nodes = [y * width + x for x, y in cells]
     path = np.full((1, len(nodes) + 2), -1, np.int32)
     path[0, :len(nodes)] = nodes
+    visited = np.zeros((1, (graph.num_nodes + 31) // 32), np.uint32)
+    for node in nodes:
+        visited[0, node // 32] |= np.uint32(1 << (node % 32))
     return Walk(path=jnp.asarray(path), slots=jnp.full((1, path.shape[1] - 1), -1, jnp.int16),
                 length=jnp.zeros(1), arrived=jnp.zeros(1, bool), stuck=jnp.array([stuck]),
-                position=jnp.array([nodes[-1]]), steps=jnp.int32(len(nodes) - 1))
+                position=jnp.array([nodes[-1]]), visited=jnp.asarray(visited),
+                steps=jnp.int32(len(nodes) - 1))
 
 
 def filled_cells(graph, task, walk_):

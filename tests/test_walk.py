@@ -3,9 +3,10 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import grid_graph, straight_line
+from jaxswarm.graph import dense_graph, grid_graph, straight_line
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.walk import FORCED, STEPS_PER_CHECK, edge_table, sample_masked, walk
+from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, edge_table, sample_masked, visited_nodes,
+                                 walk)
 
 
 def _uniform(seed, mask):
@@ -85,6 +86,44 @@ def test_walks_are_valid_self_avoiding_and_measured():
         assert all(nbr[here, k] in nodes for k in range(8) if valid[here, k])
     assert int(result.steps) <= 60
     np.testing.assert_array_equal(np.asarray(result.slots) >= 0, path[:, 1:] >= 0)
+
+
+def unpacked(bits, num_nodes):
+    """bool[A, N] from packed u32[A, W] bit sets (numpy, bit n % 32 of word n // 32)."""
+    bits = np.asarray(bits)
+    return ((bits[:, :, None] >> np.arange(32, dtype=np.uint32)) & 1).reshape(
+        len(bits), -1)[:, :num_nodes].astype(bool)
+
+
+def test_walks_on_a_general_graph_are_valid_and_record_their_nodes():
+    rng = np.random.default_rng(5)
+    weights = np.where(rng.random((30, 30)) < 0.15, rng.uniform(0.5, 3.0, (30, 30)), np.inf)
+    graph = dense_graph(weights)
+    result = walk(jax.random.key(1), graph, edge_table(graph, jnp.zeros(graph.nbr.shape)), 0, 29,
+                  num_agents=32, max_steps=29)
+    path, visited = np.asarray(result.path), unpacked(result.visited, 30)
+    for a in range(32):
+        nodes = path[a][path[a] >= 0]
+        assert len(set(nodes.tolist())) == len(nodes)
+        assert bool(is_valid_path(graph, result.path[a], start=0))
+        assert sum(weights[u, v] for u, v in zip(nodes[:-1], nodes[1:])) == pytest.approx(
+            float(result.length[a]), rel=1e-6)
+        assert set(np.flatnonzero(visited[a])) == set(nodes.tolist())
+    assert bool(result.arrived.any()) and bool(result.stuck.any())
+
+
+def test_visited_nodes_is_the_union_of_the_selected_paths():
+    graph = grid_graph(np.random.default_rng(2).random((9, 9)) < 0.2)
+    result = walk(jax.random.key(2), graph, uniform(graph), 40, 80, num_agents=16, max_steps=40)
+    path = np.asarray(result.path)
+    np.testing.assert_array_equal(unpacked(result.visited, 81).any(axis=0),
+                                  np.asarray(visited_nodes(result, 81)))
+    which = np.asarray(result.arrived)
+    expected = np.zeros(81, bool)
+    expected[path[~which][path[~which] >= 0]] = True
+    np.testing.assert_array_equal(np.asarray(visited_nodes(result, 81, ~result.arrived)),
+                                  expected)
+    assert expected.any() and not expected.all()
 
 
 def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():

@@ -71,10 +71,10 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, lowest_neighbour, relax, straight_line
+from jaxswarm.graph import Graph, lowest_neighbour, move_lengths, relax, straight_line
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
-from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, step_lengths, walk
+from jaxswarm.swarm.walk import FORCED, Walk, edge_table, step_budget, visited_nodes, walk
 
 
 EROSION_LAWS = ("linear", "exponential", "graded")
@@ -312,25 +312,15 @@ def _erode_and_deposit(config: RFDConfig, graph: Graph, task: Task, altitude, lo
         stuck_at = jnp.where(drops.stuck, drops.position, n)  # n is out of bounds: dropped
         altitude = altitude.at[stuck_at].add(params.sediment, mode="drop")
     if config.erosion_law == "graded":
-        failed = _visited_nodes(n, drops, ~drops.arrived)
+        failed = visited_nodes(drops, n, ~drops.arrived)
         plateau = altitude >= params.initial_height
         altitude = settle(graph, altitude + jnp.where(failed & plateau, params.sediment, 0.0),
                           params)
         altitude = _carve_graded(graph, altitude, drops, params)
-        altitude = erode_banks(graph, altitude, _visited_nodes(n, drops), params)
+        altitude = erode_banks(graph, altitude, visited_nodes(drops, n), params)
     else:
         altitude = _erode_eq4(config, graph, altitude, drops, params)
     return jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
-
-
-def _visited_nodes(num_nodes: int, drops: Walk, which=None) -> jax.Array:
-    """bool[N]: the nodes on the paths of the drops selected by ``which`` (bool[A]; all drops
-    when None)."""
-    on_path = drops.path >= 0
-    if which is not None:
-        on_path = on_path & which[:, None]
-    return jnp.zeros((num_nodes,), bool).at[jnp.where(on_path, drops.path, num_nodes)].set(
-        True, mode="drop")
 
 
 def settle(graph: Graph, altitude, params):
@@ -367,7 +357,7 @@ def _erode_eq4(config: RFDConfig, graph: Graph, altitude, drops: Walk, params):
     moved = (drops.slots >= 0) & drops.arrived[:, None]
     here = jnp.where(moved, drops.path[:, :-1], 0)
     there = jnp.where(moved, drops.path[:, 1:], 0)
-    distance = step_lengths(graph, here, drops.slots)
+    distance = move_lengths(graph, here, drops.slots)
     gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
     if config.erosion_law == "exponential":
         # p_base ** gradient, capped so that a cliff cannot overflow float32.
@@ -402,7 +392,7 @@ def _carve_graded(graph: Graph, altitude, drops: Walk, params):
         slot = jax.lax.dynamic_slice_in_dim(slots, first, CARVE_COLUMNS, axis=1)
         on_path = nodes >= 0
         node = jnp.where(on_path, nodes, 0)
-        edge = step_lengths(graph, node, slot)
+        edge = move_lengths(graph, node, slot)
         # to_end[a, k]: length drop a walks from this node to where it stopped.
         to_end = after[:, None] + jax.lax.cumsum(edge, axis=1, reverse=True)
         depth = altitude[node]

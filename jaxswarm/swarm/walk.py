@@ -4,7 +4,8 @@
 ``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
 heuristics do not change while the agents walk). Each step, every still-walking agent gathers
 its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
-has not visited in this walk), and draws one slot through :func:`sample_masked` (a greedy
+has not visited in this walk; on grids and path maps the neighbours are the node plus fixed
+slot offsets, so only the log-weights are gathered), and draws one slot through :func:`sample_masked` (a greedy
 agent takes its most likely slot instead, ties drawn at random). An agent stops
 when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
 runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
@@ -15,7 +16,8 @@ the number of devices changes a walk.
 
 Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
 ``i8[A, L - 1]`` and the nodes ``i16[A, L - 1]`` (i32 above 32,767 nodes; ``L = max_steps + 1``),
-written a block of ``STEPS_PER_CHECK`` steps at a time; the paths come out as ``i32[A, L]``.
+written a block of ``STEPS_PER_CHECK`` steps at a time; the paths come out as ``i32[A, L]``
+and the visited sets with them (:func:`visited_nodes` reads them).
 Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
@@ -29,7 +31,7 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, PartitionSpec as P
 
-from jaxswarm.graph import NO_NODE, Graph
+from jaxswarm.graph import NO_NODE, Graph, slot_offsets, total_length
 
 STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
@@ -56,10 +58,14 @@ class Walk(NamedTuple):
       path: i32[A, L] nodes visited, starting with the start node, -1 padded.
       slots: i16[A, L - 1] neighbour slot of each move (``path[a, t + 1] = nbr[path[a, t], slot]``),
         -1 after the agent stopped.
-      length: f32[A] walked length (sum of edge costs).
+      length: f32[A] walked length (sum of edge costs, measured once the walk is over by
+        :func:`jaxswarm.graph.total_length`, so on grids the same moves in any order give the
+        same float).
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).
       position: i32[A] the node each agent stopped at.
+      visited: u32[A, ceil(N / 32)] the nodes on each agent's path as a packed bit set (bit
+        ``n % 32`` of word ``n // 32`` is node ``n``); see :func:`visited_nodes`.
       steps: i32[] lockstep steps executed: the slowest agent's move count rounded up to a
         multiple of ``STEPS_PER_CHECK``, at most ``max_steps``.
     """
@@ -70,7 +76,18 @@ class Walk(NamedTuple):
     arrived: jax.Array
     stuck: jax.Array
     position: jax.Array
+    visited: jax.Array
     steps: jax.Array
+
+
+def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) -> jax.Array:
+    """bool[N]: the nodes on the paths of the agents selected by ``which`` (bool[A]; all
+    agents when None), read from the walk's packed visited sets (cheaper than scattering the
+    padded paths)."""
+    words = walk.visited if which is None else jnp.where(which[:, None], walk.visited, 0)
+    union = jax.lax.reduce(words, jnp.uint32(0), jax.lax.bitwise_or, (0,))
+    bits = (union[:, None] >> jnp.arange(32, dtype=jnp.uint32)) & 1
+    return bits.reshape(-1)[:num_nodes].astype(bool)
 
 
 def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
@@ -128,12 +145,6 @@ def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
     moves, ``-inf`` to exclude) and pass them through this before :func:`walk`.
     """
     return jnp.where(graph.valid_edges(), log_weights, -jnp.inf)
-
-
-def step_lengths(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
-    """f32[...]: the length of each recorded move, edge ``slots`` (i8/i16/i32) out of ``nodes``
-    (i32, same shape); 0 where the slot is -1 (no move)."""
-    return jnp.where(slots >= 0, graph.cost[nodes, jnp.maximum(slots, 0).astype(jnp.int32)], 0.0)
 
 
 def _mark(bits: jax.Array, agents: jax.Array, nodes: jax.Array) -> jax.Array:
@@ -235,7 +246,6 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
         visited=_mark(jnp.zeros((share, (n + 31) // 32), jnp.uint32), agents, position),
         slots=jnp.full((share, columns), -1, slot_dtype),
         nodes=jnp.full((share, columns), NO_NODE, node_dtype),
-        length=jnp.zeros((share,), jnp.float32),
         walking=jnp.full((share,), start != goal),
         arrived=jnp.full((share,), start == goal),
         stuck=jnp.zeros((share,), bool),
@@ -273,23 +283,29 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
         return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, start_column)),
                     nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, start_column)))
 
+    def neighbours_of(here):
+        """i32[a, K] each agent's neighbours, clamped into the map: computed from the slot
+        offsets on grids (no gather), read from ``nbr`` otherwise. A slot without a neighbour
+        yields some node there, never used: its log-weight is -inf."""
+        if graph.is_grid:
+            return jnp.clip(here[:, None] + jnp.asarray(slot_offsets(graph)), 0, n - 1)
+        return jnp.maximum(graph.nbr[here], 0)
+
     def one_step(c, uniform, greedy):
         here = c["position"]
-        neighbours = graph.nbr[here]
+        neighbours = neighbours_of(here)
         row = log_weights[here]
-        seen = _is_marked(c["visited"], jnp.where(neighbours >= 0, neighbours, 0))
+        seen = _is_marked(c["visited"], neighbours)
         admissible = (row > -jnp.inf) & ~seen & c["walking"][:, None]
         choice, has_choice = sample_masked(uniform, row, admissible, greedy)
         moving = c["walking"] & has_choice & (c["step"] < max_steps)
-        slot = jnp.maximum(choice, 0)
-        target = jnp.take_along_axis(neighbours, slot[:, None], axis=1)[:, 0]
+        target = jnp.take_along_axis(neighbours, jnp.maximum(choice, 0)[:, None], axis=1)[:, 0]
         there = jnp.where(moving, target, here)
         arrived_now = moving & (there == goal)
         c = dict(
             c,
             position=there,
             visited=_mark(c["visited"], jnp.arange(here.shape[0]), there),
-            length=c["length"] + jnp.where(moving, graph.cost[here, slot], 0.0),
             walking=moving & ~arrived_now,
             arrived=c["arrived"] | arrived_now,
             stuck=c["stuck"] | (c["walking"] & ~has_choice),
@@ -316,6 +332,7 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
                                          for name in per_agent})
     path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
                            axis=1)
-    return Walk(path=path, slots=c["slots"][:, :max_steps].astype(jnp.int16),
-                length=c["length"], arrived=c["arrived"], stuck=c["stuck"],
-                position=c["position"], steps=c["step"])
+    slots = c["slots"][:, :max_steps].astype(jnp.int16)
+    return Walk(path=path, slots=slots, length=total_length(graph, path[:, :-1], slots),
+                arrived=c["arrived"], stuck=c["stuck"], position=c["position"],
+                visited=c["visited"], steps=c["step"])
