@@ -150,8 +150,13 @@ def total_length(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
     """
     if not graph.is_grid:
         return jnp.sum(move_lengths(graph, nodes, slots), axis=-1)
-    moves = jnp.sum(slots >= 0, axis=-1)
-    diagonal = jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=-1)
+    return lattice_length(jnp.sum(slots >= 0, axis=-1),
+                          jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=-1))
+
+
+def lattice_length(moves: jax.Array, diagonal: jax.Array) -> jax.Array:
+    """f32[...]: the length of ``moves`` (i32[...]) moves on a grid or path map, ``diagonal``
+    (i32[...]) of them diagonal; equal counts give bit-identical lengths."""
     return (moves - diagonal).astype(jnp.float32) + diagonal.astype(jnp.float32) * SQRT2
 
 

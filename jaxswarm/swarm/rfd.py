@@ -380,16 +380,15 @@ def _carve_graded(graph: Graph, altitude, drops: Walk, params):
     n = altitude.shape[0]
     num_agents, width = drops.path.shape
     blocks = -(-width // CARVE_COLUMNS)
-    pad = blocks * CARVE_COLUMNS - width
-    path = jnp.pad(drops.path, ((0, 0), (0, pad)), constant_values=-1)
-    slots = jnp.pad(drops.slots, ((0, 0), (0, pad + 1)), constant_values=-1)
     walked_blocks = (drops.steps + CARVE_COLUMNS) // CARVE_COLUMNS  # blocks holding nodes
 
     def one_block(carry):
         block, after, best, carved = carry
-        first = block * CARVE_COLUMNS
-        nodes = jax.lax.dynamic_slice_in_dim(path, first, CARVE_COLUMNS, axis=1)
-        slot = jax.lax.dynamic_slice_in_dim(slots, first, CARVE_COLUMNS, axis=1)
+        # The block's columns, read past the end as -1 (no copy of the paths padded to whole
+        # blocks; the last node has no move, so slots reads one column further as -1).
+        columns = block * CARVE_COLUMNS + jnp.arange(CARVE_COLUMNS)
+        nodes = jnp.take(drops.path, columns, axis=1, mode="fill", fill_value=-1)
+        slot = jnp.take(drops.slots, columns, axis=1, mode="fill", fill_value=-1)
         on_path = nodes >= 0
         node = jnp.where(on_path, nodes, 0)
         edge = move_lengths(graph, node, slot)

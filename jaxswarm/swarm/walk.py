@@ -31,7 +31,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, PartitionSpec as P
 
-from jaxswarm.graph import NO_NODE, Graph, slot_offsets, total_length
+from jaxswarm.graph import (NO_NODE, ORTHOGONAL_SLOTS, Graph, lattice_length, slot_offsets,
+                            total_length)
 
 STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
@@ -251,6 +252,8 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
         stuck=jnp.zeros((share,), bool),
         step=jnp.array(0, jnp.int32),
     )
+    if graph.is_grid:  # the moves of each kind, tallied per chunk, measure the walks' lengths
+        carry.update(moves=jnp.zeros((share,), jnp.int32), diagonal=jnp.zeros((share,), jnp.int32))
     per_agent = [name for name in carry if name not in ("key", "step")]
 
     def keep_walking(c):
@@ -280,6 +283,9 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
         nodes = jnp.full((STEPS_PER_CHECK, rows), NO_NODE, node_dtype)
         c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
                                             (dict(c, key=key), slots, nodes))
+        if graph.is_grid:
+            c = dict(c, moves=c["moves"] + jnp.sum(slots >= 0, axis=0),
+                     diagonal=c["diagonal"] + jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=0))
         return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, start_column)),
                     nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, start_column)))
 
@@ -333,6 +339,10 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
     path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
                            axis=1)
     slots = c["slots"][:, :max_steps].astype(jnp.int16)
-    return Walk(path=path, slots=slots, length=total_length(graph, path[:, :-1], slots),
+    if graph.is_grid:
+        length = lattice_length(c["moves"], c["diagonal"])
+    else:
+        length = total_length(graph, path[:, :-1], slots)
+    return Walk(path=path, slots=slots, length=length,
                 arrived=c["arrived"], stuck=c["stuck"], position=c["position"],
                 visited=c["visited"], steps=c["step"])
