@@ -266,13 +266,13 @@ def _lowest(graph: Graph, packed, by_slot):
     return lowest
 
 
-@jax.jit
 def _require_lattice(graph: Graph) -> None:
     if not graph.is_grid:
         raise ValueError("this map is a general graph, not a grid or path map: its slots have "
                          "no fixed offsets or lengths")
 
 
+@jax.jit
 def _valid_edges(graph: Graph) -> jax.Array:
     has_nbr = graph.nbr >= 0
     target_free = jnp.take(graph.free, jnp.where(has_nbr, graph.nbr, 0), axis=-1)
