@@ -5,10 +5,10 @@
 heuristics do not change while the agents walk). Each step, every still-walking agent gathers
 its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
 has not visited in this walk; on grids and path maps the neighbours are the node plus fixed
-slot offsets, so only the log-weights are gathered), and draws one slot through :func:`sample_masked` (a greedy
-agent takes its most likely slot instead, ties drawn at random). An agent stops
-when it reaches the goal, when it has no admissible neighbour ("stuck"), or when the step budget
-runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
+slot offsets, so only the log-weights are gathered), and draws one slot through
+:func:`sample_masked` (a greedy agent takes its most likely slot instead, ties drawn at
+random). An agent stops when it reaches the goal, when it has no admissible neighbour ("stuck"),
+or when the step budget runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
 at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch of just those.
 With ``devices > 1`` the agents are shared out over that many devices, each running its own
 loop (``shard_map``); every agent draws the same uniforms either way, so neither compaction nor
@@ -59,9 +59,9 @@ class Walk(NamedTuple):
       path: i32[A, L] nodes visited, starting with the start node, -1 padded.
       slots: i16[A, L - 1] neighbour slot of each move (``path[a, t + 1] = nbr[path[a, t], slot]``),
         -1 after the agent stopped.
-      length: f32[A] walked length (sum of edge costs, measured once the walk is over by
-        :func:`jaxswarm.graph.total_length`, so on grids the same moves in any order give the
-        same float).
+      length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
+        counted by kind (:func:`jaxswarm.graph.lattice_length`), so the same moves in any order
+        give the same float; on general graphs the edge costs are summed.
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).
       position: i32[A] the node each agent stopped at.
