@@ -18,7 +18,7 @@ from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import Solution, is_valid_path, path_length
 from jaxswarm.swarm import Swarm, make, make_task, run
-from jaxswarm.swarm.core import StepInfo
+from jaxswarm.swarm.core import StepInfo, keep_best
 from jaxswarm.swarm.walk import Walk
 
 ITERATIONS = 8
@@ -418,6 +418,33 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
     return Swarm(name="late", config=None, init=init, step=step, best=best,
                  default_params=None, check_params=lambda params: None,
                  memory=lambda state: jnp.zeros(1), memory_label="")
+
+
+@pytest.mark.parametrize("name", ["rfd_star", "ant_system"])
+def test_a_run_stops_when_every_agent_followed_the_same_path(name):
+    obstacles = np.ones((3, 5), bool)
+    obstacles[1] = False  # a one-cell corridor: there is one path
+    graph = grid_graph(obstacles)
+    state, trace = run(make(name, num_agents=8), jax.random.key(0), graph,
+                       make_task(graph, (0, 1), (4, 1)), make(name).default_params, iterations=10)
+    assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
+
+
+def test_keep_best_calls_an_iteration_converged_only_on_one_path_of_all_agents():
+    def walked(paths, arrived):
+        paths = jnp.asarray(paths, jnp.int32)
+        return Walk(path=paths, slots=jnp.zeros((len(paths), paths.shape[1] - 1), jnp.int16),
+                    length=jnp.sum(paths >= 0, axis=1).astype(jnp.float32) - 1,
+                    arrived=jnp.asarray(arrived), stuck=~jnp.asarray(arrived),
+                    position=paths[:, -1], visited=jnp.zeros((len(paths), 1), jnp.uint32),
+                    steps=jnp.int32(paths.shape[1] - 1))
+
+    best_path, best_cost = jnp.full((3,), -1, jnp.int32), jnp.float32(jnp.inf)
+    same, other = [[0, 1, 2]] * 3, [[0, 1, 2], [0, 3, 2], [0, 1, 2]]
+    for paths, arrived, converged in [(same, [True] * 3, True), (other, [True] * 3, False),
+                                      (same, [True, False, True], False)]:
+        _, cost, info = keep_best(walked(paths, arrived), best_path, best_cost)
+        assert bool(info.converged) == converged and float(cost) == 2.0
 
 
 @pytest.mark.parametrize("first_path_at, improvements, stops_after", [

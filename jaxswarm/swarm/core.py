@@ -209,9 +209,13 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False):
     winner = jnp.argmin(costs)
     cost = costs[winner]
     better = ((cost <= best_cost) & jnp.isfinite(cost)) if ties else cost < best_cost
+    # Comparing the [A, L] paths costs a pass over them: only when every agent arrived.
+    all_arrived = jnp.all(walk.arrived)
+    same_path = jax.lax.cond(all_arrived, lambda path: jnp.all(path == path[:1]),
+                             lambda path: jnp.array(False), walk.path)
     info = StepInfo(iteration_cost=cost,
                     arrived=jnp.mean(walk.arrived.astype(jnp.float32)),
-                    converged=jnp.all(walk.arrived) & jnp.all(walk.path == walk.path[:1]))
+                    converged=all_arrived & same_path)
     return (jnp.where(better, walk.path[winner], best_path), jnp.where(better, cost, best_cost),
             info)
 
