@@ -10,15 +10,17 @@ Shared machines are noisy: with ``--repeats R`` the seeds of each map are timed 
 the script prints the median of the R medians and their range. The runs themselves are
 deterministic, so a repeat whose paths differ from the first stops the script.
 
-With ``--devices N`` the CPU is split into N JAX devices and each walk's drops are spread over
-them (``make("rfd_star", devices=N)``), so one run uses N cores; the results are bit-identical
-to one device.
+XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see :mod:`jaxswarm.cpu`: a
+run is thousands of tiny kernels in a row, and a second thread mostly adds hand-offs between the
+cores). With ``--devices N`` the CPU is split into N JAX devices and each walk's drops are spread
+over them (``make("rfd_star", devices=N)``), so one run uses N cores (and at least N threads);
+the results are bit-identical to one device.
 
 Run from the repository root::
 
     python benchmarks/rfd.py
     python benchmarks/rfd.py --maps mosaic100,alley100,maze100 --seeds 5 --devices 2
-    python benchmarks/rfd.py --maps maze100 --repeats 5
+    python benchmarks/rfd.py --maps maze100 --repeats 5 --threads 2
 """
 from __future__ import annotations
 
@@ -30,6 +32,8 @@ import statistics
 from pathlib import Path
 
 import jax
+
+from jaxswarm.cpu import configure
 
 
 def _rfd_static():
@@ -48,13 +52,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--agents", type=int, default=256)
     parser.add_argument("--devices", type=int, default=1,
                         help="CPU devices to spread each walk's drops over")
+    parser.add_argument("--threads", type=int, default=1,
+                        help="XLA:CPU intra-op threads (jaxswarm.cpu.configure)")
     parser.add_argument("--repeats", type=int, default=1,
                         help="time each map's seeds this many times (median and range)")
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
-    # Before JAX's first use (the package creates arrays when imported).
-    jax.config.update("jax_num_cpu_devices", args.devices)
+    # Before JAX's first use (jaxswarm.swarm creates arrays when imported).
+    try:
+        configure(devices=args.devices, threads=args.threads)
+    except ValueError as error:
+        parser.error(str(error))
     from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
 
     try:
@@ -65,7 +74,8 @@ def main(argv: list[str] | None = None) -> int:
     paper_ms = PAPER_TABLE1_MS["RFD*"]  # the paper's Table 1, RFD* time [ms], static
     solve_map = _rfd_static().solve_map
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
-          f"({jax.default_backend()}, drops spread over {args.devices} device(s))")
+          f"({jax.default_backend()}, {max(args.threads, args.devices)} XLA thread(s), drops spread over "
+          f"{args.devices} device(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
           f"{'mean iterations':>16} {'range ms':>12}")
     for name in maps:

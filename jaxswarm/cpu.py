@@ -1,0 +1,60 @@
+"""How JAX uses the CPU: devices and XLA's thread pool, set before JAX's first computation.
+
+XLA:CPU runs a compiled program as a graph of small kernels ("thunks") on a pool of
+``XLAEigen`` threads, one per core by default, and starts any kernel whose inputs are ready on
+whichever thread is free. A swarm iteration is thousands of tiny kernels in a row (one lockstep
+step of 256 agents is about 15 of them, each a microsecond or two), so with two threads each step
+hands its data back and forth between the cores: in a ``perf`` profile of the maze100 walk each
+core spent about a third of its time looking for the next kernel and a quarter more in the
+runtime and the kernel's thread wake-ups, against 40 % in the kernels. With one thread the same kernels run back to back: on a 2-core
+machine an RFD* run on maze100 took about 0.78x the time (``benchmarks/rfd.py --threads``). Large
+batches (a sweep of many runs under ``vmap``) have bigger kernels and can gain from more threads.
+
+The pool size is read once, when JAX creates its CPU client, from the environment variable
+``PJRT_NPROC`` (XLA's own setting; the number of JAX CPU devices raises it to at least that many).
+:func:`configure` sets both and refuses once JAX has started, when they would no longer apply.
+"""
+from __future__ import annotations
+
+import os
+
+import jax
+
+THREADS_VARIABLE = "PJRT_NPROC"
+"""The environment variable XLA:CPU reads for the size of its intra-op thread pool."""
+
+
+def configure(*, devices: int = 1, threads: int | None = None) -> None:
+    """Split the CPU into ``devices`` JAX devices and give XLA ``threads`` intra-op threads.
+
+    Call it before anything creates a JAX array, including importing :mod:`jaxswarm.swarm`,
+    :mod:`jaxswarm.sweep` or :mod:`jaxswarm.cli`, which build constants: JAX reads both
+    settings when it starts its CPU client.
+
+    Args:
+      devices: JAX CPU devices (``jax.devices()``), at least 1; several devices let
+        ``shard_map`` and sharded sweeps run on several cores.
+      threads: XLA:CPU intra-op threads, at least 1 (raised to ``devices`` by XLA if lower);
+        None leaves XLA's default (one per core, or ``$PJRT_NPROC`` if set).
+
+    Raises:
+      ValueError: ``devices`` or ``threads`` below 1.
+      RuntimeError: JAX has already started its backends.
+    """
+    for name, value in (("devices", devices), ("threads", threads)):
+        if value is not None and (not isinstance(value, int) or value < 1):
+            raise ValueError(f"{name} must be a whole number of at least 1, got {value!r}")
+    if _backends_started():
+        raise RuntimeError("jaxswarm.cpu.configure must be called before JAX's first "
+                           "computation (JAX reads the device count and thread pool size when "
+                           "it starts); call it right after `import jax`")
+    jax.config.update("jax_num_cpu_devices", devices)
+    if threads is not None:
+        os.environ[THREADS_VARIABLE] = str(threads)
+
+
+def _backends_started() -> bool:
+    # jax 0.10 has no public query; the private one is stable since jax 0.4.
+    from jax._src import xla_bridge
+
+    return xla_bridge.backends_are_initialized()
