@@ -34,6 +34,7 @@ from pathlib import Path
 import jax
 
 from jaxswarm.cpu import configure
+from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
 
 
 def _rfd_static():
@@ -59,13 +60,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
-    # Before JAX's first use (jaxswarm.swarm creates arrays when imported).
+    # Before JAX's first computation.
     try:
         configure(devices=args.devices, threads=args.threads)
     except ValueError as error:
         parser.error(str(error))
-    from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
-
     try:
         maps = paper_map_names(args.maps)
     except ValueError as error:

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import jax
 
+from jaxswarm.cpu import configure
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map, paper_map_names
@@ -35,6 +36,9 @@ instead of ``--drops``."""
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``jaxswarm`` command; returns the exit status."""
     parser = argparse.ArgumentParser(prog="jaxswarm", description=__doc__.splitlines()[0])
+    parser.add_argument("--threads", type=int,
+                        help="XLA:CPU intra-op threads (default: one per core); 1 is fastest for "
+                             "single runs on a few cores, see jaxswarm.cpu")
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
     demo.add_argument("--map", default="maze50",
@@ -53,6 +57,11 @@ def main(argv: list[str] | None = None) -> int:
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--no-plots", action="store_true", help="write no figures")
     args = parser.parse_args(argv)
+    if args.threads is not None:
+        try:
+            configure(threads=args.threads)
+        except (ValueError, RuntimeError) as error:
+            parser.error(f"--threads: {error}")
     try:
         return run_demo(args) if args.command == "demo" else run_sweep_command(args)
     except ValueError as error:

@@ -24,18 +24,18 @@ THREADS_VARIABLE = "PJRT_NPROC"
 """The environment variable XLA:CPU reads for the size of its intra-op thread pool."""
 
 
-def configure(*, devices: int = 1, threads: int | None = None) -> None:
+def configure(*, devices: int | None = None, threads: int | None = None) -> None:
     """Split the CPU into ``devices`` JAX devices and give XLA ``threads`` intra-op threads.
 
-    Call it before anything creates a JAX array, including importing :mod:`jaxswarm.swarm`,
-    :mod:`jaxswarm.sweep` or :mod:`jaxswarm.cli`, which build constants: JAX reads both
-    settings when it starts its CPU client.
+    Call it before JAX's first computation (importing jaxswarm's modules does not start JAX):
+    JAX reads both settings when it starts its CPU client. None leaves a setting as it is.
 
     Args:
       devices: JAX CPU devices (``jax.devices()``), at least 1; several devices let
-        ``shard_map`` and sharded sweeps run on several cores.
-      threads: XLA:CPU intra-op threads, at least 1 (raised to ``devices`` by XLA if lower);
-        None leaves XLA's default (one per core, or ``$PJRT_NPROC`` if set).
+        ``shard_map`` and sharded sweeps run on several cores. None: JAX's default (one, or
+        what ``--xla_force_host_platform_device_count`` in ``XLA_FLAGS`` asks for).
+      threads: XLA:CPU intra-op threads, at least 1 (raised to the device count by XLA if
+        lower). None: XLA's default (one per core, or ``$PJRT_NPROC`` if set).
 
     Raises:
       ValueError: ``devices`` or ``threads`` below 1.
@@ -48,7 +48,8 @@ def configure(*, devices: int = 1, threads: int | None = None) -> None:
         raise RuntimeError("jaxswarm.cpu.configure must be called before JAX's first "
                            "computation (JAX reads the device count and thread pool size when "
                            "it starts); call it right after `import jax`")
-    jax.config.update("jax_num_cpu_devices", devices)
+    if devices is not None:
+        jax.config.update("jax_num_cpu_devices", devices)
     if threads is not None:
         os.environ[THREADS_VARIABLE] = str(threads)
 

@@ -1,6 +1,8 @@
 import re
 
+import jax.numpy as jnp
 import matplotlib
+import pytest
 
 matplotlib.use("Agg")
 
@@ -35,3 +37,14 @@ def test_demo_rejects_unknown_map_with_exit_status_2(capsys):
     except SystemExit as stop:
         assert stop.code == 2
     assert "--map must be one of" in capsys.readouterr().err
+
+
+def test_threads_option_names_a_bad_count_or_a_late_call(capsys):
+    jnp.ones(1).block_until_ready()  # JAX has started: a valid count comes too late
+    for count, message in (("0", "threads must be a whole number of at least 1"),
+                           ("1", "before JAX's first computation")):
+        with pytest.raises(SystemExit) as stop:
+            main(["--threads", count, "demo", "--map", "maze20"])
+        assert stop.value.code == 2
+        error = capsys.readouterr().err
+        assert "error: --threads:" in error and message in error

@@ -11,8 +11,9 @@ from jaxswarm.cpu import configure
 PROBE = """
 import json, os, sys
 import jax
+import jaxswarm.cli, jaxswarm.exact, jaxswarm.plot, jaxswarm.swarm, jaxswarm.sweep
 from jaxswarm.cpu import configure
-configure(devices={devices}, threads={threads})
+configure(devices={devices}, threads={threads})  # after the imports: they must not start JAX
 import jax.numpy as jnp
 jnp.ones(3).block_until_ready()
 names = [open(f"/proc/self/task/{{t}}/comm").read().strip() for t in os.listdir("/proc/self/task")]
@@ -21,7 +22,7 @@ print(json.dumps({{"devices": len(jax.devices()), "pool": sum(n.startswith("tf_X
 """
 
 
-@pytest.mark.parametrize("devices, threads", [(0, None), (1, 0), (1, 1.5), (-2, 1)])
+@pytest.mark.parametrize("devices, threads", [(0, None), (None, 0), (1, 1.5), (-2, 1)])
 def test_configure_names_a_bad_count(devices, threads):
     with pytest.raises(ValueError, match="must be a whole number of at least 1"):
         configure(devices=devices, threads=threads)
@@ -36,7 +37,8 @@ def test_configure_refuses_once_jax_has_started():
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/task")
 @pytest.mark.parametrize("devices, threads, pool", [(1, 1, 1), (2, 1, 2), (1, 2, 2)])
 def test_configure_sizes_the_device_list_and_the_thread_pool(devices, threads, pool):
-    """XLA raises the pool to the device count; the pool threads are named tf_XLAEigen."""
+    """XLA raises the pool to the device count; the pool threads are named tf_XLAEigen.
+    Importing jaxswarm's modules first must not start JAX (configure would refuse)."""
     result = subprocess.run([sys.executable, "-c", PROBE.format(devices=devices, threads=threads)],
                             capture_output=True, text=True, timeout=120, check=True)
     seen = json.loads(result.stdout.strip().splitlines()[-1])

@@ -27,6 +27,7 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from jaxswarm.graph import Graph, straight_line
 from jaxswarm.paths import Solution, step_slots
@@ -91,8 +92,8 @@ class ACOParams(NamedTuple):
     tau_max: jax.Array
 
 
-DEFAULT_ACO = ACOParams(*(jnp.float32(v) for v in (0.1, 1.0, 1.0, 1.0, 50.0, 1.0, 0.01, 10.0)))
-DEFAULT_IMPROVED_ACO = DEFAULT_ACO._replace(q=jnp.float32(0.1))
+DEFAULT_ACO = ACOParams(*(np.float32(v) for v in (0.1, 1.0, 1.0, 1.0, 50.0, 1.0, 0.01, 10.0)))
+DEFAULT_IMPROVED_ACO = DEFAULT_ACO._replace(q=np.float32(0.1))
 """Improved Max-Min ACO: delta = rho * tau0, so the best path's pheromone stays at tau0 while
 every other edge decays to the floor (on alley20, 15/20 runs within 5 % against 9/20 with q = 1)."""
 

@@ -70,6 +70,7 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from jaxswarm.graph import Graph, lowest_neighbour, move_lengths, relax, straight_line
 from jaxswarm.paths import Solution
@@ -181,7 +182,9 @@ MAX_LOG_EROSION = 60.0
 
 
 def _f32(**values):
-    return {name: jnp.float32(value) for name, value in values.items()}
+    # NumPy scalars, not JAX arrays: importing the module must not start JAX's backend (see
+    # jaxswarm.cpu.configure); jit and vmap take them as float32 arrays.
+    return {name: np.float32(value) for name, value in values.items()}
 
 
 DEFAULT_RFD = RFDParams(**_f32(initial_height=1.0, erosion=1.0, sediment=0.1, omega=0.1,
