@@ -72,8 +72,9 @@ def main(argv: list[str] | None = None) -> int:
 
     paper_ms = PAPER_TABLE1_MS["RFD*"]  # the paper's Table 1, RFD* time [ms], static
     solve_map = _rfd_static().solve_map
+    threads = max(args.threads, args.devices)  # XLA gives each device a thread at least
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
-          f"({jax.default_backend()}, {max(args.threads, args.devices)} XLA thread(s), drops spread over "
+          f"({jax.default_backend()}, {threads} XLA thread(s), drops spread over "
           f"{args.devices} device(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
           f"{'mean iterations':>16} {'range ms':>12}")

@@ -6,9 +6,10 @@ whichever thread is free. A swarm iteration is thousands of tiny kernels in a ro
 step of 256 agents is about 15 of them, each a microsecond or two), so with two threads each step
 hands its data back and forth between the cores: in a ``perf`` profile of the maze100 walk each
 core spent about a third of its time looking for the next kernel and a quarter more in the
-runtime and the kernel's thread wake-ups, against 40 % in the kernels. With one thread the same kernels run back to back: on a 2-core
-machine an RFD* run on maze100 took about 0.78x the time (``benchmarks/rfd.py --threads``). Large
-batches (a sweep of many runs under ``vmap``) have bigger kernels and can gain from more threads.
+runtime, allocations and thread wake-ups, against 40 % in the kernels themselves. With one
+thread the same kernels run back to back: on a 2-core machine an RFD* run on maze100 took about
+0.78x the time (``benchmarks/rfd.py --threads``). Large batches (a sweep of many runs under
+``vmap``, a walk of thousands of agents) have bigger kernels and can gain from more threads.
 
 The pool size is read once, when JAX creates its CPU client, from the environment variable
 ``PJRT_NPROC`` (XLA's own setting; the number of JAX CPU devices raises it to at least that many).

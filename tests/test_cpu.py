@@ -9,7 +9,7 @@ import pytest
 from jaxswarm.cpu import configure
 
 PROBE = """
-import json, os, sys
+import json, os
 import jax
 import jaxswarm.cli, jaxswarm.exact, jaxswarm.plot, jaxswarm.swarm, jaxswarm.sweep
 from jaxswarm.cpu import configure
