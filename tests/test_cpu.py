@@ -9,11 +9,13 @@ import pytest
 from jaxswarm.cpu import configure
 
 PROBE = """
-import json, os
+import importlib, json, os, pkgutil
 import jax
-import jaxswarm.cli, jaxswarm.exact, jaxswarm.plot, jaxswarm.swarm, jaxswarm.sweep
+import jaxswarm
+for module in pkgutil.walk_packages(jaxswarm.__path__, "jaxswarm."):
+    importlib.import_module(module.name)
 from jaxswarm.cpu import configure
-configure(devices={devices}, threads={threads})  # after the imports: they must not start JAX
+configure(devices={devices}, threads={threads})  # after every import: none may start JAX
 import jax.numpy as jnp
 jnp.ones(3).block_until_ready()
 names = [open(f"/proc/self/task/{{t}}/comm").read().strip() for t in os.listdir("/proc/self/task")]
@@ -38,7 +40,7 @@ def test_configure_refuses_once_jax_has_started():
 @pytest.mark.parametrize("devices, threads, pool", [(1, 1, 1), (2, 1, 2), (1, 2, 2)])
 def test_configure_sizes_the_device_list_and_the_thread_pool(devices, threads, pool):
     """XLA raises the pool to the device count; the pool threads are named tf_XLAEigen.
-    Importing jaxswarm's modules first must not start JAX (configure would refuse)."""
+    Importing every jaxswarm module first must not start JAX (configure would refuse)."""
     result = subprocess.run([sys.executable, "-c", PROBE.format(devices=devices, threads=threads)],
                             capture_output=True, text=True, timeout=120, check=True)
     seen = json.loads(result.stdout.strip().splitlines()[-1])
