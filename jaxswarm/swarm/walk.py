@@ -8,8 +8,9 @@ has not visited in this walk; on grids and path maps the neighbours are the node
 slot offsets, so only the log-weights are gathered), and draws one slot through
 :func:`sample_masked` (a greedy agent takes its most likely slot instead, ties drawn at
 random). An agent stops when it reaches the goal, when it has no admissible neighbour ("stuck"),
-or when the step budget runs out. The walk is a ``lax.while_loop`` that ends as soon as every agent has stopped; once
-at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch of just those.
+or when the step budget runs out. The walk is a ``lax.while_loop`` that ends as soon as every
+agent has stopped; once at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch
+of just those.
 With ``devices > 1`` the agents are shared out over that many devices, each running its own
 loop (``shard_map``); every agent draws the same uniforms either way, so neither compaction nor
 the number of devices changes a walk.
