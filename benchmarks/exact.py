@@ -250,8 +250,9 @@ def main(argv: list[str] | None = None) -> int:
         table += rows
         all_ok &= ok
     print_table(table)
-    print(f"lengths: {'all planners agree with each other and with the .scen optima' if all_ok else 'MISMATCH (see above)'}"
-          f" | benchmark took {time.perf_counter() - began:.0f} s")
+    verdict = ("all planners agree with each other and with the .scen optima" if all_ok
+               else "MISMATCH (see above)")
+    print(f"lengths: {verdict} | benchmark took {time.perf_counter() - began:.0f} s")
     return 0 if all_ok else 1
 
 

@@ -140,7 +140,8 @@ def run_study(sizes, grids: int, density: float = 0.3, seed: int = 0, *,
             means = {name: np.mean([r["expanded"] for r in size_rows if r["planner"] == name])
                      for name in PLANNERS}
             log(f"[{done:>2}/{len(sizes)}] size {size:>3}: {grids} grids in "
-                f"{time.perf_counter() - size_began:6.1f} s (elapsed {time.perf_counter() - began:6.1f} s)"
+                f"{time.perf_counter() - size_began:6.1f} s "
+                f"(elapsed {time.perf_counter() - began:6.1f} s)"
                 " | mean expanded " + ", ".join(f"{LABELS[n]} {m:.0f}" for n, m in means.items()))
     return rows
 
@@ -159,7 +160,8 @@ def estimate_seconds(sizes, grids: int, density: float, seed: int) -> float:
 
     small, large = min(sizes), max(sizes)
     first_small, per_small = timed(small), timed(small)
-    first_large, per_large = (timed(large), timed(large)) if large != small else (first_small, per_small)
+    first_large, per_large = ((timed(large), timed(large)) if large != small
+                              else (first_small, per_small))
     one_off = max(0.0, (first_small - per_small + first_large - per_large) / 2)
     b = (per_large - per_small) / (large**2 - small**2) if large != small else 0.0
     b = max(b, 0.0)
@@ -231,7 +233,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--sizes", type=parse_sizes, default=parse_sizes("10:100:5"),
                         help="grid sides, start:stop:step (stop included) or a comma list "
                              "(default 10:100:5)")
-    parser.add_argument("--grids", type=int, default=1000, help="random grids per size (default 1000)")
+    parser.add_argument("--grids", type=int, default=1000,
+                        help="random grids per size (default 1000)")
     parser.add_argument("--density", type=float, default=0.3,
                         help="obstacle probability before the path is cleared (default 0.3)")
     parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")

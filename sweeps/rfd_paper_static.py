@@ -247,7 +247,8 @@ def main(argv: list[str] | None = None) -> int:
                                      agents=args.agents)
         rows += mine
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    markdown = table(rows, args.maps, seeds=args.seeds, iterations=args.iterations, agents=args.agents)
+    markdown = table(rows, args.maps, seeds=args.seeds, iterations=args.iterations,
+                     agents=args.agents)
     write_atomically(args.out / "table.md", markdown)
     fig = figure(best)
     save_png(fig, args.out / "best_paths.png")

@@ -4,9 +4,9 @@ For every map, each algorithm runs once per seed (``--seeds``, default 20) for a
 iterations (``--iterations``; a run also stops when every drop follows the same path, and, if
 ``--patience`` is given, after that many iterations without improvement). Each run is jitted once
 per map and algorithm and then timed on its own (compile excluded). Printed per map: the optimum
-(Dijkstra), each algorithm's mean best length over the seeds, its success count (relative gap < 1e-4 to the
-optimum) and the median wall time of one run. Written to ``--out`` (default ``out/rfd_static``):
-``runs.csv`` (one row per map, algorithm and seed) and ``table.md``.
+(Dijkstra), each algorithm's mean best length over the seeds, its success count (relative gap
+< 1e-4 to the optimum) and the median wall time of one run. Written to ``--out`` (default
+``out/rfd_static``): ``runs.csv`` (one row per map, algorithm and seed) and ``table.md``.
 
 Run from the repository root::
 

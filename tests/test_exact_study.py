@@ -71,7 +71,8 @@ def test_the_three_planners_find_the_same_optimal_cost_on_every_grid(outputs):
 def test_search_counters_are_consistent(outputs):
     # Every expansion is a pop and every pop was a push.
     for row in outputs["runs"]:
-        expanded, iterations, generated = (int(row[k]) for k in ("expanded", "iterations", "generated"))
+        expanded, iterations, generated = (int(row[k])
+                                           for k in ("expanded", "iterations", "generated"))
         assert 0 < expanded <= iterations <= generated, row
 
 

@@ -96,7 +96,8 @@ def test_malformed_map_names_line(tmp_path, text, line, problem):
 @pytest.mark.parametrize("text, line, problem", [
     ("1\tm.map\t3\t2\t0\t0\t2\t1\t2.4\n", 1, "expected a .version"),
     ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\n", 2, "expected 9 fields"),
-    ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\t2.4\n1\tm.map\t3\t2\tx\t0\t2\t1\t2.4\n", 3, "bad number"),
+    ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\t2.4\n"
+     "1\tm.map\t3\t2\tx\t0\t2\t1\t2.4\n", 3, "bad number"),
     ("version 1\n1\tm.map\t3\t2\t0\t0\t2\t1\t-1\n", 2, "bad optimal length"),
 ])
 def test_malformed_scenarios_name_line(tmp_path, text, line, problem):

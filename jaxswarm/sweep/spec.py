@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import math
 import sys
 from pathlib import Path
 from typing import Any
