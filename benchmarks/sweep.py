@@ -44,7 +44,7 @@ import numpy as np
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep import run_sweep, spec_from_dict
-from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
+from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE, DEFAULT_VMAP_SIZE
 
 GiB = 2 ** 30
 MiB = 2 ** 20
@@ -61,7 +61,7 @@ def machine() -> str:
 def sweep_document(args) -> dict:
     return {"sweep": {"name": "bench", "algorithm": "rfd_star", "maps": [args.map],
                       "seeds": args.seeds, "iterations": args.iterations,
-                      "chunk_size": args.chunk_size},
+                      "chunk_size": args.chunk_size, "vmap_size": args.vmap_size},
             "config": {"num_agents": args.agents},
             "params": {"p_base": {"start": 2, "stop": 200, "num": args.values, "log": True},
                        "alpha": {"start": 1, "stop": 20, "num": args.values}}}
@@ -148,6 +148,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="values per param (the grid is values x values)")
     parser.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                         help="runs per sweep chunk (default: the sweep spec's default)")
+    parser.add_argument("--vmap-size", type=int, default=DEFAULT_VMAP_SIZE,
+                        help="runs vmapped together (default: the sweep spec's default)")
     parser.add_argument("--loop-runs", type=int, default=None,
                         help="time only this many loop runs and extrapolate (default: all)")
     args = parser.parse_args(argv)
@@ -158,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"machine: {machine()}")
     print(f"RFD* on {args.map}: p_base x alpha = {args.values} x {args.values} values x "
           f"{args.seeds} seeds = {total} runs, {args.iterations} iterations, {args.agents} agents, "
-          f"chunks of {args.chunk_size}")
+          f"chunks of {args.chunk_size}, vmapped {args.vmap_size} at a time")
     print("sweep: one timed run_sweep into a fresh store (single run, not repeated: too long)",
           flush=True)
     sweep = time_sweep(spec)
@@ -190,8 +192,8 @@ def main(argv: list[str] | None = None) -> int:
           f"compile ({sweep['compiles']} compile(s)); chunks' compute alone "
           f"{sweep['chunk_seconds']:.2f} s ({total / sweep['chunk_seconds']:.2f} runs/s)")
     used = frame.groupby("chunk")["iterations"]
-    print(f"iterations used: sweep mean {frame['iterations'].mean():.1f}, but each chunk runs "
-          f"as long as its slowest run (max per chunk: "
+    print(f"iterations used: sweep mean {frame['iterations'].mean():.1f}, but a vmapped group "
+          f"runs as long as its slowest run (max per chunk: "
           f"{', '.join(str(int(v)) for v in used.max())}); loop mean "
           f"{np.mean(loop['iterations']):.1f} over its {measured} runs")
     if extrapolated:

@@ -70,6 +70,7 @@ def test_spec_grid_ranges_and_seeds():
     (dict(sweep={"maps": [{"random": 20}]}), r"sweep.maps\[0\]: seed = None"),
     (dict(sweep={"seeds": 0}), "sweep.seeds: must be at least 1"),
     (dict(sweep={"iterations": 0}), "sweep.iterations: must be a positive integer"),
+    (dict(sweep={"vmap_size": 0}), "sweep.vmap_size: must be a positive integer"),
     (dict(sweep={"colour": "red"}), "sweep.colour: unknown key"),
     (dict(config={"num_ants": 4}), "config.num_ants: unknown config of rfd_star"),
     (dict(config={"num_agents": 0}), r"\[config\]: num_agents must be at least 1"),
@@ -124,6 +125,7 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     metadata = json.loads((out / "metadata.json").read_text())
     assert metadata["spec"]["params"]["p_base"] == [5.0, 20.0]
     assert metadata["jax"] == jax.__version__ and metadata["seeds"] == [0, 1, 2]
+    assert metadata["vmap_size"] == spec.vmap_size == 8
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
 
 
@@ -137,6 +139,20 @@ def test_same_spec_resumes_without_recomputing_and_other_spec_is_refused(finishe
     pd.testing.assert_frame_equal(again, frame)
     with pytest.raises(StoreMismatchError, match="differs in: seeds"):
         run_sweep(spec_from_dict(tiny(sweep={"seeds": 4})), out, progress=False)
+
+
+def test_the_vmap_size_changes_no_row_and_a_store_resumes_with_another(finished, tmp_path):
+    spec, out, frame = finished
+    # Chunks of 5 runs in groups of 2: two full groups and a remainder of one per chunk.
+    grouped = spec_from_dict(tiny(sweep={"vmap_size": 2}))
+    messages = []
+    rows = run_sweep(grouped, tmp_path / "grouped", progress=False, log=messages.append)
+    assert any("2 at a time" in message for message in messages)
+    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
+    pd.testing.assert_frame_equal(rows[columns], frame[columns])
+    messages = []
+    run_sweep(grouped, out, progress=False, log=messages.append)
+    assert messages == [f"resuming {out}: 6 of 6 chunks already finished"]
 
 
 def test_plots_are_written_next_to_the_results(finished):

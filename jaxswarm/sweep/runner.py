@@ -2,10 +2,14 @@
 
 Per map, the runs are ordered combination-major (run ``r`` = combination ``r // S``, seed
 ``seeds[r % S]``) and cut into chunks of ``chunk_size``. A chunk is one call of a compiled
-``vmap`` of :func:`jaxswarm.swarm.run` over keys and stacked params; its batch axis is sharded
-over ``jax.devices()`` (the chunk is padded to a multiple of the device count; padding rows are
-dropped). Maps of the same shape share the compiled program; each compile is logged. A run with
-seed ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``.
+program: its runs are shared out over ``jax.devices()`` (``shard_map``; the chunk is padded to
+a multiple of the device count, and padding rows are dropped), and each device goes through its
+share ``vmap_size`` runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` over keys and
+stacked params inside ``lax.map``. Small groups keep each run's buffers in the CPU's caches: on
+2 cores, groups of 8 ran a chunk of 64 in about 0.7x the time of one ``vmap`` over all 64.
+Maps of the same shape share the compiled program; each compile is logged. A run with seed
+``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
+whatever the chunk size, the group size and the number of devices.
 
 Each map's optimum comes from the batched distance field, so every row carries its optimality
 gap. Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec
@@ -25,7 +29,7 @@ from typing import Callable
 import jax
 import numpy as np
 import pandas as pd
-from jax.sharding import Mesh, NamedSharding, PartitionSpec
+from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
 from jaxswarm.exact.field import optimum
@@ -36,6 +40,9 @@ from jaxswarm.sweep.store import ResultsStore, read_results
 
 SUCCESS_GAP = 1e-4
 """A run succeeds when its relative gap to the optimum is below this."""
+
+RUNS_AXIS = "runs"
+"""The mesh axis a chunk's runs are sharded over."""
 
 
 def default_out(spec: SweepSpec) -> Path:
@@ -73,11 +80,11 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     num_runs = spec.num_runs
     params = _stacked_params(swarm.default_params, grid, len(seeds))
     devices = jax.devices()
-    mesh = Mesh(np.asarray(devices), ("runs",))
-    batch_sharding = NamedSharding(mesh, PartitionSpec("runs"))
-    replicated = NamedSharding(mesh, PartitionSpec())
+    mesh = Mesh(np.asarray(devices), (RUNS_AXIS,))
+    batch_sharding = NamedSharding(mesh, P(RUNS_AXIS))
+    replicated = NamedSharding(mesh, P())
     padded = -(-spec.chunk_size // len(devices)) * len(devices)
-    batch = jax.jit(jax.vmap(_one_run(swarm, spec), in_axes=(0, 0, None, None)))
+    batch = _chunk_program(swarm, spec, mesh)
     compiled = {}
 
     per_map = math.ceil(num_runs / spec.chunk_size)
@@ -101,7 +108,8 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
                 compiled[program] = batch.lower(*example, graph, task).compile()
                 log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
-                    f"per chunk on {len(devices)} device(s) in {time.perf_counter() - began:.1f} s")
+                    f"per chunk on {len(devices)} device(s), {spec.vmap_size} at a time, in "
+                    f"{time.perf_counter() - began:.1f} s")
             for c in todo:
                 first = c * spec.chunk_size
                 count = _chunk_runs(c, spec.chunk_size, num_runs)
@@ -125,12 +133,23 @@ def _program_key(graph) -> tuple:
     return treedef, tuple(leaf.shape for leaf in leaves)
 
 
-def _one_run(swarm, spec: SweepSpec):
-    def one(seed, params, graph, task):
+def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh):
+    """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], graph, task) -> (cost
+    f32[C], iterations i32[C])``, C a multiple of the mesh size, the runs sharded over the
+    mesh's ``RUNS_AXIS``; each device maps over its runs ``spec.vmap_size`` at a time."""
+    def one(run_input, graph, task):
+        seed, params = run_input
         state, trace = run(swarm, jax.random.key(seed), graph, task, params,
                            iterations=spec.iterations, patience=spec.patience)
         return swarm.best(state).cost, trace.iterations
-    return one
+
+    def share(seeds, params, graph, task):
+        return jax.lax.map(lambda run_input: one(run_input, graph, task), (seeds, params),
+                           batch_size=min(spec.vmap_size, seeds.shape[0]))
+
+    return jax.jit(jax.shard_map(share, mesh=mesh,
+                                 in_specs=(P(RUNS_AXIS), P(RUNS_AXIS), P(), P()),
+                                 out_specs=P(RUNS_AXIS), check_vma=False))
 
 
 def _stacked_params(defaults, grid: list[dict], num_seeds: int):
@@ -192,6 +211,7 @@ def _metadata(spec: SweepSpec, maps: list[SweepMap]) -> dict:
         numpy=np.__version__, python=platform.python_version(), machine=platform.machine(),
         devices=[str(d) for d in jax.devices()], git_commit=_git_commit(),
         algorithm=spec.algorithm, config=spec.config, seeds=list(spec.seeds),
+        vmap_size=spec.vmap_size,
         maps=[dict(label=m.label, start=m.start, goal=m.goal,
                    size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])
 

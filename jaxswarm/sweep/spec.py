@@ -13,6 +13,7 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
     iterations = 100
     patience = 30                       # optional: stop a run 30 iterations after its last gain
     chunk_size = 64                     # optional: runs per compiled batch (bounds memory)
+    vmap_size = 8                       # optional: runs vmapped together on a device
 
     [config]                            # static: sizes and switches of the swarm factory
     num_agents = 64
@@ -47,8 +48,10 @@ from jaxswarm.swarm import core as swarm_core
 from jaxswarm.sweep.maps import check_map_entry
 
 SECTIONS = {"sweep", "config", "params"}
-SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size"}
+SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size",
+              "vmap_size"}
 DEFAULT_CHUNK_SIZE = 64
+DEFAULT_VMAP_SIZE = 8
 
 
 class SpecError(ValueError):
@@ -67,7 +70,11 @@ class SweepSpec:
       iterations: iteration budget of each run.
       patience: stop after this many iterations without improvement since the first path
         (None = never; see :func:`jaxswarm.swarm.run`).
-      chunk_size: runs per compiled batch.
+      chunk_size: runs per compiled batch (a chunk is also the unit the store writes and a
+        resumed sweep skips).
+      vmap_size: runs vmapped together on one device; a device goes through its share of a
+        chunk that many at a time (on CPU, small groups keep each run's buffers in cache; on
+        GPUs raise it towards the chunk's share per device). It changes speed, never results.
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).
       source: the file it came from (or "<dict>").
@@ -83,6 +90,7 @@ class SweepSpec:
     config: dict
     params: dict
     source: str = "<dict>"
+    vmap_size: int = DEFAULT_VMAP_SIZE
 
     def grid(self) -> list[dict[str, float]]:
         """Every combination of the swept params, in a fixed order (the last param varies
@@ -96,7 +104,9 @@ class SweepSpec:
         return len(self.grid()) * len(self.seeds)
 
     def as_dict(self) -> dict:
-        """JSON-ready form (the store's metadata and its resume check)."""
+        """JSON-ready form of what decides the rows (the store's metadata and its resume
+        check); ``vmap_size``, which changes only the speed, is left out, so a sweep may be
+        resumed with another."""
         return dict(name=self.name, algorithm=self.algorithm, maps=list(self.maps),
                     seeds=list(self.seeds), iterations=self.iterations, patience=self.patience,
                     chunk_size=self.chunk_size, config=dict(self.config),
@@ -165,6 +175,7 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         patience = _positive_int(patience, "sweep.patience", fail)
     chunk_size = _positive_int(sweep.get("chunk_size", DEFAULT_CHUNK_SIZE), "sweep.chunk_size",
                                fail)
+    vmap_size = _positive_int(sweep.get("vmap_size", DEFAULT_VMAP_SIZE), "sweep.vmap_size", fail)
 
     config = document.get("config", {})
     if not isinstance(config, dict):
@@ -193,7 +204,7 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         checked[key] = _values(value, f"params.{key}", fail)
     spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds,
                      iterations=iterations, patience=patience, chunk_size=chunk_size,
-                     config=dict(config), params=checked, source=source)
+                     vmap_size=vmap_size, config=dict(config), params=checked, source=source)
     for combination in spec.grid():  # out-of-range values fail here, before any compute
         try:
             swarm.check_params(swarm.default_params._replace(
