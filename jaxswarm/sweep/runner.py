@@ -6,7 +6,7 @@ program: its runs are shared out over ``jax.devices()`` (``shard_map``; the chun
 a multiple of the device count, and padding rows are dropped), and each device goes through its
 share ``vmap_size`` runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` over keys and
 stacked params inside ``lax.map``. Small groups keep each run's buffers in the CPU's caches: on
-2 cores, groups of 8 ran a chunk of 64 in about 0.7x the time of one ``vmap`` over all 64.
+2 cores, groups of 8 ran chunks of 64 in 0.6-0.9x the time of one ``vmap`` over all 64.
 Maps of the same shape share the compiled program; each compile is logged. A run with seed
 ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
 whatever the chunk size, the group size and the number of devices.
