@@ -23,6 +23,9 @@ from jaxswarm.sweep.plots import plot_sweep, summary
 
 REPO = Path(__file__).resolve().parents[1]
 
+OUTCOME_COLUMNS = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
+"""What a run decides, without its timing: equal wherever and however the runs are batched."""
+
 
 def tiny(**changes):
     """A small spec document: 2 x 2 params x 3 seeds on one paper map and one random map."""
@@ -148,8 +151,7 @@ def test_the_vmap_size_changes_no_row_and_a_store_resumes_with_another(finished,
     messages = []
     rows = run_sweep(grouped, tmp_path / "grouped", progress=False, log=messages.append)
     assert any("2 at a time" in message for message in messages)
-    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
-    pd.testing.assert_frame_equal(rows[columns], frame[columns])
+    pd.testing.assert_frame_equal(rows[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
     messages = []
     run_sweep(grouped, out, progress=False, log=messages.append)
     assert messages == [f"resuming {out}: 6 of 6 chunks already finished"]
@@ -241,8 +243,7 @@ def test_sharding_over_four_cpu_devices_gives_identical_rows(finished, tmp_path)
     assert done.returncode == 0, done.stderr
     assert "devices 4" in done.stdout and "on 4 device(s)" in done.stdout
     sharded = read_results(out)
-    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
-    pd.testing.assert_frame_equal(sharded[columns], frame[columns])
+    pd.testing.assert_frame_equal(sharded[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
 
 
 @pytest.mark.slow
@@ -294,5 +295,4 @@ def test_two_processes_with_jax_distributed_give_identical_rows(finished, tmp_pa
     outputs = [p.communicate(timeout=600) for p in processes]
     assert all(p.returncode == 0 for p in processes), outputs
     assert all("processes 2 devices 4" in stdout for stdout, _ in outputs)
-    columns = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
-    pd.testing.assert_frame_equal(read_results(out)[columns], frame[columns])
+    pd.testing.assert_frame_equal(read_results(out)[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
