@@ -1,11 +1,11 @@
-"""Time of the two relaxations to a fixpoint: the batched distance field and RFD*'s settling.
+"""Time of the two relaxations to a fixpoint: the batched distance field and rfd_graded's settling.
 
 Both run Jacobi sweeps over each node's cheapest neighbour (:func:`jaxswarm.graph.relax`):
 
 * ``distance_field``: the distance from every node to the goal of each paper map (``--maps``),
   the optimum each sweep row carries;
-* ``settle``: RFD*'s sediment settling on one realistic iteration of maze100: the altitudes
-  after ``--iterations`` iterations of RFD* (seed 1), plus the sediment the drops of one more
+* ``settle``: rfd_graded's sediment settling on one realistic iteration of maze100: the altitudes
+  after ``--iterations`` iterations of rfd_graded (seed 1), plus the sediment the drops of one more
   walk leave where they did not arrive, settled until no filled node is a pit.
 
 Each is jitted, called once to compile, then timed ``--repeats`` times; the median is printed.
@@ -46,15 +46,15 @@ def median_ms(function, *args, repeats: int) -> float:
 
 
 def settling_input(iterations: int):
-    """maze100's graph, RFD*'s params and the altitudes one iteration settles (f32[N])."""
+    """maze100's graph, rfd_graded's params and the altitudes one iteration settles (f32[N])."""
     chosen = paper_map("maze100")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("rfd_star")
+    swarm = make("rfd_graded")
     params = swarm.default_params
     state, _ = jax.jit(lambda key: run(swarm, key, graph, task, params,
                                        iterations=iterations))(jax.random.key(1))
-    table = rfd.transition_rule(swarm.config, graph, task, state.altitude, params)
+    table = rfd.graded_transition(graph, task, state.altitude, params)
     drops = walk(jax.random.key(5), graph, table, task.start, task.goal,
                  num_agents=swarm.config.num_agents,
                  max_steps=step_budget(graph, swarm.config.max_steps),
@@ -70,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
                         default="maze50,maze100,mosaic100,alley100",
                         help="comma-separated paper maps for the distance field, or all")
     parser.add_argument("--iterations", type=int, default=40,
-                        help="RFD* iterations before the settled one")
+                        help="rfd_graded iterations before the settled one")
     parser.add_argument("--repeats", type=int, default=30)
     args = parser.parse_args(argv)
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | python "

@@ -1,6 +1,6 @@
 """Throughput and memory of the batched sweep runner beside the same runs done one at a time.
 
-An RFD* sweep of ``p_base`` x ``alpha`` (``--values`` x ``--values`` values: ``p_base``
+An rfd_graded sweep of ``p_base`` x ``alpha`` (``--values`` x ``--values`` values: ``p_base``
 geometric from 2 to 200, ``alpha`` linear from 1 to 20) x ``--seeds`` seeds on ``--map``
 (default mosaic50, 8 x 8 x 20 = 1,280 runs of 100 iterations with 64 agents) is run by
 :func:`jaxswarm.sweep.run_sweep` into a fresh temporary store, then the same runs are done one at
@@ -59,7 +59,7 @@ def machine() -> str:
 
 
 def sweep_document(args) -> dict:
-    return {"sweep": {"name": "bench", "algorithm": "rfd_star", "maps": [args.map],
+    return {"sweep": {"name": "bench", "algorithm": "rfd_graded", "maps": [args.map],
                       "seeds": args.seeds, "iterations": args.iterations,
                       "chunk_size": args.chunk_size, "vmap_size": args.vmap_size},
             "config": {"num_agents": args.agents},
@@ -158,7 +158,7 @@ def main(argv: list[str] | None = None) -> int:
     combinations = len(spec.grid())
 
     print(f"machine: {machine()}")
-    print(f"RFD* on {args.map}: p_base x alpha = {args.values} x {args.values} values x "
+    print(f"rfd_graded on {args.map}: p_base x alpha = {args.values} x {args.values} values x "
           f"{args.seeds} seeds = {total} runs, {args.iterations} iterations, {args.agents} agents, "
           f"chunks of {args.chunk_size}, vmapped {args.vmap_size} at a time")
     print("sweep: one timed run_sweep into a fresh store (single run, not repeated: too long)",

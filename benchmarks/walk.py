@@ -1,7 +1,8 @@
-"""Throughput and memory of the lockstep walker with the RFD* and ant transition rules, on maze100.
+"""Throughput and memory of the lockstep walker with the rfd_graded and ACO* transition rules, on
+maze100.
 
-For each swarm (``--swarms``, default RFD* and ACO*) and each total agent count (agents x seeds:
-64 = 64 x 1, 1,024 = 256 x 4, 16,384 = 256 x 64 by default) one walk per seed is run under
+For each swarm (``--swarms``, default rfd_graded and ACO*) and each total agent count (agents x
+seeds: 64 = 64 x 1, 1,024 = 256 x 4, 16,384 = 256 x 64 by default) one walk per seed is run under
 ``vmap`` from the swarm's initial memory (flat altitudes, uniform pheromone), jitted, after one
 warm-up call (compile excluded). Printed per configuration, as the median over ``--repeats``
 runs:
@@ -22,6 +23,7 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import platform
 import resource
@@ -44,7 +46,11 @@ def machine() -> str:
             f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()})")
 
 
-TRANSITION_RULES = {"rfd_star": rfd.transition_rule, "aco_star": aco.transition_rule}
+TRANSITION_RULES = {
+    "rfd_graded": rfd.graded_transition,
+    "aco_star": functools.partial(aco.transition_rule, goal_distance=True),
+}
+"""The walks measured: each swarm's transition table of its memory."""
 
 
 def make_walks(swarm_name: str, map_name: str, drops: int, seeds: int):
@@ -59,8 +65,8 @@ def make_walks(swarm_name: str, map_name: str, drops: int, seeds: int):
 
     def one(key):
         state = swarm.init(key, graph, task, params)
-        memory = state.altitude if swarm_name == "rfd_star" else state.pheromone
-        table = rule(swarm.config, graph, task, memory, params)
+        memory = state.altitude if swarm_name == "rfd_graded" else state.pheromone
+        table = rule(graph, task, memory, params)
         return walk(key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps)
 
     walks = jax.jit(jax.vmap(one))
@@ -95,7 +101,7 @@ def measure(swarm_name: str, map_name: str, drops: int, seeds: int, repeats: int
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default="maze100")
-    parser.add_argument("--swarms", default="rfd_star,aco_star",
+    parser.add_argument("--swarms", default="rfd_graded,aco_star",
                         help=f"comma-separated, from {', '.join(TRANSITION_RULES)}")
     parser.add_argument("--layouts", default="64x1,256x4,256x64",
                         help="comma-separated DROPSxSEEDS")

@@ -23,14 +23,19 @@ from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map, paper_map_names
 from jaxswarm.paths import as_node
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import make, make_task, registry, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
-SWARM_PLANNERS = {"RFD*": "rfd_star", "Ant System": "ant_system", "ACO*": "aco_star",
-                  "Max-Min ACO": "max_min_aco", "Improved Max-Min ACO": "improved_max_min_aco"}
 OWN_POPULATION = {"improved_max_min_aco"}
 """Swarms that keep their own agent count (the Max-Min ACO paper's populations of 50 ants)
 instead of ``--drops``."""
+
+
+def swarm_label(name: str) -> str:
+    """A registered swarm's name in tables: its label and whether it is a paper's algorithm as
+    written ("paper") or this project's own ("ours")."""
+    entry = registry.entry(name)
+    return f"{entry.label} ({'paper' if entry.faithful else 'ours'})"
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -112,7 +117,8 @@ def run_demo(args: argparse.Namespace) -> int:
         solution = solutions[label] = runs[0]
         milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
         rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
-    for label, name_in_registry in SWARM_PLANNERS.items():
+    for name_in_registry in registry.REGISTRY:
+        label = swarm_label(name_in_registry)
         config = {} if name_in_registry in OWN_POPULATION else dict(num_agents=args.drops)
         swarm = make(name_in_registry, **config)
         state, trace, milliseconds = _run_swarm(swarm, graph, start, goal, args)
@@ -125,6 +131,8 @@ def run_demo(args: argparse.Namespace) -> int:
                   for label, cost, *rest in rows]))
     field = float(optimum(graph, as_node(graph, start), as_node(graph, goal)))
     print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
+    print("(paper): the paper's algorithm as written; (ours): jaxswarm's own algorithm; "
+          "no path: no agent reached the goal within the iterations")
     fig = plot_solutions(graph, solutions, start=start, goal=goal, path=args.out,
                          title=f"{name}: exact and swarm planners")
     plt.close(fig)

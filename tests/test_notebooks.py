@@ -112,7 +112,7 @@ def test_quickstart(notebook_env):
     assert math.isfinite(optimum) and optimum > 0
     for name, cost in exact.items():
         assert cost == pytest.approx(optimum, rel=1e-9), f"{name} disagrees with Dijkstra"
-    assert len(result["swarms"]) == 3
+    assert len(result["swarms"]) == 4
     for name, cost in result["swarms"].items():
         assert cost >= optimum * (1 - 1e-5), f"{name} beats the optimum"
     assert result["reproducible"] is True

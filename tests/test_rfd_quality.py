@@ -1,4 +1,6 @@
-"""RFD* against the Dijkstra optimum on the paper maps (fixed seeds: deterministic)."""
+"""rfd_graded (ours) against the Dijkstra optimum on the paper maps (fixed seeds: deterministic).
+
+Only our own algorithm has a quality bar; the papers' are reported by the sweeps, not tuned."""
 import jax
 import numpy as np
 import pytest
@@ -16,7 +18,7 @@ def successes(name: str) -> int:
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
     optimum = dijkstra(graph, chosen.start, chosen.goal).cost
-    swarm = make("rfd_star")
+    swarm = make("rfd_graded")
     keys = jax.random.split(jax.random.key(0), SEEDS)
     states, _ = jax.jit(jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
                                                iterations=100)))(keys)
@@ -26,11 +28,11 @@ def successes(name: str) -> int:
 
 
 @pytest.mark.parametrize("name", [n for n in PAPER_MAPS if n.endswith("20")])
-def test_rfd_star_reaches_the_optimum_on_20x20_maps(name):
+def test_rfd_graded_reaches_the_optimum_on_20x20_maps(name):
     assert successes(name) >= NEEDED
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", [n for n in PAPER_MAPS if not n.endswith("20")])
-def test_rfd_star_reaches_the_optimum_on_larger_maps(name):
+def test_rfd_graded_reaches_the_optimum_on_larger_maps(name):
     assert successes(name) >= NEEDED

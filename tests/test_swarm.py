@@ -45,11 +45,6 @@ def key_data(state):
         state)
 
 
-def test_registry_lists_and_builds_swarms():
-    assert {"rfd", "rfd_star"} <= set(swarms.registered())
-    assert make("rfd_star", **SMALL) is make("rfd_star", **SMALL)  # cached: compiled code shared
-    with pytest.raises(ValueError, match="unknown swarm 'bees'; registered: .*rfd_star"):
-        make("bees")
 
 
 @pytest.mark.parametrize("name", swarms.registered())
@@ -189,7 +184,7 @@ def test_exponential_erosion_also_erodes_flat_ground(corridor):
 
 def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corridor):
     graph, task = corridor
-    swarm = make("rfd_star", num_agents=8)
+    swarm = make("rfd_graded", num_agents=8)
     altitude = one_iteration(swarm, graph, task, erosion=0.5, initial_height=100.0)
     np.testing.assert_allclose(altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
     # A higher slope cuts less deep, and the bed never rises: min(old, new) per node.
@@ -206,7 +201,7 @@ def test_graded_carving_drains_into_a_river_without_arriving():
     # node 3 without reaching the goal and carve 0-2 to slope x (walked to 3 + depth of 3).
     graph = grid_graph(np.zeros((1, 6), bool))
     task = make_task(graph, (0, 0), (5, 0))
-    swarm = make("rfd_star", num_agents=4, max_steps=3)
+    swarm = make("rfd_graded", num_agents=4, max_steps=3)
     params = swarm.default_params._replace(erosion=jnp.float32(0.5))
     plateau = float(params.initial_height)
     state = swarm.init(jax.random.key(0), graph, task, params)
@@ -233,9 +228,9 @@ def fake_walk(graph, cells, stuck=True):
 
 def filled_cells(graph, task, walk_):
     from jaxswarm.swarm import rfd
-    swarm = make("rfd_star", num_agents=1)
+    swarm = make("rfd_graded", num_agents=1)
     altitude = swarm.init(jax.random.key(0), graph, task, swarm.default_params).altitude
-    table = rfd.transition_rule(swarm.config, graph, task, altitude, swarm.default_params)
+    table = rfd.graded_transition(graph, task, altitude, swarm.default_params)
     filled = np.flatnonzero(np.asarray(rfd.blind_alleys(graph, table, walk_)))
     return sorted((int(v) % graph.shape[1], int(v) // graph.shape[1]) for v in filled)
 
@@ -263,11 +258,10 @@ def test_graded_gradients_between_bed_and_plateau_are_clipped():
     from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((2, 3), bool))  # nodes 0 1 2 / 3 4 5, goal 2
     task = make_task(graph, (0, 0), (2, 0))
-    swarm = make("rfd_star", num_agents=4)
-    params = swarm.default_params
+    params = make("rfd_graded").default_params
     plateau = float(params.initial_height)
     altitude = jnp.array([2.0, 1.0, 0.0, plateau, plateau + 5, plateau], jnp.float32)
-    table = np.asarray(rfd.transition_rule(swarm.config, graph, task, altitude, params))
+    table = np.asarray(rfd.graded_transition(graph, task, altitude, params))
     nbr = np.asarray(graph.nbr)
     log_p, alpha = math.log(float(params.p_base)), float(params.alpha)
 
@@ -294,7 +288,7 @@ def test_settling_leaves_no_filled_pit():
     obstacles[1, 6] = False  # (6, 1) is free but walled in on the east
     obstacles[[0, 2], :] = True
     graph = grid_graph(obstacles)  # a corridor (0, 1)..(5, 1), and (6, 1) joined to (5, 1)
-    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+    params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
     altitude = jnp.full((graph.num_nodes,), 100.0)
     row = 7  # node of (x, 1) is 7 + x
@@ -317,7 +311,7 @@ def test_sediment_settles_all_the_way_in_one_call():
     # settles to a slope of repose down to there, which takes about 200 sweeps.
     from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((1, 200), bool))
-    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+    params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
     altitude = jnp.full((200,), 101.0).at[199].set(100.0)
     settled = np.asarray(rfd.settle(graph, altitude, params))
@@ -328,7 +322,7 @@ def test_sediment_settles_all_the_way_in_one_call():
 def test_a_drop_erodes_the_banks_it_visits():
     from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((1, 5), bool))
-    params = make("rfd_star").default_params._replace(initial_height=jnp.float32(100.0),
+    params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        erosion=jnp.float32(1.0))
     altitude = jnp.array([100.0, 7.0, 9.0, 0.5, 0.0])
     visited = jnp.array([True, True, True, False, False])
@@ -343,7 +337,7 @@ def test_ground_explored_in_vain_rises_towards_the_frontier():
     # settles so that it slopes down to the unexplored (3, 0).
     graph = grid_graph(np.zeros((1, 6), bool))
     task = make_task(graph, (0, 0), (5, 0))
-    swarm = make("rfd_star", num_agents=4, max_steps=2)
+    swarm = make("rfd_graded", num_agents=4, max_steps=2)
     params = swarm.default_params._replace(initial_height=jnp.float32(100.0),
                                            sediment=jnp.float32(0.5), repose=jnp.float32(0.25))
     state = swarm.init(jax.random.key(0), graph, task, params)
@@ -358,7 +352,7 @@ def test_with_exact_altitudes_the_greedy_drop_walks_a_shortest_path():
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
     optimum = dijkstra(graph, chosen.start, chosen.goal).cost
-    swarm = make("rfd_star", num_agents=4, greedy_drops=1)
+    swarm = make("rfd_graded", num_agents=4, greedy_drops=1)
     params = swarm.default_params
     field = distance_field(graph, task.goal) * params.erosion
     state = swarm.init(jax.random.key(0), graph, task, params)
@@ -375,12 +369,15 @@ def test_greedy_drops_are_checked():
         make("rfd_star", greedy_drops=-1)
 
 
-def test_erosion_law_is_checked():
+def test_rfd_star_options_are_checked():
     with pytest.raises(ValueError, match="unknown erosion_law 'sideways'; choose one of linear"):
         make("rfd_star", erosion_law="sideways")
-    from jaxswarm.swarm.rfd import RFDConfig
-    with pytest.raises(ValueError, match="erosion_law 'graded' needs the modified RFD"):
-        RFDConfig(modified=False, erosion_law="graded")
+    with pytest.raises(ValueError, match="unknown erosion_law 'graded'"):  # that is rfd_graded
+        make("rfd_star", erosion_law="graded")
+    with pytest.raises(ValueError, match="max_climb must be non-negative"):
+        make("rfd_star", max_climb=-1.0)
+    with pytest.raises(ValueError, match="unknown option 'climb' of rfd_star; known: num_agents"):
+        make("rfd_star", climb=0.3)
 
 
 def test_unreachable_goal_is_a_clean_not_found_result():
@@ -474,7 +471,7 @@ def test_patience_counts_iterations_without_gain_since_the_first_path(first_path
 ])
 def test_bad_params_are_named(maze, field, value, message):
     graph, task, _ = maze
-    swarm = make("rfd_star", **SMALL)
+    swarm = make("rfd_graded", **SMALL)
     params = swarm.default_params._replace(**{field: jnp.float32(value)})
     with pytest.raises(ValueError, match=message):
         run(swarm, jax.random.key(0), graph, task, params, iterations=2)
@@ -514,7 +511,7 @@ SPREAD = textwrap.dedent("""
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
     keys = jax.random.split(jax.random.key(3), 2)
-    for name, agents in (("rfd_star", 64), ("improved_max_min_aco", 50)):
+    for name, agents in (("rfd_graded", 64), ("improved_max_min_aco", 50)):
         one, two = (make(name, num_agents=agents, devices=d) for d in (1, 2))
         alone = [run(one, key, graph, task, one.default_params, iterations=25) for key in keys]
         spread = [run(two, key, graph, task, two.default_params, iterations=25) for key in keys]
@@ -534,5 +531,5 @@ def test_spreading_the_agents_over_two_cpu_devices_changes_no_result():
                           capture_output=True, text=True, timeout=600, cwd=tests.parent,
                           env=dict(os.environ, JAX_PLATFORMS="cpu"))
     assert done.returncode == 0, done.stderr
-    assert done.stdout.split("\n")[:2] == ["rfd_star identical on 2 devices",
+    assert done.stdout.split("\n")[:2] == ["rfd_graded identical on 2 devices",
                                            "improved_max_min_aco identical on 2 devices"]

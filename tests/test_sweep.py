@@ -1,5 +1,6 @@
 """The sweep runner: specs, results store, resume after a kill, sharding, plots."""
 import json
+import shutil
 import os
 import signal
 import subprocess
@@ -16,7 +17,7 @@ import pytest
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
 from jaxswarm.sweep.plots import plot_sweep, summary
@@ -51,15 +52,15 @@ def finished(tmp_path_factory):
 def test_spec_grid_ranges_and_seeds():
     spec = spec_from_dict(tiny(params={"erosion": {"start": 0.5, "stop": 50, "num": 3,
                                                    "log": True},
-                                       "climb": {"start": 0.5, "stop": 2.0, "step": 0.5}}))
+                                       "sediment": {"start": 0.5, "stop": 2.0, "step": 0.5}}))
     assert spec.params["alpha"] == (2.0, 8.0)
     np.testing.assert_allclose(spec.params["erosion"], [0.5, 5.0, 50.0])
-    assert spec.params["climb"] == (0.5, 1.0, 1.5)
+    assert spec.params["sediment"] == (0.5, 1.0, 1.5)
     assert spec.seeds == (0, 1, 2)
     grid = spec.grid()
     assert len(grid) == 2 * 2 * 3 * 3 and spec.num_runs == len(grid) * 3
-    assert grid[0] == dict(p_base=5.0, alpha=2.0, erosion=0.5, climb=0.5)
-    assert grid[1]["climb"] == 1.0  # the last param varies fastest
+    assert grid[0] == dict(p_base=5.0, alpha=2.0, erosion=0.5, sediment=0.5)
+    assert grid[1]["sediment"] == 1.0  # the last param varies fastest
 
 
 @pytest.mark.parametrize("changes, message", [
@@ -142,6 +143,45 @@ def test_same_spec_resumes_without_recomputing_and_other_spec_is_refused(finishe
     pd.testing.assert_frame_equal(again, frame)
     with pytest.raises(StoreMismatchError, match="differs in: seeds"):
         run_sweep(spec_from_dict(tiny(sweep={"seeds": 4})), out, progress=False)
+
+
+def _rewrite_metadata(out, change):
+    path = out / "metadata.json"
+    metadata = json.loads(path.read_text())
+    change(metadata)
+    path.write_text(json.dumps(metadata))
+
+
+def test_a_store_records_the_swarms_definition_and_refuses_another(finished, tmp_path):
+    spec, out, _ = finished
+    metadata = json.loads((out / "metadata.json").read_text())
+    assert metadata["swarm"] == definition(make("rfd_star", num_agents=8))
+    assert metadata["swarm"]["config"]["erosion_law"] == "linear"
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    # The same name under another definition (here: a default param changed since).
+    _rewrite_metadata(copy, lambda m: m["swarm"]["default_params"].update(alpha=12.0))
+    with pytest.raises(StoreMismatchError, match=r"another definition of 'rfd_star' .*"
+                                                 r"differs in: default_params.alpha"):
+        run_sweep(spec, copy, progress=False)
+
+
+def test_a_store_of_0_1_0s_rfd_star_is_not_resumed(finished, tmp_path):
+    spec, out, _ = finished
+    old = tmp_path / "old"
+    shutil.copytree(out, old)
+
+    def as_written_by_0_1_0(metadata):  # 0.1.0 recorded no definition
+        del metadata["swarm"]
+        metadata["jaxswarm"] = "0.1.0"
+
+    _rewrite_metadata(old, as_written_by_0_1_0)
+    stamps = sorted(p.name for p in (old / "runs").iterdir())
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.1\.0.*'rfd_star' was "
+                                                 r"the graded law, now registered as "
+                                                 r"'rfd_graded'"):
+        run_sweep(spec, old, progress=False)
+    assert sorted(p.name for p in (old / "runs").iterdir()) == stamps  # nothing written
 
 
 def test_the_vmap_size_changes_no_row_and_a_store_resumes_with_another(finished, tmp_path):

@@ -1,24 +1,40 @@
-"""Ant colonies on the lockstep walker: Ant System, ACO* and Max-Min ACO.
+"""Ant colonies on the lockstep walker: Ant System and ACO* (the RFD paper), Max-Min ACO and
+Improved Max-Min ACO (the Max-Min ACO paper).
 
 Pheromone ``tau`` lives on edges (``f32[N, K]``, one value per neighbour slot, kept equal on an
-edge and its reverse). Each iteration all ants walk from the start, choosing the next node ``j``
-with probability proportional to
+edge and its reverse). Each iteration (a population) all ants walk from the start, never
+revisiting a node, choosing the next node ``j`` with probability proportional to
 
-    tau_ij^alpha * eta_ij^beta / d_j^alpha_goal                 (RFD paper eq. 7, general form)
+    tau_ij^alpha * eta_ij^beta / d_j^alpha_goal
 
-with ``eta_ij = 1 / length(i, j)`` and ``d_j`` the straight-line distance from ``j`` to the goal
-(ACO* only; there the goal is taken whenever adjacent). Then
+* ``ant_system`` (RFD paper eqs. 7-9): ``tau_ij`` alone (eq. 7: ``alpha = 1``, ``beta = 0``;
+  ``eta_ij = 1 / length(i, j)`` with ``beta > 0`` is an option). After the walk, evaporation
+  ``tau <- (1 - rho) tau`` (eq. 9) and, for every ant that reached the goal, ``Q / f(S)`` on each
+  edge of its path ``S`` of length ``f(S)`` (eq. 8).
+* ``aco_star`` (the RFD paper's ACO*): Ant System divided by ``d_j ** alpha_goal``, the
+  straight-line distance from ``j`` to the goal "as in the denominator of eq. 6"; it divides by
+  ``d_goal = 0``, so the goal is taken whenever adjacent.
+* ``max_min_aco`` (as the Max-Min ACO paper uses it, after Han et al.): ``eta_ij = 1 /
+  length(i, j)`` weighted evenly with the pheromone (``alpha = beta = 1``); after each
+  population evaporation, a floor ``tau_min`` ("not allowed to decrease below a minimum
+  level"), and ``Q / f`` on the path of the population's best ant. Switches of ours:
+  ``global_best`` (the best path so far deposits instead) and ``upper_bound`` (also cap
+  ``tau`` at ``tau_max``, as in Stuetzle and Hoos's MMAS; off by default).
+* ``improved_max_min_aco`` (the paper's Algorithm 1): ``eta_ij`` is the desirability of the
+  move's direction given the goal's. The paper gives no formula; ours is
+  ``(1 + cos angle) / 2 + DIRECTION_FLOOR``, 1 straight at the goal, falling to the floor
+  straight away from it. Pheromone starts at ``tau0`` (one in the paper). The first ant of the
+  first population walks with heuristic weight ``beta_first`` (5) and a memory of where it has
+  been (:mod:`jaxswarm.swarm.bug2`): its path is the first best path. Every later ant walks with
+  ``alpha = beta = 1``. After each population: evaporation, the floor ``tau_min`` (the paper's
+  ``minpher``), and ``q`` (its ``delta``) added on every edge of the best path so far, which a
+  path as short replaces (the paper's ``<=``). Our walker runs the first ant before the first
+  population of ``num_agents`` ants, so that population has one ant more than the others.
+  Switch: ``first_ant="greedy"`` makes the first ant always take its most likely move (the
+  deterministic depth-first ant of jaxswarm 0.1.0).
 
-* Ant System: evaporation ``tau <- (1 - rho) tau`` (eq. 9) and, for every ant that reached the
-  goal, a deposit ``Q / f(S)`` on each edge of its path ``S`` of length ``f(S)`` (eq. 8);
-* Max-Min ACO: evaporation, a deposit by the best ant only (this iteration's or the best so far,
-  a config switch), and ``tau`` kept within ``[tau_min, tau_max]``;
-* Improved Max-Min ACO (the Max-Min ACO paper): ``eta_ij`` is the desirability of the move's
-  direction given the direction of the goal, ``(1 + cos angle) / 2``; pheromone starts at
-  ``tau0`` (one in the paper); the Bug2-like first ant (:mod:`jaxswarm.swarm.bug2`, the limit of
-  a large heuristic weight) sets the first best path; after each population evaporation is
-  floored at ``tau_min`` (the paper's ``minpher``) and the best path so far gains ``q`` (its
-  ``delta``) on every edge.
+Pheromone updates of the Max-Min colonies follow Algorithm 1's order: evaporate, floor,
+reinforce.
 """
 from __future__ import annotations
 
@@ -31,56 +47,103 @@ import numpy as np
 
 from jaxswarm.graph import Graph, straight_line
 from jaxswarm.paths import Solution, step_slots
-from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best, register
-from jaxswarm.swarm.bug2 import bug2_path, direction_cosine
+from jaxswarm.swarm.bug2 import direction_cosine, first_ant_path
+from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best
 from jaxswarm.swarm.walk import FORCED, edge_table, step_budget, walk
 
 DIRECTION_FLOOR = 1e-3
 """Added to the direction desirability so that a move straight away from the goal stays possible."""
 
+FIRST_ANTS = ("weighted", "greedy")
+"""How Improved Max-Min ACO's first ant chooses among its admissible moves: drawn by its weights
+(the paper), or always the most likely one."""
+
 
 @dataclasses.dataclass(frozen=True)
-class ACOConfig:
-    """Static sizes and switches.
+class AntSystemConfig:
+    """Static sizes of Ant System and ACO*.
 
     Attributes:
       num_agents: ants per iteration.
       max_steps: step budget of one walk; None = N - 1 on general graphs, min(N - 1, 8 (H + W))
         on grids.
-      goal_heuristic: ACO*: divide each weight by ``d_j ** alpha_goal`` (goal taken when adjacent).
-      max_min: Max-Min ACO (best ant deposits, pheromone bounds) instead of Ant System.
-      global_best: Max-Min only: the best path so far deposits instead of this iteration's best.
-      improved: Improved Max-Min ACO (direction heuristic, Bug2-like first ant, floor only).
       devices: spread each walk's ants over this many devices (see
         :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
     """
 
     num_agents: int = 256
     max_steps: int | None = None
-    goal_heuristic: bool = False
-    max_min: bool = False
-    global_best: bool = False
-    improved: bool = False
     devices: int = 1
 
     def __post_init__(self):
         check_sizes(self.num_agents, self.max_steps, self.devices)
-        if self.global_best and not self.max_min:
-            raise ValueError("global_best is a Max-Min ACO switch (max_min=True)")
 
 
-class ACOParams(NamedTuple):
-    """Numbers of the ant colonies (f32 scalars, traced).
+@dataclasses.dataclass(frozen=True)
+class MaxMinConfig:
+    """Static sizes and switches of Max-Min ACO (the defaults are the paper's use of it).
 
     Attributes:
-      rho: evaporation rate in (0, 1].
-      q: Q, the deposit numerator (a path of length f deposits Q / f per edge).
-      alpha: pheromone exponent.
-      beta: exponent of eta = 1 / edge length.
-      alpha_goal: ACO* exponent of the goal distance (unused otherwise).
-      tau0: initial pheromone on every edge.
-      tau_min, tau_max: Max-Min bounds (unused by Ant System).
+      num_agents: ants per population.
+      max_steps: step budget of one walk (as for :class:`AntSystemConfig`).
+      global_best: ours: the best path so far deposits instead of the population's best.
+      upper_bound: ours: also keep ``tau`` at most ``tau_max``.
+      devices: spread each walk's ants over this many devices.
     """
+
+    num_agents: int = 256
+    max_steps: int | None = None
+    global_best: bool = False
+    upper_bound: bool = False
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+
+
+@dataclasses.dataclass(frozen=True)
+class ImprovedConfig:
+    """Static sizes and switches of Improved Max-Min ACO.
+
+    Attributes:
+      num_agents: ants per population (50 in the paper).
+      max_steps: step budget of one walk (as for :class:`AntSystemConfig`).
+      first_ant: one of ``FIRST_ANTS``.
+      devices: spread each walk's ants over this many devices.
+    """
+
+    num_agents: int = 50
+    max_steps: int | None = None
+    first_ant: str = "weighted"
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+        if self.first_ant not in FIRST_ANTS:
+            raise ValueError(f"unknown first_ant {self.first_ant!r}; "
+                             f"choose one of {', '.join(FIRST_ANTS)}")
+
+
+class AntSystemParams(NamedTuple):
+    """Numbers of Ant System (f32 scalars, traced).
+
+    Attributes:
+      rho: evaporation rate in (0, 1] (eq. 9).
+      q: Q, the deposit numerator (eq. 8: a path of length f deposits Q / f per edge).
+      alpha: pheromone exponent (1 in eq. 7).
+      beta: exponent of eta = 1 / edge length (0 in eq. 7).
+      tau0: initial pheromone on every edge.
+    """
+
+    rho: jax.Array
+    q: jax.Array
+    alpha: jax.Array
+    beta: jax.Array
+    tau0: jax.Array
+
+
+class ACOStarParams(NamedTuple):
+    """Numbers of ACO*: Ant System's and ``alpha_goal``, the exponent of the goal distance."""
 
     rho: jax.Array
     q: jax.Array
@@ -88,14 +151,58 @@ class ACOParams(NamedTuple):
     beta: jax.Array
     alpha_goal: jax.Array
     tau0: jax.Array
+
+
+class MaxMinParams(NamedTuple):
+    """Numbers of Max-Min ACO: Ant System's, the floor ``tau_min`` and the cap ``tau_max``
+    (read only with ``upper_bound``)."""
+
+    rho: jax.Array
+    q: jax.Array
+    alpha: jax.Array
+    beta: jax.Array
+    tau0: jax.Array
     tau_min: jax.Array
     tau_max: jax.Array
 
 
-DEFAULT_ACO = ACOParams(*(np.float32(v) for v in (0.1, 1.0, 1.0, 1.0, 50.0, 1.0, 0.01, 10.0)))
-DEFAULT_IMPROVED_ACO = DEFAULT_ACO._replace(q=np.float32(0.1))
-"""Improved Max-Min ACO: delta = rho * tau0, so the best path's pheromone stays at tau0 while
-every other edge decays to the floor (on alley20, 15/20 runs within 5 % against 9/20 with q = 1)."""
+class ImprovedParams(NamedTuple):
+    """Numbers of Improved Max-Min ACO.
+
+    Attributes:
+      rho: evaporation rate in (0, 1].
+      q: delta, added on every edge of the best path after each population.
+      alpha: pheromone exponent of the later ants (1).
+      beta: heuristic exponent of the later ants (1).
+      beta_first: heuristic exponent of the first ant (5, the paper's ``hweight``).
+      tau0: initial pheromone (1).
+      tau_min: the floor (the paper's ``minpher``).
+    """
+
+    rho: jax.Array
+    q: jax.Array
+    alpha: jax.Array
+    beta: jax.Array
+    beta_first: jax.Array
+    tau0: jax.Array
+    tau_min: jax.Array
+
+
+def _f32(params_type, **values):
+    # NumPy scalars: importing the module must not start JAX's backend (jaxswarm.cpu).
+    return params_type(**{name: np.float32(value) for name, value in values.items()})
+
+
+DEFAULT_ANT_SYSTEM = _f32(AntSystemParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, tau0=1.0)
+DEFAULT_ACO_STAR = _f32(ACOStarParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, alpha_goal=50.0,
+                        tau0=1.0)
+DEFAULT_MAX_MIN = _f32(MaxMinParams, rho=0.1, q=1.0, alpha=1.0, beta=1.0, tau0=1.0,
+                       tau_min=0.01, tau_max=10.0)
+DEFAULT_IMPROVED = _f32(ImprovedParams, rho=0.1, q=0.1, alpha=1.0, beta=1.0, beta_first=5.0,
+                        tau0=1.0, tau_min=0.01)
+"""The papers give alpha, beta, beta_first and tau0 (eq. 7; Algorithm 1); the rest are ours.
+Improved: delta = rho * tau0, so the best path's pheromone stays at tau0 while every other edge
+decays to the floor."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -119,23 +226,35 @@ jax.tree_util.register_dataclass(
     ACOState, data_fields=["key", "pheromone", "best_path", "best_cost"], meta_fields=[])
 
 
-def transition_rule(config: ACOConfig, graph: Graph, task: Task, pheromone, params):
-    """f32[N, K] log-weight of every edge (the walker's table): eq. 7 in its general form."""
+def transition_rule(graph: Graph, task: Task, pheromone, params, *, direction: bool = False,
+                    goal_distance: bool = False, beta=None):
+    """f32[N, K] log-weight table ``alpha log tau + beta log eta (- alpha_goal log d_j)``.
+
+    Args:
+      graph, task: the map and the goal.
+      pheromone: f32[N, K] tau.
+      params: the colony's Params (``alpha``, ``beta``; ``alpha_goal`` with ``goal_distance``).
+      direction: eta is the direction desirability (Improved Max-Min) instead of 1 / length.
+      goal_distance: ACO*: divide by ``d_j ** alpha_goal``, the goal forced whenever adjacent.
+      beta: the heuristic exponent, if not ``params.beta`` (the Improved first ant's).
+    """
     heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-    if config.improved:
+    if direction:
         eta = (1.0 + direction_cosine(graph, task.goal)) / 2.0 + DIRECTION_FLOOR
     else:
         eta = 1.0 / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
-    logw = params.alpha * jnp.log(pheromone) + params.beta * jnp.log(eta)
-    if config.goal_heuristic:
+    beta = params.beta if beta is None else beta
+    logw = params.alpha * jnp.log(pheromone) + beta * jnp.log(eta)
+    if goal_distance:
         to_goal = straight_line(graph, task.goal)
         logw = logw - params.alpha_goal * jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))[heads]
         logw = jnp.where(heads == task.goal, FORCED, logw)
     return edge_table(graph, logw)
 
 
-def _deposit(graph: Graph, pheromone, nodes, slots, amount):
-    """Add ``amount[a]`` on every edge (nodes[a, t], slots[a, t]) and on its reverse edge."""
+def deposit(graph: Graph, pheromone, nodes, slots, amount):
+    """f32[N, K] ``pheromone`` with ``amount[a]`` added on every edge (nodes[a, t], slots[a, t])
+    (i32[A, T], -1 slots skipped) and on its reverse edge."""
     moved = slots >= 0
     rows = jnp.where(moved, nodes, 0)
     cols = jnp.maximum(slots, 0).astype(jnp.int32)
@@ -148,51 +267,37 @@ def _deposit(graph: Graph, pheromone, nodes, slots, amount):
                         jnp.maximum(back, 0)].add(value, mode="drop")
 
 
-def _reinforce(graph: Graph, pheromone, path, amount):
-    """Add the scalar ``amount`` on every edge of one padded path, both directions."""
-    return _deposit(graph, pheromone, path[None, :-1], step_slots(graph, path)[None],
-                    amount[None])
+def reinforce(graph: Graph, pheromone, path, amount):
+    """f32[N, K] ``pheromone`` with the scalar ``amount`` added on every edge of one padded path
+    (i32[L]), both directions."""
+    return deposit(graph, pheromone, path[None, :-1], step_slots(graph, path)[None],
+                   amount[None])
 
 
-def _build(config: ACOConfig, name: str) -> Swarm:
+def _colony(name: str, config, *, default_params, update, init_best=None, direction=False,
+            goal_distance=False, ties=False) -> Swarm:
+    """A colony Swarm: walk, keep the best, then ``update(graph, pheromone, ants, best_path,
+    best_cost, info, params) -> pheromone``. ``init_best(key, graph, task, pheromone, params)``
+    gives a first best path (i32[L], cost) before the first population."""
     def init(key, graph: Graph, task: Task, params) -> ACOState:
         length = step_budget(graph, config.max_steps) + 1
         pheromone = jnp.full(graph.nbr.shape, params.tau0, jnp.float32)
-        if not config.improved:
-            return ACOState(key=key, pheromone=pheromone,
-                            best_path=jnp.full((length,), -1, jnp.int32),
-                            best_cost=jnp.float32(jnp.inf))
-        path, cost, found = bug2_path(graph, task.start, task.goal)
-        fits = found & (jnp.sum(path >= 0) <= length)  # a longer first path cannot be stored
-        path = jnp.where(fits, jnp.pad(path, (0, max(length - path.shape[0], 0)),
-                                       constant_values=-1)[:length], -1)
-        pheromone = _reinforce(graph, pheromone, path, jnp.where(fits, params.q, 0.0))
-        return ACOState(key=key, pheromone=pheromone, best_path=path,
-                        best_cost=jnp.where(fits, cost, jnp.inf).astype(jnp.float32))
+        best_path, best_cost = jnp.full((length,), -1, jnp.int32), jnp.float32(jnp.inf)
+        if init_best is not None:
+            key, first_key = jax.random.split(key)
+            best_path, best_cost = init_best(first_key, graph, task, pheromone, params, length)
+        return ACOState(key=key, pheromone=pheromone, best_path=best_path, best_cost=best_cost)
 
     def step(state: ACOState, graph: Graph, task: Task, params):
         key, walk_key = jax.random.split(state.key)
-        table = transition_rule(config, graph, task, state.pheromone, params)
+        table = transition_rule(graph, task, state.pheromone, params, direction=direction,
+                                goal_distance=goal_distance)
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
                     max_steps=step_budget(graph, config.max_steps), devices=config.devices)
-        # The Improved Max-Min ACO keeps the latest of equally short paths (its "<=").
         best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
-                                               ties=config.improved)
-        pheromone = (1.0 - params.rho) * state.pheromone
-        if config.improved:
-            pheromone = _reinforce(graph, jnp.maximum(pheromone, params.tau_min), best_path,
-                                   jnp.where(jnp.isfinite(best_cost), params.q, 0.0))
-        elif not config.max_min:
-            pheromone = _deposit(graph, pheromone, ants.path[:, :-1], ants.slots,
-                                 jnp.where(ants.arrived, params.q / ants.length, 0.0))
-        else:
-            winner = jnp.argmin(jnp.where(ants.arrived, ants.length, jnp.inf))
-            path, cost = ((best_path, best_cost) if config.global_best
-                          else (ants.path[winner], info.iteration_cost))
-            amount = jnp.where(jnp.isfinite(cost), params.q / cost, 0.0)
-            pheromone = jnp.clip(_reinforce(graph, pheromone, path, amount), params.tau_min,
-                                 params.tau_max)
+                                               ties=ties)
+        pheromone = update(graph, state.pheromone, ants, best_path, best_cost, info, params)
         return ACOState(key=key, pheromone=pheromone, best_path=best_path,
                         best_cost=best_cost), info
 
@@ -201,55 +306,75 @@ def _build(config: ACOConfig, name: str) -> Swarm:
                         found=jnp.isfinite(state.best_cost))
 
     return Swarm(name=name, config=config, init=init, step=step, best=best,
-                 default_params=DEFAULT_IMPROVED_ACO if config.improved else DEFAULT_ACO,
-                 check_params=_check,
+                 default_params=default_params, check_params=_check,
                  memory=lambda state: state.pheromone.sum(axis=-1),
                  memory_label="pheromone on a node's edges")
 
 
-@register("ant_system")
-def ant_system(num_agents: int = 256, max_steps: int | None = None, devices: int = 1) -> Swarm:
-    """Ant System (RFD paper eqs. 7-9)."""
-    return _build(ACOConfig(num_agents, max_steps, devices=devices), "ant_system")
+def _ant_system_update(graph, pheromone, ants, best_path, best_cost, info, params):
+    """Eq. 9, then eq. 8 for every ant that arrived."""
+    return deposit(graph, (1.0 - params.rho) * pheromone, ants.path[:, :-1], ants.slots,
+                   jnp.where(ants.arrived, params.q / ants.length, 0.0))
 
 
-@register("aco_star")
-def aco_star(num_agents: int = 256, max_steps: int | None = None, devices: int = 1) -> Swarm:
-    """ACO*: Ant System with the goal-distance heuristic ``1 / d_j ** alpha_goal``."""
-    return _build(ACOConfig(num_agents, max_steps, goal_heuristic=True, devices=devices),
-                  "aco_star")
+def build_ant_system(config: AntSystemConfig) -> Swarm:
+    """Ant System (RFD paper eqs. 7-9), with :class:`AntSystemParams`."""
+    return _colony("ant_system", config, default_params=DEFAULT_ANT_SYSTEM,
+                   update=_ant_system_update)
 
 
-@register("max_min_aco")
-def max_min_aco(num_agents: int = 256, max_steps: int | None = None,
-                global_best: bool = False, devices: int = 1) -> Swarm:
-    """Max-Min ACO: only the iteration-best (or, with ``global_best``, the best-so-far) path
-    deposits, and pheromone stays within [tau_min, tau_max]."""
-    return _build(ACOConfig(num_agents, max_steps, max_min=True, global_best=global_best,
-                            devices=devices), "max_min_aco")
+def build_aco_star(config: AntSystemConfig) -> Swarm:
+    """ACO*: Ant System with the goal-distance heuristic, with :class:`ACOStarParams`."""
+    return _colony("aco_star", config, default_params=DEFAULT_ACO_STAR,
+                   update=_ant_system_update, goal_distance=True)
 
 
-@register("improved_max_min_aco")
-def improved_max_min_aco(num_agents: int = 50, max_steps: int | None = None,
-                         devices: int = 1) -> Swarm:
-    """Improved Max-Min ACO (the Max-Min ACO paper): direction heuristic, Bug2-like first ant,
-    evaporation floored at ``tau_min`` and ``q`` added on the best path after each population
-    of ``num_agents`` ants (50 in the paper)."""
-    return _build(ACOConfig(num_agents, max_steps, improved=True, devices=devices),
-                  "improved_max_min_aco")
+def build_max_min_aco(config: MaxMinConfig) -> Swarm:
+    """Max-Min ACO as the Max-Min ACO paper uses it, with :class:`MaxMinParams`."""
+    def update(graph, pheromone, ants, best_path, best_cost, info, params):
+        if config.global_best:
+            path, cost = best_path, best_cost
+        else:
+            winner = jnp.argmin(jnp.where(ants.arrived, ants.length, jnp.inf))
+            path, cost = ants.path[winner], info.iteration_cost
+        pheromone = jnp.maximum((1.0 - params.rho) * pheromone, params.tau_min)
+        pheromone = reinforce(graph, pheromone, path,
+                              jnp.where(jnp.isfinite(cost), params.q / cost, 0.0))
+        return jnp.minimum(pheromone, params.tau_max) if config.upper_bound else pheromone
+
+    return _colony("max_min_aco", config, default_params=DEFAULT_MAX_MIN, update=update)
 
 
-def _check(params: ACOParams) -> None:
-    check_positive("rho", params.rho)
-    if float(params.rho) > 1:
-        raise ValueError(f"rho must be at most 1, got {float(params.rho)}")
-    check_positive("q", params.q)
-    check_positive("alpha", params.alpha, allow_zero=True)
-    check_positive("beta", params.beta, allow_zero=True)
-    check_positive("alpha_goal", params.alpha_goal, allow_zero=True)
-    check_positive("tau0", params.tau0)
-    check_positive("tau_min", params.tau_min)
-    check_positive("tau_max", params.tau_max)
-    if float(params.tau_min) > float(params.tau_max):
-        raise ValueError(f"tau_min ({float(params.tau_min)}) exceeds tau_max "
-                         f"({float(params.tau_max)})")
+def build_improved_max_min_aco(config: ImprovedConfig) -> Swarm:
+    """Improved Max-Min ACO (the Max-Min ACO paper's Algorithm 1), with :class:`ImprovedParams`."""
+    def init_best(key, graph, task, pheromone, params, length):
+        table = transition_rule(graph, task, pheromone, params, direction=True,
+                                beta=params.beta_first)
+        path, cost, found = first_ant_path(key, graph, table, task.start, task.goal,
+                                           greedy=config.first_ant == "greedy")
+        fits = found & (jnp.sum(path >= 0) <= length)  # a longer first path cannot be stored
+        path = jnp.pad(path, (0, max(length - path.shape[0], 0)), constant_values=-1)[:length]
+        return jnp.where(fits, path, -1), jnp.where(fits, cost, jnp.inf).astype(jnp.float32)
+
+    def update(graph, pheromone, ants, best_path, best_cost, info, params):
+        pheromone = jnp.maximum((1.0 - params.rho) * pheromone, params.tau_min)
+        return reinforce(graph, pheromone, best_path,
+                         jnp.where(jnp.isfinite(best_cost), params.q, 0.0))
+
+    return _colony("improved_max_min_aco", config, default_params=DEFAULT_IMPROVED,
+                   update=update, init_best=init_best, direction=True, ties=True)
+
+
+_RULES = {"rho": "positive", "q": "positive", "alpha": "non-negative", "beta": "non-negative",
+          "beta_first": "non-negative", "alpha_goal": "non-negative", "tau0": "positive",
+          "tau_min": "positive", "tau_max": "positive"}
+
+
+def _check(params) -> None:
+    for name, value in params._asdict().items():
+        check_positive(name, value, allow_zero=_RULES[name] == "non-negative")
+    if np.any(np.asarray(params.rho) > 1):
+        raise ValueError(f"rho must be at most 1, got {params.rho}")
+    if "tau_max" in params._fields and np.any(np.asarray(params.tau_min)
+                                              > np.asarray(params.tau_max)):
+        raise ValueError(f"tau_min ({params.tau_min}) exceeds tau_max ({params.tau_max})")

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import inspect
 from typing import Any, Callable, NamedTuple
 
 import jax
@@ -228,41 +227,3 @@ def check_positive(name: str, value, *, allow_zero: bool = False) -> None:
     if np.any(array < 0) or (not allow_zero and np.any(array == 0)):
         bound = "non-negative" if allow_zero else "positive"
         raise ValueError(f"{name} must be {bound}, got {value!r}")
-
-
-_REGISTRY: dict[str, Callable[..., Swarm]] = {}
-
-
-def register(name: str):
-    """Decorator adding a Swarm factory to the registry under ``name``; the factory is cached, so
-    equal configs return the same Swarm object (and share compiled code)."""
-    def decorate(factory):
-        cached = functools.lru_cache(maxsize=None)(factory)
-        _REGISTRY[name] = cached
-        return cached
-    return decorate
-
-
-def make(name: str, **config) -> Swarm:
-    """The registered swarm ``name`` built with ``config`` (see each factory for its options).
-
-    Raises:
-      ValueError: unknown name (the message lists the registered ones) or bad config.
-    """
-    return _factory(name)(**config)
-
-
-def config_options(name: str) -> tuple[str, ...]:
-    """The keyword options (static config) of the registered swarm ``name``'s factory."""
-    return tuple(inspect.signature(_factory(name)).parameters)
-
-
-def _factory(name: str) -> Callable[..., Swarm]:
-    if name not in _REGISTRY:
-        raise ValueError(f"unknown swarm {name!r}; registered: {', '.join(sorted(_REGISTRY))}")
-    return _REGISTRY[name]
-
-
-def registered() -> tuple[str, ...]:
-    """Names of all registered swarms."""
-    return tuple(sorted(_REGISTRY))

@@ -33,7 +33,7 @@ from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
 from jaxswarm.exact.field import optimum
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep.maps import SweepMap, resolve_map
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
@@ -67,14 +67,15 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
       chunk's wall time divided by its runs, compile excluded), ``chunk``.
 
     Raises:
-      ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec.
+      ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec
+        or another definition of the swarm (:class:`~jaxswarm.sweep.store.StoreMismatchError`).
     """
     out = Path(out) if out is not None else default_out(spec)
     base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
     maps = [resolve_map(entry, base_dir) for entry in spec.maps]
     writer = jax.process_index() == 0
-    store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps), writer=writer)
     swarm = make(spec.algorithm, **spec.config)
+    store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, swarm), writer=writer)
     grid = spec.grid()
     seeds = np.asarray(spec.seeds)
     num_runs = spec.num_runs
@@ -203,14 +204,15 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, c
     return rows
 
 
-def _metadata(spec: SweepSpec, maps: list[SweepMap]) -> dict:
+def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm) -> dict:
     import jaxlib
     return dict(
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
         jaxswarm=_version(), jax=jax.__version__, jaxlib=jaxlib.__version__,
         numpy=np.__version__, python=platform.python_version(), machine=platform.machine(),
         devices=[str(d) for d in jax.devices()], git_commit=_git_commit(),
-        algorithm=spec.algorithm, config=spec.config, seeds=list(spec.seeds),
+        algorithm=spec.algorithm, config=spec.config, swarm=definition(swarm),
+        seeds=list(spec.seeds),
         vmap_size=spec.vmap_size,
         maps=[dict(label=m.label, start=m.start, goal=m.goal,
                    size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])

@@ -44,7 +44,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-from jaxswarm.swarm import core as swarm_core
+from jaxswarm.swarm import registry as swarm_registry
 from jaxswarm.sweep.maps import check_map_entry
 
 SECTIONS = {"sweep", "config", "params"}
@@ -153,9 +153,9 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
             fail(f"sweep.{key}", "missing")
 
     algorithm = sweep["algorithm"]
-    if algorithm not in swarm_core.registered():
+    if algorithm not in swarm_registry.registered():
         fail("sweep.algorithm", f"unknown algorithm {algorithm!r}; registered: "
-             f"{', '.join(swarm_core.registered())}")
+             f"{', '.join(swarm_registry.registered())}")
     name = sweep.get("name", algorithm)
     if not isinstance(name, str) or not name or "/" in name:
         fail("sweep.name", f"must be a non-empty string without '/', got {name!r}")
@@ -180,7 +180,7 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     config = document.get("config", {})
     if not isinstance(config, dict):
         fail("[config]", "must be a table")
-    accepted = swarm_core.config_options(algorithm)
+    accepted = swarm_registry.config_options(algorithm)
     for key in config:
         if key not in accepted:
             fail(f"config.{key}", f"unknown config of {algorithm}; accepted: "
@@ -189,7 +189,7 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         fail("config.devices", "a sweep spreads its runs over the devices itself; leave the "
              "agents of each run on one device (devices = 1)")
     try:
-        swarm = swarm_core.make(algorithm, **config)
+        swarm = swarm_registry.make(algorithm, **config)
     except (TypeError, ValueError) as error:
         fail("[config]", str(error))
 

@@ -2,13 +2,16 @@
 
 Layout of a store directory::
 
-    metadata.json        package and JAX versions, spec, static config, seeds, git commit, maps
+    metadata.json        package and JAX versions, spec, the swarm's definition (its name, every
+                         config field and default param), seeds, git commit, maps
     runs/part-MMM-CCCCC.parquet   one file per finished chunk (map MMM, chunk CCCCC)
 
 A chunk is written to a hidden temporary file in ``runs/`` and moved into place with
 ``os.replace``, so a reader (``pandas.read_parquet(store / "runs")``, which skips hidden files)
 never sees half a chunk, and a killed sweep leaves only whole chunks behind. Reopening a store
-for the same spec finds the finished chunks (resume); a different spec is refused.
+for the same spec and the same swarm definition finds the finished chunks (resume); a different
+spec, or a swarm that has changed under its name (a store of jaxswarm 0.1.0, whose ``rfd_star``
+was the law now called ``rfd_graded``), is refused.
 """
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from jaxswarm.atomic import TEMPORARY_GLOB, atomic_path, write_atomically
 
 
 class StoreMismatchError(ValueError):
-    """The directory holds results of a different sweep spec."""
+    """The directory holds results of a different sweep spec or swarm definition."""
 
 
 class ResultsStore:
@@ -34,10 +37,12 @@ class ResultsStore:
 
         The writer (process 0 of a multi-host sweep; the only process otherwise) removes stale
         temporary files of an interrupted write and writes ``metadata`` (with the spec under
-        ``"spec"``) for a new store; other processes only read it.
+        ``"spec"``) for a new store; other processes only read it. ``metadata["swarm"]`` (see
+        :func:`jaxswarm.swarm.definition`) must equal the stored one for a resume.
 
         Raises:
-          StoreMismatchError: ``root`` already holds results of another spec.
+          StoreMismatchError: ``root`` already holds results of another spec or of another
+            definition of the swarm.
         """
         self.root = Path(root)
         self.runs = self.root / "runs"
@@ -52,12 +57,13 @@ class ResultsStore:
                 write_atomically(self.root / "metadata.json",
                                  json.dumps(dict(metadata, spec=spec), indent=2, default=str))
         elif existing.get("spec") != as_stored:
-            before = existing.get("spec", {})
-            differ = sorted(k for k in set(as_stored) | set(before)
-                            if before.get(k) != as_stored.get(k))
             raise StoreMismatchError(
                 f"{self.root} holds results of a different sweep (differs in: "
-                f"{', '.join(differ)}); choose another --out or delete it")
+                f"{', '.join(_differences(existing.get('spec', {}), as_stored))}); "
+                "choose another --out or delete it")
+        else:
+            _check_definition(self.root, existing, json.loads(json.dumps(
+                metadata["swarm"], default=str)))
 
     def chunk_path(self, map_index: int, chunk_index: int) -> Path:
         """Where chunk ``chunk_index`` of map ``map_index`` lives once finished."""
@@ -79,6 +85,39 @@ class ResultsStore:
         """The store's metadata record, or None if there is none yet."""
         path = Path(root) / "metadata.json"
         return json.loads(path.read_text()) if path.is_file() else None
+
+
+def _differences(before: dict, after: dict) -> list[str]:
+    """The keys whose values differ between two dicts, sorted."""
+    return sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
+
+
+def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
+    """Refuse to resume a store whose swarm was defined otherwise than ``swarm`` today.
+
+    Raises:
+      StoreMismatchError: naming the difference (the config fields and default params that
+        changed, or the jaxswarm version that wrote a store without a recorded definition).
+    """
+    stored = existing.get("swarm")
+    if stored == swarm:
+        return
+    if stored is None:
+        renamed = (" (its 'rfd_star' was the graded law, now registered as 'rfd_graded'; "
+                   "'rfd_star' is now the RFD paper's RFD*)" if swarm["name"] == "rfd_star"
+                   else "")
+        raise StoreMismatchError(
+            f"{root} was written by jaxswarm {existing.get('jaxswarm') or 'before 0.2.0'}, "
+            f"which did not record the definition of {swarm['name']!r}; since 0.2.0 a "
+            f"registered name is the paper's algorithm{renamed}, see CHANGELOG.md; choose "
+            "another --out or delete it")
+    changed = [f"config.{k}" for k in _differences(stored.get("config", {}), swarm["config"])]
+    changed += [f"default_params.{k}" for k in _differences(stored.get("default_params", {}),
+                                                            swarm["default_params"])]
+    raise StoreMismatchError(
+        f"{root} holds results of another definition of {swarm['name']!r} (written by jaxswarm "
+        f"{existing.get('jaxswarm')}; differs in: {', '.join(changed) or 'name'}); choose "
+        "another --out or delete it")
 
 
 def read_results(root) -> pd.DataFrame:

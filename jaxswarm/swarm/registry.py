@@ -1,0 +1,102 @@
+"""The registry of swarms: each name, its static Config and the function that builds it.
+
+A registered name is a paper's algorithm as the paper writes it; an algorithm of this project is
+registered under its own name (``rfd_graded``). ``make(name, **config)`` checks the options by
+building the Config (whose defaults are the only ones), and equal Configs return the same Swarm,
+so they share compiled code.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+from typing import Callable, NamedTuple
+
+import numpy as np
+
+from jaxswarm.swarm import aco
+from jaxswarm.swarm.core import Swarm
+from jaxswarm.swarm.rfd import graded, paper
+
+
+class Entry(NamedTuple):
+    """One registered swarm.
+
+    Attributes:
+      config: its Config class (the options of ``make`` and their defaults).
+      build: ``(config) -> Swarm``.
+      label: its name in tables and figures.
+      source: the paper and equations it implements, or ``"jaxswarm"`` for ours.
+      faithful: the paper's algorithm as written (False: an algorithm of this project).
+    """
+
+    config: type
+    build: Callable[..., Swarm]
+    label: str
+    source: str
+    faithful: bool = True
+
+
+REGISTRY: dict[str, Entry] = {
+    "rfd": Entry(paper.RFDConfig, paper.build_rfd, "RFD", "RFD paper, eqs. 1-5"),
+    "rfd_star": Entry(paper.RFDStarConfig, paper.build_rfd_star, "RFD*",
+                      "RFD paper, eq. 6 with eqs. 4-5"),
+    "rfd_graded": Entry(graded.GradedConfig, graded.build_rfd_graded, "RFD graded",
+                        "jaxswarm: RFD*'s eq. 6 over a graded river bed", faithful=False),
+    "ant_system": Entry(aco.AntSystemConfig, aco.build_ant_system, "Ant System",
+                        "RFD paper, eqs. 7-9"),
+    "aco_star": Entry(aco.AntSystemConfig, aco.build_aco_star, "ACO*",
+                      "RFD paper, ACO*: eq. 7 over the goal distance"),
+    "max_min_aco": Entry(aco.MaxMinConfig, aco.build_max_min_aco, "Max-Min ACO",
+                         "Max-Min ACO paper, section 4"),
+    "improved_max_min_aco": Entry(aco.ImprovedConfig, aco.build_improved_max_min_aco,
+                                  "Improved Max-Min ACO", "Max-Min ACO paper, Algorithm 1"),
+}
+"""Registered name -> :class:`Entry`."""
+
+
+def make(name: str, **config) -> Swarm:
+    """The registered swarm ``name`` built with ``config`` (see its Config class for options).
+
+    Raises:
+      ValueError: unknown name (the message lists the registered ones), unknown option (the
+        message lists the known ones) or a bad value.
+    """
+    options = config_options(name)
+    unknown = sorted(set(config) - set(options))
+    if unknown:
+        raise ValueError(f"unknown option {unknown[0]!r} of {name}; known: {', '.join(options)}")
+    return _build(name, REGISTRY[name].config(**config))
+
+
+@functools.lru_cache(maxsize=None)
+def _build(name: str, config) -> Swarm:
+    return REGISTRY[name].build(config)
+
+
+def config_options(name: str) -> tuple[str, ...]:
+    """The static options (Config fields) of the registered swarm ``name``."""
+    return tuple(field.name for field in dataclasses.fields(entry(name).config))
+
+
+def registered() -> tuple[str, ...]:
+    """Names of all registered swarms."""
+    return tuple(sorted(REGISTRY))
+
+
+def definition(swarm: Swarm) -> dict:
+    """JSON-ready record of what a swarm is: its name, every Config field and every default
+    param (what a results store compares before it resumes)."""
+    return dict(name=swarm.name, config=dataclasses.asdict(swarm.config),
+                default_params={k: float(np.asarray(v))
+                                for k, v in swarm.default_params._asdict().items()})
+
+
+def entry(name: str) -> Entry:
+    """The registry entry of ``name``.
+
+    Raises:
+      ValueError: unknown name (the message lists the registered ones).
+    """
+    if name not in REGISTRY:
+        raise ValueError(f"unknown swarm {name!r}; registered: {', '.join(sorted(REGISTRY))}")
+    return REGISTRY[name]

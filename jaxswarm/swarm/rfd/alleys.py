@@ -1,0 +1,42 @@
+"""Blind alleys: where a stuck drop's sediment goes when it fills the dead end it ran into."""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.graph import Graph
+from jaxswarm.swarm.walk import Walk
+
+
+def blind_alleys(graph: Graph, log_weights, drops: Walk):
+    """bool[N]: the blind alleys the stuck drops of a walk (``drops``, A agents) ran into, given
+    the walk's transition table ``log_weights`` f32[N, K].
+
+    For each stuck drop: the node where it stopped, and back along its trail every node from
+    which each admissible move (finite ``log_weights``) leads either back to where the drop came
+    from or into a node already filled; the first node with another way out, and the start, end
+    the alley.
+    """
+    n = graph.num_nodes
+    num_agents = drops.path.shape[0]
+    agents = jnp.arange(num_agents)
+    last = jnp.sum(drops.path >= 0, axis=1) - 1  # index of the node where each drop stopped
+    filled = jnp.zeros((n,), bool).at[jnp.where(drops.stuck, drops.position, n)].set(
+        True, mode="drop")
+
+    def any_filling(carry):
+        return jnp.any(carry[1])
+
+    def one_back(carry):
+        back, filling, filled = carry
+        index = jnp.maximum(last - back, 1)
+        node, came_from = drops.path[agents, index], drops.path[agents, index - 1]
+        heads = graph.nbr[node]
+        way_out = ((log_weights[node] > -jnp.inf) & (heads != came_from[:, None])
+                   & ~filled[jnp.where(heads >= 0, heads, 0)])
+        dead = filling & (last - back >= 1) & ~jnp.any(way_out, axis=1)
+        return back + 1, dead, filled.at[jnp.where(dead, node, n)].set(True, mode="drop")
+
+    _, _, filled = jax.lax.while_loop(any_filling, one_back,
+                                      (jnp.int32(1), drops.stuck, filled))
+    return filled

@@ -1,0 +1,234 @@
+"""``rfd_graded``: this project's river formation law (not a paper's algorithm).
+
+It keeps RFD*'s transition rule (eq. 6, ``p_base ** gradient / d_j ** alpha``, the goal taken
+whenever adjacent) and replaces the paper's erosion (eqs. 4 and 5) by a graded river bed:
+
+* **Carving.** A river cuts its bed down to a graded profile. A drop lowers every node ``i`` of
+  its path to ``E * r(i)`` when that is lower, where ``r(i)`` is the shortest way its own walk
+  offers from ``i`` to water: to the goal, or to any node ``m`` later on its path carved before
+  this iteration, plus ``altitude(m) / E`` (a tributary: the drop need not arrive, only drain
+  into a bed). The altitude of a carved node is then ``E`` times the shortest route to the goal
+  the swarm has walked from it, refined one walked edge at a time (an asynchronous Bellman-Ford
+  over the walks), and at a fork the branch with the shorter remainder is the steeper one.
+  Ground no drop has carved stays at ``initial_height`` (keep it above ``E`` times the longest
+  walk). No eq. 5 sediment: the profile is not levelled.
+* **Clipped gradients.** A drop in a bed climbs out as if the slope were at most ``climb``
+  steep, so it keeps looking for shortcuts beside its river; a drop on the plateau sees a bed as
+  no steeper than ``E``, so a river does not swallow every drop that passes beside it. Drops on
+  uncarved ground do not climb slopes steeper than ``climb``.
+* **Banks.** A carved node a drop visits is lowered to its lowest carved neighbour plus ``E``
+  times the edge (a high stretch of bed left by an early meandering walk is corrected by the
+  first drop that visits it).
+* **Blind alleys and settling.** A stuck drop fills the blind alley it ran into
+  (:func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`); a drop that did not arrive leaves
+  ``sediment`` on every uncarved node of its trail, and filled ground settles (:func:`settle`)
+  so that no filled node is a pit: ground explored in vain rises and slopes down to where no
+  drop has been yet, and the drops, which do not climb, cross it to the frontier.
+* **Greedy drops.** The first ``greedy_drops`` drops (1) take their most likely move, so a
+  formed river is walked exactly (one unlikely draw in 150 moves misses a 100 x 100 optimum).
+
+Why: with eqs. 4 and 5 an altitude difference travels back from the goal one node per iteration
+and reflects how often an edge was used rather than how short the paths through it were; on the
+paper's 50 x 50 and 100 x 100 maps the paper's RFD* converged to long paths within 100
+iterations for every setting we tried. With these defaults ``rfd_graded`` reaches the Dijkstra
+optimum in at least 19 of 20 seeds on each of the nine paper maps (``sweeps/rfd_static.py``,
+``tests/test_rfd_quality.py``), and in 59 of 60 runs on Moving AI maps it was never tuned on.
+Until jaxswarm 0.2.0 this law was registered as ``rfd_star`` (see CHANGELOG.md).
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.graph import Graph, lowest_neighbour, move_lengths, relax
+from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes
+from jaxswarm.swarm.rfd.alleys import blind_alleys
+from jaxswarm.swarm.rfd.river import f32, goal_log_distance, gradients, river_swarm
+from jaxswarm.swarm.walk import FORCED, Walk, edge_table, visited_nodes
+
+SETTLE_SWEEPS = 1024
+"""Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
+down; it stops as soon as nothing moves). Sediment may have to slide far: at one maze100
+iteration we measured, settling took 188 sweeps (5.5-7 ms). Settling at most 64 sweeps per
+iteration, and the rest in later ones, made the optimum come later: in two sets of 20 maze100
+seeds at median iterations 67 and 26.5, against 22.5 and 19 when settled fully."""
+
+CARVE_COLUMNS = 8
+"""Path columns per block of the carving (:func:`carve`). Its reverse running sum and minimum
+lower to reduce-windows whose cost grows with the square of the block width on CPU: 8 columns
+carve maze100 in about 3 ms per iteration, 64 (the walk's block) in about 5."""
+
+
+@dataclasses.dataclass(frozen=True)
+class GradedConfig:
+    """Static sizes and switches of ``rfd_graded``.
+
+    Attributes:
+      num_agents: drops per iteration.
+      max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 on
+        general graphs and min(N - 1, 8 (H + W)) on grids.
+      greedy_drops: how many drops (the first ones) take their most likely move.
+      devices: spread each walk's drops over this many devices (see
+        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
+    """
+
+    num_agents: int = 256
+    max_steps: int | None = None
+    greedy_drops: int = 1
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+        if not 0 <= self.greedy_drops <= self.num_agents:
+            raise ValueError(f"greedy_drops must be between 0 and num_agents "
+                             f"({self.num_agents}), got {self.greedy_drops}")
+
+
+class GradedParams(NamedTuple):
+    """Numbers of ``rfd_graded`` (f32 scalars, traced; defaults in ``DEFAULT_GRADED``).
+
+    Attributes:
+      p_base: base of the transition weight ``p_base ** gradient`` (eq. 6).
+      alpha: exponent of the goal-distance heuristic ``1 / d_j ** alpha`` (eq. 6).
+      initial_height: the uncarved plateau (above ``erosion`` times the longest walk).
+      erosion: E, the bed's slope: altitude per unit of path still to walk (and the steepest a
+        bed looks from the plateau).
+      sediment: what each node of a blind alley gains when a stuck drop fills it, and what each
+        uncarved node on the trail of a drop that did not arrive gains.
+      climb: the steepest uphill gradient a drop on uncarved ground takes; from a carved node,
+        uphill moves count as at most this steep.
+      repose: the slope filled ground settles to (see :func:`settle`); keep it well above the
+        float32 spacing at ``initial_height`` (about 1e-3 at 1e4).
+    """
+
+    p_base: jax.Array
+    alpha: jax.Array
+    initial_height: jax.Array
+    erosion: jax.Array
+    sediment: jax.Array
+    climb: jax.Array
+    repose: jax.Array
+
+
+DEFAULT_GRADED = GradedParams(**f32(p_base=100.0, alpha=12.0, initial_height=1e4, erosion=1.0,
+                                    sediment=1.0, climb=0.0, repose=0.05))
+"""Tuned on the nine paper maps (see ``sweeps/rfd_static.py``)."""
+
+
+def graded_transition(graph: Graph, task: Task, altitude, params: GradedParams):
+    """f32[N, K] log-weight table of eq. 6 for altitudes f32[N], with gradients between a carved
+    bed and the uncarved plateau clipped (at least ``-climb`` out of a bed, at most ``erosion``
+    into one), climbs steeper than ``climb`` on uncarved ground banned, and the goal forced
+    whenever adjacent."""
+    heads, gradient = gradients(graph, altitude)
+    carved = altitude < params.initial_height
+    from_bed, into_bed = carved[:, None], carved[heads]
+    too_steep = (gradient < -params.climb) & ~from_bed
+    gradient = jnp.where(from_bed, jnp.maximum(gradient, -params.climb), gradient)
+    gradient = jnp.where(~from_bed & into_bed, jnp.minimum(gradient, params.erosion), gradient)
+    logw = (gradient * jnp.log(params.p_base)
+            - params.alpha * goal_log_distance(graph, task.goal)[heads])
+    logw = jnp.where(too_steep, -jnp.inf, logw)
+    logw = jnp.where(heads == task.goal, FORCED, logw)
+    return edge_table(graph, logw)
+
+
+def graded_reshape(graph: Graph, task: Task, altitude, table, drops: Walk, params: GradedParams):
+    """f32[N] altitudes after one iteration: blind alleys filled, the trails of drops that did
+    not arrive raised and settled, the walked paths carved, the visited banks eroded."""
+    n = graph.num_nodes
+    altitude = altitude + jnp.where(blind_alleys(graph, table, drops), params.sediment, 0.0)
+    failed = visited_nodes(drops, n, ~drops.arrived)
+    plateau = altitude >= params.initial_height
+    altitude = settle(graph, altitude + jnp.where(failed & plateau, params.sediment, 0.0),
+                      params)
+    altitude = carve(graph, altitude, drops, params)
+    return erode_banks(graph, altitude, visited_nodes(drops, n), params)
+
+
+def settle(graph: Graph, altitude, params: GradedParams):
+    """Sediment slides into pits: f32[N] altitudes, for altitudes f32[N], after sweeps that raise
+    every filled node (above ``initial_height``) to at least its lowest neighbour plus
+    ``repose`` times the edge length, until no filled node is a pit (or ``SETTLE_SWEEPS`` sweeps
+    have run). Then a drop on filled ground (which does not climb) always has a way down to
+    unfilled ground or a bed. The result is the lowest ground at or above the given altitudes on
+    which no filled node is a pit, whatever the order of the sweeps."""
+    rise = jnp.where(graph.valid_edges(), params.repose * graph.cost, jnp.inf)
+
+    def raise_pits(here, lowest):  # lowest is inf for a node without edges
+        pit = (here > params.initial_height) & (lowest > here) & jnp.isfinite(lowest)
+        return jnp.where(pit, lowest, here), pit
+
+    return relax(graph, altitude, rise, raise_pits, max_sweeps=SETTLE_SWEEPS)[0]
+
+
+def erode_banks(graph: Graph, altitude, visited, params: GradedParams):
+    """f32[N] altitudes after every carved node a drop visited (``visited`` bool[N]) was lowered
+    to its lowest carved neighbour plus ``erosion`` times the edge length, where that is lower:
+    the drop saw the deeper bed beside its own."""
+    carved = altitude < params.initial_height
+    bed = jnp.where(carved, altitude, jnp.inf)
+    run = jnp.where(graph.valid_edges(), params.erosion * graph.cost, jnp.inf)
+    return jnp.where(visited & carved,
+                     jnp.minimum(altitude, lowest_neighbour(graph, bed, run)), altitude)
+
+
+def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
+    """f32[N] altitudes after every drop lowered each node of its path to ``erosion`` times the
+    shortest way its walk offers from there to water: the goal, or a later node of the path
+    carved before this iteration (below ``initial_height``) plus its depth.
+
+    Works backwards over the walked part of the paths, ``CARVE_COLUMNS`` columns at a time,
+    carrying per drop the length walked after the block and the best way to water found there.
+    """
+    n = altitude.shape[0]
+    num_agents, width = drops.path.shape
+    blocks = -(-width // CARVE_COLUMNS)
+    walked_blocks = (drops.steps + CARVE_COLUMNS) // CARVE_COLUMNS  # blocks holding nodes
+
+    def one_block(carry):
+        block, after, best, carved = carry
+        # The block's columns, read past the end as -1 (no copy of the paths padded to whole
+        # blocks; the last node has no move, so slots reads one column further as -1).
+        columns = block * CARVE_COLUMNS + jnp.arange(CARVE_COLUMNS)
+        nodes = jnp.take(drops.path, columns, axis=1, mode="fill", fill_value=-1)
+        slot = jnp.take(drops.slots, columns, axis=1, mode="fill", fill_value=-1)
+        on_path = nodes >= 0
+        node = jnp.where(on_path, nodes, 0)
+        edge = move_lengths(graph, node, slot)
+        # to_end[a, k]: length drop a walks from this node to where it stopped.
+        to_end = after[:, None] + jax.lax.cumsum(edge, axis=1, reverse=True)
+        depth = altitude[node]
+        water = jnp.where(on_path & (depth < params.initial_height),
+                          depth / params.erosion - to_end, jnp.inf)
+        reach = jnp.minimum(jax.lax.cummin(water, axis=1, reverse=True), best[:, None])
+        carves = on_path & jnp.isfinite(reach)
+        carved = carved.at[jnp.where(carves, node, n)].min(params.erosion * (reach + to_end),
+                                                           mode="drop")
+        return block - 1, to_end[:, 0], reach[:, 0], carved
+
+    _, _, _, carved = jax.lax.while_loop(
+        lambda carry: carry[0] >= 0, one_block,
+        (jnp.minimum(walked_blocks, blocks) - 1, jnp.zeros((num_agents,), jnp.float32),
+         jnp.full((num_agents,), jnp.inf, jnp.float32), altitude))
+    return carved
+
+
+def _check_graded(params: GradedParams) -> None:
+    check_positive("p_base", params.p_base)
+    check_positive("alpha", params.alpha, allow_zero=True)
+    check_positive("initial_height", params.initial_height)
+    check_positive("erosion", params.erosion)  # the slope: 0 would flatten every bed to the sea
+    check_positive("sediment", params.sediment, allow_zero=True)
+    check_positive("climb", params.climb, allow_zero=True)
+    check_positive("repose", params.repose, allow_zero=True)
+
+
+def build_rfd_graded(config: GradedConfig) -> Swarm:
+    """This project's river formation law (see the module docstring), with :class:`GradedParams`."""
+    return river_swarm("rfd_graded", config, transition=graded_transition,
+                       reshape=graded_reshape, greedy_drops=config.greedy_drops,
+                       default_params=DEFAULT_GRADED, check_params=_check_graded)

@@ -1,0 +1,245 @@
+"""River Formation Dynamics as the RFD paper writes it: the original RFD and the modified RFD*.
+
+Both walk their drops over the gradient of eq. 2, ``(altitude(i) - altitude(j)) / distance(i,
+j)``, among the neighbours a drop has not visited yet (the paper's per-drop sets ``V_k``,
+``U_k``, ``F_k``):
+
+* ``rfd`` (eqs. 1, 3): weight ``gradient`` downhill, ``omega / |gradient|`` uphill, ``delta``
+  flat.
+* ``rfd_star`` (eq. 6): weight ``p_base ** gradient / d_j ** alpha`` for every neighbour, with
+  ``d_j`` the straight-line distance from ``j`` to the goal. Eq. 6 divides by ``d_goal = 0``, so
+  the goal wins every draw when it is adjacent: we take it whenever adjacent.
+
+After the walk (Algorithm 1, lines 6-8), every edge ``i -> j`` of each path that reached the goal
+erodes node ``i`` by ``E / ((N - 1) * D) * gradient(i, j)`` (eq. 4; negative gradients erode
+nothing), and every node then gains ``erosionProduced / (N - 1)`` (eq. 5). A drop that could not
+move deposits ``sediment`` on the node where it stands (the paper's "a fraction of carried
+sediment", without an amount: the parameter is that amount). Altitudes are kept non-negative and
+the goal stays at 0.
+
+Choices the paper leaves open, as config of ``rfd_star`` (the paper's variant is the default):
+
+* ``erosion_law``: ``"linear"`` is eq. 4; ``"exponential"`` erodes by ``p_base ** gradient``
+  instead of ``gradient`` (the paper: "the same formula can be applied to the erosion values").
+
+Additions of this project, each off in the paper's variant:
+
+* ``greedy_drops``: the first drops take their most likely move instead of drawing one, so that
+  formed altitudes are walked exactly (one unlikely draw in 150 moves misses a long optimum).
+* ``fill_blind_alleys``: a stuck drop fills the whole blind alley it ran into
+  (:func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`), not only the node where it stands, so a dead
+  end is closed in one iteration instead of one node per iteration.
+* ``max_climb``: drops do not take moves steeper uphill than this gradient, so a filled alley is
+  not re-entered.
+
+The paper gives no parameter values; the defaults are this project's (``DEFAULT_RFD``,
+``DEFAULT_RFD_STAR``), and the quality they reach is reported by ``sweeps/rfd_static.py`` and
+``sweeps/rfd_paper_static.py``, not tuned into them.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.graph import Graph, move_lengths
+from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes
+from jaxswarm.swarm.rfd.alleys import blind_alleys
+from jaxswarm.swarm.rfd.river import (deposit_where_stuck, f32, goal_log_distance, gradients,
+                                      river_swarm)
+from jaxswarm.swarm.walk import FORCED, Walk, edge_table
+
+EROSION_LAWS = ("linear", "exponential")
+"""How ``rfd_star``'s arrived drops erode their paths: eq. 4, or its exponential form."""
+
+MAX_LOG_EROSION = 60.0
+"""Cap on ``log(p_base ** gradient)`` in the exponential erosion (float32 overflows near 88)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class RFDConfig:
+    """Static sizes of the original RFD.
+
+    Attributes:
+      num_agents: D, drops per iteration.
+      max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
+        longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
+      devices: spread each walk's drops over this many devices (see
+        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
+    """
+
+    num_agents: int = 256
+    max_steps: int | None = None
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+
+
+@dataclasses.dataclass(frozen=True)
+class RFDStarConfig:
+    """Static sizes and switches of RFD* (the defaults are the paper's algorithm).
+
+    Attributes:
+      num_agents: D, drops per iteration.
+      max_steps: step budget of one walk; None as for :class:`RFDConfig`.
+      erosion_law: one of ``EROSION_LAWS``.
+      greedy_drops: ours: how many drops (the first ones) take their most likely move.
+      fill_blind_alleys: ours: a stuck drop fills its whole blind alley with ``sediment``.
+      max_climb: ours: the steepest uphill gradient a drop takes (None: any, as the paper).
+      devices: spread each walk's drops over this many devices.
+    """
+
+    num_agents: int = 256
+    max_steps: int | None = None
+    erosion_law: str = "linear"
+    greedy_drops: int = 0
+    fill_blind_alleys: bool = False
+    max_climb: float | None = None
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+        if not 0 <= self.greedy_drops <= self.num_agents:
+            raise ValueError(f"greedy_drops must be between 0 and num_agents "
+                             f"({self.num_agents}), got {self.greedy_drops}")
+        if self.erosion_law not in EROSION_LAWS:
+            raise ValueError(f"unknown erosion_law {self.erosion_law!r}; "
+                             f"choose one of {', '.join(EROSION_LAWS)}")
+        if self.max_climb is not None:
+            check_positive("max_climb", self.max_climb, allow_zero=True)
+
+
+class RFDParams(NamedTuple):
+    """Numbers of the original RFD (f32 scalars, traced; defaults in ``DEFAULT_RFD``).
+
+    Attributes:
+      initial_height: altitude of every node but the goal at the start.
+      erosion: E in eq. 4.
+      sediment: what a stuck drop deposits where it stands.
+      omega: numerator of the uphill weight ``omega / |gradient|``.
+      delta: weight of a flat move.
+    """
+
+    initial_height: jax.Array
+    erosion: jax.Array
+    sediment: jax.Array
+    omega: jax.Array
+    delta: jax.Array
+
+
+class RFDStarParams(NamedTuple):
+    """Numbers of RFD* (f32 scalars, traced; defaults in ``DEFAULT_RFD_STAR``).
+
+    Attributes:
+      p_base: base of the exponential transition weight ``p_base ** gradient`` (eq. 6).
+      alpha: exponent of the goal-distance heuristic ``1 / d_j ** alpha`` (eq. 6).
+      initial_height: altitude of every node but the goal at the start.
+      erosion: E in eq. 4.
+      sediment: what a stuck drop deposits where it stands (with ``fill_blind_alleys``: on every
+        node of its blind alley).
+    """
+
+    p_base: jax.Array
+    alpha: jax.Array
+    initial_height: jax.Array
+    erosion: jax.Array
+    sediment: jax.Array
+
+
+DEFAULT_RFD = RFDParams(**f32(initial_height=1.0, erosion=1.0, sediment=0.1, omega=0.1,
+                              delta=0.1))
+DEFAULT_RFD_STAR = RFDStarParams(**f32(p_base=50.0, alpha=50.0, initial_height=1.0,
+                                       erosion=50.0, sediment=0.3))
+
+
+def rfd_transition(graph: Graph, task: Task, altitude, params: RFDParams):
+    """f32[N, K] log-weight table of eq. 1 for altitudes f32[N]."""
+    _, gradient = gradients(graph, altitude)
+    weight = jnp.where(gradient > 0, gradient,
+                       jnp.where(gradient < 0, params.omega / jnp.abs(gradient), params.delta))
+    return edge_table(graph, jnp.log(weight))
+
+
+def rfd_star_transition(config: RFDStarConfig, graph: Graph, task: Task, altitude,
+                        params: RFDStarParams):
+    """f32[N, K] log-weight table of eq. 6 for altitudes f32[N]: ``gradient * log p_base - alpha
+    * log d_j``, the goal forced whenever adjacent, and (``max_climb``) steeper climbs banned."""
+    heads, gradient = gradients(graph, altitude)
+    logw = (gradient * jnp.log(params.p_base)
+            - params.alpha * goal_log_distance(graph, task.goal)[heads])
+    if config.max_climb is not None:
+        logw = jnp.where(gradient < -config.max_climb, -jnp.inf, logw)
+    logw = jnp.where(heads == task.goal, FORCED, logw)
+    return edge_table(graph, logw)
+
+
+def erode_eq4(graph: Graph, altitude, drops: Walk, erosion, p_base=None):
+    """Eqs. 4 and 5 along the paths of the drops that arrived: f32[N] altitudes after erosion.
+
+    Each move ``i -> j`` of an arrived drop lowers ``i`` by ``erosion / ((N - 1) D)`` times
+    ``max(gradient, 0)`` (or, given ``p_base``, times ``p_base ** gradient``, the exponential
+    form); then every node gains the eroded total divided by ``N - 1``.
+    """
+    n = altitude.shape[0]
+    num_drops = drops.path.shape[0]
+    moved = (drops.slots >= 0) & drops.arrived[:, None]
+    here = jnp.where(moved, drops.path[:, :-1], 0)
+    there = jnp.where(moved, drops.path[:, 1:], 0)
+    distance = move_lengths(graph, here, drops.slots)
+    gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
+    if p_base is None:
+        shape = jnp.maximum(gradient, 0.0)
+    else:  # p_base ** gradient, capped so that a cliff cannot overflow float32
+        shape = jnp.exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
+    amount = jnp.where(moved, erosion / ((n - 1) * num_drops) * shape, 0.0)
+    altitude = altitude.at[here].add(-amount)
+    return altitude + jnp.sum(amount) / (n - 1)
+
+
+def _check_rfd(params: RFDParams) -> None:
+    check_positive("initial_height", params.initial_height)
+    check_positive("erosion", params.erosion, allow_zero=True)
+    check_positive("sediment", params.sediment, allow_zero=True)
+    check_positive("omega", params.omega)
+    check_positive("delta", params.delta)
+
+
+def _check_rfd_star(params: RFDStarParams) -> None:
+    check_positive("p_base", params.p_base)
+    check_positive("alpha", params.alpha, allow_zero=True)
+    check_positive("initial_height", params.initial_height)
+    check_positive("erosion", params.erosion, allow_zero=True)
+    check_positive("sediment", params.sediment, allow_zero=True)
+
+
+def build_rfd(config: RFDConfig) -> Swarm:
+    """The original River Formation Dynamics (eqs. 1-5), with :class:`RFDParams`."""
+    def reshape(graph, task, altitude, table, drops, params):
+        altitude = deposit_where_stuck(altitude, drops, params.sediment)
+        return erode_eq4(graph, altitude, drops, params.erosion)
+
+    return river_swarm("rfd", config, transition=rfd_transition, reshape=reshape,
+                       greedy_drops=0, default_params=DEFAULT_RFD, check_params=_check_rfd)
+
+
+def build_rfd_star(config: RFDStarConfig) -> Swarm:
+    """The modified RFD* (eq. 6 with eqs. 4-5), with :class:`RFDStarParams`."""
+    def transition(graph, task, altitude, params):
+        return rfd_star_transition(config, graph, task, altitude, params)
+
+    def reshape(graph, task, altitude, table, drops, params):
+        if config.fill_blind_alleys:
+            altitude = altitude + jnp.where(blind_alleys(graph, table, drops), params.sediment,
+                                            0.0)
+        else:
+            altitude = deposit_where_stuck(altitude, drops, params.sediment)
+        exponential = config.erosion_law == "exponential"
+        return erode_eq4(graph, altitude, drops, params.erosion,
+                         params.p_base if exponential else None)
+
+    return river_swarm("rfd_star", config, transition=transition, reshape=reshape,
+                       greedy_drops=config.greedy_drops, default_params=DEFAULT_RFD_STAR,
+                       check_params=_check_rfd_star)

@@ -1,0 +1,121 @@
+"""What every river formation variant shares: the altitude memory and one iteration's shape.
+
+Every node has an altitude; the goal is the sea, fixed at 0, every other node starts at
+``initial_height``. Each iteration all drops walk from the start over one table of transition
+log-weights (:mod:`jaxswarm.swarm.walk`: no drop visits a node twice, the RFD paper's per-drop
+neighbour sets), then the variant reshapes the altitudes from what the drops did, and the best
+arrived path is kept.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Callable
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.graph import Graph, straight_line
+from jaxswarm.paths import Solution
+from jaxswarm.swarm.core import Swarm, Task, keep_best
+from jaxswarm.swarm.walk import Walk, step_budget, walk
+
+
+@dataclasses.dataclass(frozen=True)
+class RFDState:
+    """Memory of a river formation run (a pytree).
+
+    Attributes:
+      key: PRNG key for the next iteration.
+      altitude: f32[N] node altitudes (the goal's is 0).
+      best_path: i32[L] best path found so far, -1 padded (all -1 before any drop arrived).
+      best_cost: f32[] its length (inf before any drop arrived).
+    """
+
+    key: jax.Array
+    altitude: jax.Array
+    best_path: jax.Array
+    best_cost: jax.Array
+
+
+jax.tree_util.register_dataclass(
+    RFDState, data_fields=["key", "altitude", "best_path", "best_cost"], meta_fields=[])
+
+
+Transition = Callable[[Graph, Task, jax.Array, object], jax.Array]
+"""``(graph, task, altitude f32[N], params) -> f32[N, K]`` the walker's log-weight table."""
+Reshape = Callable[[Graph, Task, jax.Array, jax.Array, Walk, object], jax.Array]
+"""``(graph, task, altitude f32[N], table f32[N, K], drops, params) -> f32[N]`` the altitudes
+after one iteration's erosion and sediment."""
+
+
+def f32(**values) -> dict:
+    """Default params as NumPy float32 scalars, not JAX arrays: importing a swarm must not start
+    JAX's backend (see :func:`jaxswarm.cpu.configure`); jit and vmap take them as f32 arrays."""
+    return {name: np.float32(value) for name, value in values.items()}
+
+
+def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
+                greedy_drops: int, default_params, check_params) -> Swarm:
+    """A river formation Swarm from its transition rule and its altitude update.
+
+    Args:
+      name: registry name.
+      config: the variant's static config (``num_agents``, ``max_steps`` and ``devices`` are read).
+      transition: the log-weight table of the current altitudes.
+      reshape: erosion and sediment after a walk.
+      greedy_drops: how many drops (the first ones) take their most likely move.
+      default_params: the variant's default Params.
+      check_params: host-side Params check.
+    """
+    def init(key, graph: Graph, task: Task, params) -> RFDState:
+        altitude = jnp.full((graph.num_nodes,), params.initial_height,
+                            jnp.float32).at[task.goal].set(0.0)
+        return RFDState(key=key, altitude=altitude,
+                        best_path=jnp.full((step_budget(graph, config.max_steps) + 1,), -1,
+                                           jnp.int32),
+                        best_cost=jnp.float32(jnp.inf))
+
+    def step(state: RFDState, graph: Graph, task: Task, params):
+        key, walk_key = jax.random.split(state.key)
+        table = transition(graph, task, state.altitude, params)
+        drops = walk(walk_key, graph, table, task.start, task.goal,
+                     num_agents=config.num_agents,
+                     max_steps=step_budget(graph, config.max_steps), devices=config.devices,
+                     greedy_agents=greedy_drops)
+        altitude = reshape(graph, task, state.altitude, table, drops, params)
+        altitude = jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
+        best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
+        return RFDState(key=key, altitude=altitude, best_path=best_path,
+                        best_cost=best_cost), info
+
+    def best(state: RFDState) -> Solution:
+        return Solution(path=state.best_path, cost=state.best_cost,
+                        found=jnp.isfinite(state.best_cost))
+
+    return Swarm(name=name, config=config, init=init, step=step, best=best,
+                 default_params=default_params, check_params=check_params,
+                 memory=lambda state: state.altitude, memory_label="altitude")
+
+
+def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
+    """``(heads i32[N, K], gradient f32[N, K])``: each slot's neighbour (0 where there is none)
+    and the RFD paper's eq. 2, ``(altitude(i) - altitude(j)) / distance(i, j)``."""
+    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
+    return heads, (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost,
+                                                                     1.0)
+
+
+def goal_log_distance(graph: Graph, goal) -> jax.Array:
+    """f32[N] ``log d_j``, the straight-line distance of each node to the goal (eq. 6); nodes at
+    distance 0 other than the goal (general graphs without coordinates) get 0, a neutral
+    heuristic, instead of ``log 0``."""
+    to_goal = straight_line(graph, goal)
+    return jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
+
+
+def deposit_where_stuck(altitude: jax.Array, drops: Walk, sediment) -> jax.Array:
+    """f32[N]: ``altitude`` after every drop that could not move deposited ``sediment`` on the
+    node where it stopped (the RFD paper's "deposits a fraction of carried sediment")."""
+    stuck_at = jnp.where(drops.stuck, drops.position, altitude.shape[0])  # out of bounds: dropped
+    return altitude.at[stuck_at].add(sediment, mode="drop")

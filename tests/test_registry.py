@@ -1,0 +1,69 @@
+"""The registry: the papers' names and ours, one Swarm per Config, and rfd_graded being exactly
+jaxswarm 0.1.0's default rfd_star."""
+import json
+from pathlib import Path
+
+import jax
+import numpy as np
+import pytest
+
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.swarm import config_options, definition, make, make_task, registered, run
+from jaxswarm.swarm.registry import REGISTRY
+
+GOLDEN = Path(__file__).parent / "golden" / "rfd_star_0.1.0.json"
+"""Runs of jaxswarm 0.1.0's ``make("rfd_star", num_agents=...)`` (the graded law, its defaults):
+map, agents, iterations, patience, seed and what came out (best path and cost, iterations run,
+the best cost after each, final altitudes)."""
+
+
+def test_the_registry_holds_the_papers_algorithms_and_ours():
+    assert set(registered()) == {"rfd", "rfd_star", "rfd_graded", "ant_system", "aco_star",
+                                 "max_min_aco", "improved_max_min_aco"}
+    ours = {name for name, entry in REGISTRY.items() if not entry.faithful}
+    assert ours == {"rfd_graded"}
+    with pytest.raises(ValueError, match="unknown swarm 'bees'; registered: .*rfd_star"):
+        make("bees")
+
+
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_equal_configs_give_one_swarm(name):
+    explicit = {option: getattr(REGISTRY[name].config(), option)
+                for option in config_options(name)}
+    assert make(name) is make(name, **explicit)
+    assert make(name, num_agents=32) is make(name, num_agents=32, devices=1)
+    assert make(name, num_agents=32) is not make(name, num_agents=16)
+    assert definition(make(name, num_agents=32))["config"]["num_agents"] == 32
+
+
+def test_the_papers_variants_are_the_defaults():
+    star = make("rfd_star").config
+    assert (star.erosion_law, star.greedy_drops, star.fill_blind_alleys, star.max_climb) == (
+        "linear", 0, False, None)
+    assert set(make("rfd_star").default_params._fields) == {
+        "p_base", "alpha", "initial_height", "erosion", "sediment"}
+    assert float(make("ant_system").default_params.beta) == 0.0  # eq. 7: pheromone only
+    assert float(make("aco_star").default_params.beta) == 0.0
+    max_min = make("max_min_aco").config
+    assert not max_min.upper_bound and not max_min.global_best
+    improved = make("improved_max_min_aco")
+    assert improved.config.first_ant == "weighted" and improved.config.num_agents == 50
+    assert float(improved.default_params.beta_first) == 5.0  # Algorithm 1's hweight
+    assert (float(improved.default_params.alpha), float(improved.default_params.beta)) == (1, 1)
+
+
+@pytest.mark.parametrize("record", json.loads(GOLDEN.read_text()),
+                         ids=lambda r: f"{r['map']}-seed{r['seed']}")
+def test_rfd_graded_is_0_1_0s_rfd_star(record):
+    chosen = paper_map(record["map"])
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    swarm = make("rfd_graded", num_agents=record["num_agents"])
+    state, trace = run(swarm, jax.random.key(record["seed"]), graph, task, swarm.default_params,
+                       iterations=record["iterations"], patience=record["patience"])
+    assert int(trace.iterations) == record["ran"]
+    assert float(state.best_cost) == record["best_cost"]
+    np.testing.assert_array_equal(np.asarray(state.best_path), record["best_path"])
+    np.testing.assert_array_equal(np.asarray(trace.best_cost)[:record["ran"]],
+                                  np.float32(record["trace_best"]))
+    np.testing.assert_array_equal(np.asarray(state.altitude), np.float32(record["altitude"]))
