@@ -131,7 +131,7 @@ def run_demo(args: argparse.Namespace) -> int:
                   for label, cost, *rest in rows]))
     field = float(optimum(graph, as_node(graph, start), as_node(graph, goal)))
     print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
-    print("(paper): the paper's algorithm as written; (ours): jaxswarm's own algorithm; "
+    print("(paper): the paper's algorithm as written; (ours): jaxswarm's own algorithm\n"
           "no path: no agent reached the goal within the iterations")
     fig = plot_solutions(graph, solutions, start=start, goal=goal, path=args.out,
                          title=f"{name}: exact and swarm planners")
