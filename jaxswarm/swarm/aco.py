@@ -46,9 +46,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph, straight_line
-from jaxswarm.paths import Solution, step_slots
+from jaxswarm.paths import step_slots
 from jaxswarm.swarm.bug2 import direction_cosine, first_ant_path
-from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes, keep_best
+from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
+                                 keep_best)
 from jaxswarm.swarm.walk import FORCED, edge_table, step_budget, walk
 
 DIRECTION_FLOOR = 1e-3
@@ -59,66 +60,36 @@ FIRST_ANTS = ("weighted", "greedy")
 (the paper), or always the most likely one."""
 
 
-@dataclasses.dataclass(frozen=True)
-class AntSystemConfig:
-    """Static sizes of Ant System and ACO*.
-
-    Attributes:
-      num_agents: ants per iteration.
-      max_steps: step budget of one walk; None = N - 1 on general graphs, min(N - 1, 8 (H + W))
-        on grids.
-      devices: spread each walk's ants over this many devices (see
-        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
-    """
-
-    num_agents: int = 256
-    max_steps: int | None = None
-    devices: int = 1
-
-    def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
+AntSystemConfig = SwarmConfig
+"""Ant System and ACO* have only the sizes (``num_agents``: ants per iteration)."""
 
 
 @dataclasses.dataclass(frozen=True)
-class MaxMinConfig:
-    """Static sizes and switches of Max-Min ACO (the defaults are the paper's use of it).
+class MaxMinConfig(SwarmConfig):
+    """Static switches of Max-Min ACO (the defaults are the paper's use of it).
 
     Attributes:
-      num_agents: ants per population.
-      max_steps: step budget of one walk (as for :class:`AntSystemConfig`).
       global_best: ours: the best path so far deposits instead of the population's best.
       upper_bound: ours: also keep ``tau`` at most ``tau_max``.
-      devices: spread each walk's ants over this many devices.
     """
 
-    num_agents: int = 256
-    max_steps: int | None = None
     global_best: bool = False
     upper_bound: bool = False
-    devices: int = 1
-
-    def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
 
 
 @dataclasses.dataclass(frozen=True)
-class ImprovedConfig:
-    """Static sizes and switches of Improved Max-Min ACO.
+class ImprovedConfig(SwarmConfig):
+    """Static switches of Improved Max-Min ACO, whose populations are of 50 ants (the paper's).
 
     Attributes:
-      num_agents: ants per population (50 in the paper).
-      max_steps: step budget of one walk (as for :class:`AntSystemConfig`).
       first_ant: one of ``FIRST_ANTS``.
-      devices: spread each walk's ants over this many devices.
     """
 
     num_agents: int = 50
-    max_steps: int | None = None
     first_ant: str = "weighted"
-    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
+        super().__post_init__()
         if self.first_ant not in FIRST_ANTS:
             raise ValueError(f"unknown first_ant {self.first_ant!r}; "
                              f"choose one of {', '.join(FIRST_ANTS)}")
@@ -301,11 +272,7 @@ def _colony(name: str, config, *, default_params, update, init_best=None, direct
         return ACOState(key=key, pheromone=pheromone, best_path=best_path,
                         best_cost=best_cost), info
 
-    def best(state: ACOState) -> Solution:
-        return Solution(path=state.best_path, cost=state.best_cost,
-                        found=jnp.isfinite(state.best_cost))
-
-    return Swarm(name=name, config=config, init=init, step=step, best=best,
+    return Swarm(name=name, config=config, init=init, step=step, best=best_solution,
                  default_params=default_params, check_params=_check,
                  memory=lambda state: state.pheromone.sum(axis=-1),
                  memory_label="pheromone on a node's edges")

@@ -24,7 +24,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
-from jaxswarm.paths import as_node
+from jaxswarm.paths import Solution, as_node
 from jaxswarm.swarm.walk import check_devices
 
 
@@ -180,6 +180,33 @@ def _run(swarm, key, graph, task, params, iterations, patience):
     state, trace, _, _ = jax.lax.while_loop(
         keep_going, one_iteration, (state, trace, jnp.int32(0), jnp.array(False)))
     return state, trace
+
+
+@dataclasses.dataclass(frozen=True)
+class SwarmConfig:
+    """The static sizes every swarm has; a swarm's own Config adds its switches.
+
+    Attributes:
+      num_agents: agents (drops, ants) per iteration.
+      max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
+        longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
+      devices: spread each walk's agents over this many devices (see
+        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
+    """
+
+    num_agents: int = 256
+    max_steps: int | None = None
+    devices: int = 1
+
+    def __post_init__(self):
+        check_sizes(self.num_agents, self.max_steps, self.devices)
+
+
+def best_solution(state) -> Solution:
+    """The best path so far of a swarm state with ``best_path`` i32[L] and ``best_cost`` f32[]
+    (inf until an agent arrived), as a Solution."""
+    return Solution(path=state.best_path, cost=state.best_cost,
+                    found=jnp.isfinite(state.best_cost))
 
 
 def check_sizes(num_agents: int, max_steps: int | None, devices: int = 1) -> None:

@@ -44,9 +44,10 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import Graph, lowest_neighbour, move_lengths, relax
-from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes
+from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import f32, goal_log_distance, gradients, river_swarm
+from jaxswarm.swarm.rfd.river import (check_greedy_drops, f32, goal_log_distance, gradients,
+                                      river_swarm)
 from jaxswarm.swarm.walk import FORCED, Walk, edge_table, visited_nodes
 
 SETTLE_SWEEPS = 1024
@@ -63,28 +64,18 @@ carve maze100 in about 3 ms per iteration, 64 (the walk's block) in about 5."""
 
 
 @dataclasses.dataclass(frozen=True)
-class GradedConfig:
+class GradedConfig(SwarmConfig):
     """Static sizes and switches of ``rfd_graded``.
 
     Attributes:
-      num_agents: drops per iteration.
-      max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 on
-        general graphs and min(N - 1, 8 (H + W)) on grids.
       greedy_drops: how many drops (the first ones) take their most likely move.
-      devices: spread each walk's drops over this many devices (see
-        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
     """
 
-    num_agents: int = 256
-    max_steps: int | None = None
     greedy_drops: int = 1
-    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
-        if not 0 <= self.greedy_drops <= self.num_agents:
-            raise ValueError(f"greedy_drops must be between 0 and num_agents "
-                             f"({self.num_agents}), got {self.greedy_drops}")
+        super().__post_init__()
+        check_greedy_drops(self.greedy_drops, self.num_agents)
 
 
 class GradedParams(NamedTuple):

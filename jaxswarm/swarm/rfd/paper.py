@@ -45,10 +45,10 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import Graph, move_lengths
-from jaxswarm.swarm.core import Swarm, Task, check_positive, check_sizes
+from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import (deposit_where_stuck, f32, goal_log_distance, gradients,
-                                      river_swarm)
+from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, f32,
+                                      goal_log_distance, gradients, river_swarm)
 from jaxswarm.swarm.walk import FORCED, Walk, edge_table
 
 EROSION_LAWS = ("linear", "exponential")
@@ -58,53 +58,29 @@ MAX_LOG_EROSION = 60.0
 """Cap on ``log(p_base ** gradient)`` in the exponential erosion (float32 overflows near 88)."""
 
 
-@dataclasses.dataclass(frozen=True)
-class RFDConfig:
-    """Static sizes of the original RFD.
-
-    Attributes:
-      num_agents: D, drops per iteration.
-      max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
-        longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
-      devices: spread each walk's drops over this many devices (see
-        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
-    """
-
-    num_agents: int = 256
-    max_steps: int | None = None
-    devices: int = 1
-
-    def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
+RFDConfig = SwarmConfig
+"""The original RFD has only the sizes (``num_agents`` is D, the drops per iteration)."""
 
 
 @dataclasses.dataclass(frozen=True)
-class RFDStarConfig:
+class RFDStarConfig(SwarmConfig):
     """Static sizes and switches of RFD* (the defaults are the paper's algorithm).
 
     Attributes:
-      num_agents: D, drops per iteration.
-      max_steps: step budget of one walk; None as for :class:`RFDConfig`.
       erosion_law: one of ``EROSION_LAWS``.
       greedy_drops: ours: how many drops (the first ones) take their most likely move.
       fill_blind_alleys: ours: a stuck drop fills its whole blind alley with ``sediment``.
       max_climb: ours: the steepest uphill gradient a drop takes (None: any, as the paper).
-      devices: spread each walk's drops over this many devices.
     """
 
-    num_agents: int = 256
-    max_steps: int | None = None
     erosion_law: str = "linear"
     greedy_drops: int = 0
     fill_blind_alleys: bool = False
     max_climb: float | None = None
-    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
-        if not 0 <= self.greedy_drops <= self.num_agents:
-            raise ValueError(f"greedy_drops must be between 0 and num_agents "
-                             f"({self.num_agents}), got {self.greedy_drops}")
+        super().__post_init__()
+        check_greedy_drops(self.greedy_drops, self.num_agents)
         if self.erosion_law not in EROSION_LAWS:
             raise ValueError(f"unknown erosion_law {self.erosion_law!r}; "
                              f"choose one of {', '.join(EROSION_LAWS)}")
@@ -215,7 +191,7 @@ def _check_rfd_star(params: RFDStarParams) -> None:
     check_positive("sediment", params.sediment, allow_zero=True)
 
 
-def build_rfd(config: RFDConfig) -> Swarm:
+def build_rfd(config: SwarmConfig) -> Swarm:
     """The original River Formation Dynamics (eqs. 1-5), with :class:`RFDParams`."""
     def reshape(graph, task, altitude, table, drops, params):
         altitude = deposit_where_stuck(altitude, drops, params.sediment)

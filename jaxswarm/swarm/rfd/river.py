@@ -16,8 +16,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph, straight_line
-from jaxswarm.paths import Solution
-from jaxswarm.swarm.core import Swarm, Task, keep_best
+from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.walk import Walk, step_budget, walk
 
 
@@ -89,13 +88,16 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
         return RFDState(key=key, altitude=altitude, best_path=best_path,
                         best_cost=best_cost), info
 
-    def best(state: RFDState) -> Solution:
-        return Solution(path=state.best_path, cost=state.best_cost,
-                        found=jnp.isfinite(state.best_cost))
-
-    return Swarm(name=name, config=config, init=init, step=step, best=best,
+    return Swarm(name=name, config=config, init=init, step=step, best=best_solution,
                  default_params=default_params, check_params=check_params,
                  memory=lambda state: state.altitude, memory_label="altitude")
+
+
+def check_greedy_drops(greedy_drops: int, num_agents: int) -> None:
+    """Static config check: between 0 and all of the drops are greedy."""
+    if not 0 <= greedy_drops <= num_agents:
+        raise ValueError(f"greedy_drops must be between 0 and num_agents ({num_agents}), "
+                         f"got {greedy_drops}")
 
 
 def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
