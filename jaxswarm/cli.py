@@ -19,10 +19,10 @@ from pathlib import Path
 import jax
 
 from jaxswarm.cpu import configure
-from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
+from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map, paper_map_names
-from jaxswarm.paths import as_node
+from jaxswarm.paths import as_node, path_length
 from jaxswarm.swarm import make, make_task, registry, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
@@ -71,6 +71,10 @@ def main(argv: list[str] | None = None) -> int:
         return run_demo(args) if args.command == "demo" else run_sweep_command(args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
+    except KeyboardInterrupt:
+        resume = ("; the finished chunks are kept: run the same command again to resume"
+                  if args.command == "sweep" else "")
+        parser.exit(130, f"jaxswarm {args.command}: interrupted{resume}\n")
 
 
 def run_sweep_command(args: argparse.Namespace) -> int:
@@ -125,9 +129,11 @@ def run_demo(args: argparse.Namespace) -> int:
         solution = solutions[label] = swarm.best(state)
         traces[label] = (swarm, state, trace)
         rows.append((label, solution.cost, "-", int(trace.iterations), f"{milliseconds:.2f}"))
-    reference = solutions["Dijkstra"].cost
+    # Gaps compare every path measured one way (float32, moves counted by kind), never below 0.
+    reference = optimal_length(graph, start, goal)
     print(_table(("planner", "length", "gap", "expanded", "iterations", "time [ms]"),
-                 [(label, _fmt(cost), _gap(cost, reference), *rest)
+                 [(label, _fmt(cost), _gap(float(path_length(graph, solutions[label].path)),
+                                           reference), *rest)
                   for label, cost, *rest in rows]))
     field = float(optimum(graph, as_node(graph, start), as_node(graph, goal)))
     print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
@@ -173,6 +179,8 @@ def _load(args):
     if args.map.endswith(".map"):
         if args.start is None or args.goal is None:
             raise ValueError("--start and --goal are required with a .map file")
+        if not Path(args.map).is_file():
+            raise ValueError(f"--map {args.map}: no such file")
         return Path(args.map).stem, load_map(args.map), args.start, args.goal
     raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)} or a .map file, "
                      f"got {args.map!r}")

@@ -5,6 +5,8 @@ import pytest
 
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
+# Where the library looks for Moving AI maps named in sweep specs (it never guesses a folder).
+os.environ.setdefault("JAXSWARM_MOVINGAI", str(MOVINGAI))
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,5 @@
 import re
+from pathlib import Path
 
 import jax.numpy as jnp
 import matplotlib
@@ -11,7 +12,8 @@ from jaxswarm.cli import main  # noqa: E402
 
 def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     out = tmp_path / "demo.png"
-    assert main(["demo", "--map", "maze20", "--repeats", "1", "--out", str(out)]) == 0
+    assert main(["demo", "--map", "maze20", "--repeats", "1", "--drops", "16", "--iterations", "5",
+                 "--out", str(out)]) == 0
     text = capsys.readouterr().out
     lengths = {}
     exact = ("Dijkstra", "A*", "bidirectional A*")
@@ -34,12 +36,46 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
         assert png.read_bytes()[:4] == b"\x89PNG"
 
 
-def test_demo_rejects_unknown_map_with_exit_status_2(capsys):
-    try:
-        main(["demo", "--map", "nowhere"])
-    except SystemExit as stop:
-        assert stop.code == 2
-    assert "--map must be one of" in capsys.readouterr().err
+@pytest.mark.parametrize("arguments, message", [
+    (["--map", "nowhere"], "--map must be one of"),
+    (["--map", "nosuch.map", "--start", "1,1", "--goal", "2,2"], "--map nosuch.map: no such file"),
+    (["--map", "nosuch.map"], "--start and --goal are required with a .map file"),
+])
+def test_demo_rejects_a_bad_map_in_one_line_with_exit_status_2(capsys, arguments, message):
+    with pytest.raises(SystemExit) as stop:
+        main(["demo", *arguments])
+    assert stop.value.code == 2
+    error = capsys.readouterr().err
+    assert message in error and "Traceback" not in error and len(error.splitlines()) == 1
+
+
+def test_demo_plans_on_a_moving_ai_map_between_given_cells(tmp_path, capsys):
+    from conftest import MOVINGAI
+    out = tmp_path / "demo.png"
+    assert main(["demo", "--map", str(MOVINGAI / "mapf" / "empty-32-32.map"), "--start", "0,0",
+                 "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8",
+                 "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("map empty-32-32: 32x32, 1024 free cells, start (0, 0) -> goal (5, 3)")
+    dijkstra_row = re.search(r"^Dijkstra\s+(\S+)\s+(\S+)", text, re.MULTILINE)
+    assert dijkstra_row.groups() == (f"{2 + 3 * 2 ** 0.5:.2f}", "+0.00%")  # 3 diagonals, 2 east
+    assert out.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_an_interrupted_sweep_says_in_one_line_that_the_command_resumes(monkeypatch, capsys):
+    import jaxswarm.sweep
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(jaxswarm.sweep, "run_sweep", interrupted)
+    with pytest.raises(SystemExit) as stop:
+        main(["sweep", str(Path(__file__).parents[1] / "sweeps" / "rfd_star_pbase_alpha.toml"),
+              "--no-progress"])
+    assert stop.value.code == 130
+    error = capsys.readouterr().err
+    assert error == ("jaxswarm sweep: interrupted; the finished chunks are kept: run the same "
+                     "command again to resume\n")
 
 
 def test_threads_option_names_a_bad_count_or_a_late_call(capsys):

@@ -1,4 +1,5 @@
 import math
+import re
 
 import numpy as np
 import pytest
@@ -111,3 +112,24 @@ def test_scenario_fields(tmp_path):
     assert rows[0].start == (0, 0) and rows[0].goal == (2, 1) and rows[0].bucket == 3
     assert rows[0].optimal_length == pytest.approx(1 + math.sqrt(2)) and rows[0].line == 2
     assert not rows[1].reachable
+
+
+def test_scenario_rows_are_checked_against_their_map(tmp_path):
+    map_path = tmp_path / "tiny.map"
+    map_path.write_text("type octile\nheight 2\nwidth 3\nmap\n..@\n...\n")
+    obstacles = read_map(map_path)
+    good = "0\ttiny.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
+    rows = {"blocked start": ("0\ttiny.map\t3\t2\t2\t0\t0\t1\t2.0\n", "start (2, 0) is an obstacle"),
+            "goal outside": ("0\ttiny.map\t3\t2\t0\t0\t3\t1\t3.0\n",
+                             "goal (3, 1) is outside the row's 3x2 map"),
+            "other size": ("0\ttiny.map\t4\t2\t0\t0\t2\t1\t2.4\n",
+                           "the row is for a 4x2 map, the map is 3x2")}
+    scen = tmp_path / "tiny.map.scen"
+    scen.write_text("version 1\n" + good)
+    assert load_scenarios(scen, obstacles)[0].goal == (2, 1)
+    for bad, message in rows.values():
+        scen.write_text("version 1\n" + good + bad)
+        load_scenarios(scen)  # without the map, only the format is checked
+        expected = re.escape(f"tiny.map.scen, line 3: {message}")
+        with pytest.raises(MovingAIFormatError, match=expected):
+            load_scenarios(scen, obstacles)

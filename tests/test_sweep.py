@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from jaxswarm.exact import dijkstra
+from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
@@ -102,6 +102,51 @@ def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path):
     assert not out.exists()  # nothing was started
 
 
+def _tiny_movingai(folder):
+    """A 3 x 2 Moving AI map whose second scenario row starts on an obstacle."""
+    (folder / "tiny.map").write_text("type octile\nheight 2\nwidth 3\nmap\n..@\n...\n")
+    (folder / "tiny-even-1.scen").write_text(
+        "version 1\n0\ttiny.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
+        "0\ttiny.map\t3\t2\t2\t0\t0\t1\t2.0\n")
+    (folder / "tiny-random-1.scen").write_text(
+        "version 1\n0\ttiny.map\t3\t2\t2\t1\t0\t0\t2.41421356\n")
+
+
+@pytest.mark.parametrize("entry, message", [
+    ({"movingai": "tiny.map", "scenario": 1},
+     r"sweep.maps\[1\] = .*tiny-even-1.scen, line 3: start \(2, 0\) is an obstacle"),
+    ({"movingai": "tiny.map", "scenario": 9}, r"sweep.maps\[1\] = .*scenario 9 out of range"),
+    ({"movingai": "nowhere.map", "scenario": 0},
+     r"sweep.maps\[1\] = .*Moving AI map 'nowhere.map' not found"),
+    ({"movingai": "tiny.map", "scenario": 0, "scenario_file": "odd"},
+     r"sweep.maps\[1\] = .*no scenario file odd beside it"),
+])
+def test_a_bad_map_entry_is_named_and_leaves_nothing_on_disk(tmp_path, monkeypatch, entry,
+                                                             message):
+    _tiny_movingai(tmp_path)
+    monkeypatch.setenv("JAXSWARM_MOVINGAI", str(tmp_path))
+    spec = spec_from_dict(tiny(sweep={"maps": ["mosaic20", entry]}))
+    out = tmp_path / "out"
+    with pytest.raises(ValueError, match=message):
+        run_sweep(spec, out, progress=False)
+    assert not out.exists()
+
+
+def test_a_moving_ai_entry_chooses_its_scenario_file(tmp_path, monkeypatch):
+    _tiny_movingai(tmp_path)
+    monkeypatch.setenv("JAXSWARM_MOVINGAI", str(tmp_path))
+    entries = [{"movingai": "tiny.map", "scenario": 0},
+               {"movingai": "tiny.map", "scenario": 0, "scenario_file": "random"}]
+    spec = spec_from_dict(tiny(sweep={"maps": entries, "seeds": 1},
+                               params={"p_base": [5.0], "alpha": [2.0]}))
+    frame = run_sweep(spec, tmp_path / "out", progress=False, log=lambda _: None)
+    assert list(frame["map"]) == ["tiny#0", "tiny#0"]
+    # even row 0 goes (0, 0) -> (2, 1), random row 0 (2, 1) -> (0, 0): the same optimum.
+    np.testing.assert_allclose(frame["optimum"], 1 + np.sqrt(2), rtol=1e-6)
+    metadata = json.loads((tmp_path / "out" / "metadata.json").read_text())
+    assert [m["start"] for m in metadata["maps"]] == [[0, 0], [2, 1]]
+
+
 def test_rows_are_tidy_and_match_single_runs(finished):
     spec, out, frame = finished
     assert len(frame) == 2 * spec.num_runs == 24
@@ -114,7 +159,10 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     optimum = dijkstra(graph, chosen.start, chosen.goal).cost
     rows = frame[frame["map"] == "mosaic20"]
     np.testing.assert_allclose(rows["optimum"], optimum, rtol=1e-6)
-    assert (rows["gap"][rows["found"]] > -1e-6).all()
+    # The optimum is measured as swarm paths are (the float32 field gives 18.656853 here, a
+    # path of the optimal moves 18.656855): an optimal run has gap 0, never a negative one.
+    assert (rows["optimum"] == optimal_length(graph, chosen.start, chosen.goal)).all()
+    assert (frame["gap"][frame["found"]] >= 0).all()
     swarm = make("rfd_star", num_agents=8)
     for _, row in rows.iloc[[0, 7, 11]].iterrows():  # a row equals run() with key(seed)
         params = swarm.default_params._replace(p_base=jnp.float32(row.p_base),

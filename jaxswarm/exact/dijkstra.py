@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from jaxswarm.exact.best_first import search
 from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution
+from jaxswarm.paths import Solution, path_length
 
 
 def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Solution:
@@ -23,3 +23,16 @@ def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Soluti
       ValueError: start or goal off the map or blocked.
     """
     return search(graph, start, goal, heuristic_kind="zero", max_len=max_len)
+
+
+def optimal_length(graph: Graph, start, goal) -> float:
+    """The optimum as the swarms measure their paths: Dijkstra's shortest path, its length
+    summed in float32 by :func:`jaxswarm.paths.path_length` (moves counted by kind on grids and
+    path maps). A swarm path is never shorter, so a gap to it is never negative; inf where the
+    goal cannot be reached.
+
+    Raises:
+      ValueError: start or goal off the map or blocked.
+    """
+    solution = dijkstra(graph, start, goal)
+    return float(path_length(graph, solution.path)) if solution.found else float("inf")

@@ -104,8 +104,19 @@ def load_map(path, **grid_options) -> Graph:
     return grid_graph(read_map(path), **grid_options)
 
 
-def load_scenarios(path) -> list[Scenario]:
-    """All rows of a ``.scen`` file, in file order."""
+def load_scenarios(path, obstacles: np.ndarray | None = None) -> list[Scenario]:
+    """All rows of a ``.scen`` file, in file order.
+
+    Args:
+      path: the ``.scen`` file.
+      obstacles: optional bool[H, W] of the map the rows refer to (:func:`read_map`): each row
+        is then checked against it.
+
+    Raises:
+      MovingAIFormatError: a malformed row, or (with ``obstacles``) a row whose size differs
+        from the map's, whose start or goal lies outside its own size, or on an obstacle; the
+        message names the file and line.
+    """
     with open(path, encoding="ascii", errors="replace") as f:
         lines = f.read().splitlines()
     if not lines or not lines[0].startswith("version"):
@@ -126,9 +137,30 @@ def load_scenarios(path) -> list[Scenario]:
             raise MovingAIFormatError(path, number, f"bad optimal length {fields[8]!r}")
         if length == 0 and (sx, sy) != (gx, gy):
             length = math.inf
-        scenarios.append(Scenario(bucket, fields[1], width, height, (sx, sy), (gx, gy), length,
-                                  number))
+        scenario = Scenario(bucket, fields[1], width, height, (sx, sy), (gx, gy), length, number)
+        if obstacles is not None:
+            check_scenario(scenario, obstacles, path)
+        scenarios.append(scenario)
     return scenarios
+
+
+def check_scenario(scenario: Scenario, obstacles: np.ndarray, path) -> None:
+    """Check one row of the ``.scen`` file ``path`` against its map's bool[H, W] obstacles.
+
+    Raises:
+      MovingAIFormatError: the row's size differs from the map's, or its start or goal lies
+        outside it or on an obstacle; the message names the file and line.
+    """
+    height, width = obstacles.shape
+    if (scenario.width, scenario.height) != (width, height):
+        raise MovingAIFormatError(path, scenario.line, f"the row is for a {scenario.width}x"
+                                  f"{scenario.height} map, the map is {width}x{height}")
+    for name, (x, y) in (("start", scenario.start), ("goal", scenario.goal)):
+        if not (0 <= x < width and 0 <= y < height):
+            raise MovingAIFormatError(path, scenario.line, f"{name} ({x}, {y}) is outside the "
+                                      f"row's {width}x{height} map")
+        if obstacles[y, x]:
+            raise MovingAIFormatError(path, scenario.line, f"{name} ({x}, {y}) is an obstacle")
 
 
 def _positive_int(text: str, path, line: int, name: str) -> int:

@@ -2,7 +2,11 @@
 
 An entry is a paper map name (``"mosaic50"``), a seeded random grid
 (``{ random = 50, seed = 3, density = 0.3 }``, corner to corner) or one row of a Moving AI
-scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``).
+scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 counted from 0;
+``scenario_file = "random"`` takes the MAPF set's ``<map>-random-1.scen`` instead of the default
+``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map).
+A relative ``.map`` path is looked up beside the spec, then in the folder that the environment
+variable ``JAXSWARM_MOVINGAI`` names (e.g. ``shared/benchdata/movingai``).
 """
 from __future__ import annotations
 
@@ -12,11 +16,15 @@ from pathlib import Path
 
 from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.maps import movingai
+from jaxswarm.paths import as_node
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.maps.random import random_grid
 
 RANDOM_KEYS = {"random", "seed", "density"}
-MOVINGAI_KEYS = {"movingai", "scenario"}
+MOVINGAI_KEYS = {"movingai", "scenario", "scenario_file"}
+MOVINGAI_DATA = "JAXSWARM_MOVINGAI"
+"""The environment variable naming the folder of Moving AI maps (relative entries are looked up
+there after the spec's own folder)."""
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -68,6 +76,9 @@ def check_map_entry(entry) -> str | None:
             return f"movingai = {entry['movingai']!r}: must name a .map file"
         if not _int_at_least(entry.get("scenario"), 0):
             return "a Moving AI map needs scenario = ROW (a non-negative row of its .scen file)"
+        if not isinstance(entry.get("scenario_file", ""), str):
+            return (f"scenario_file = {entry['scenario_file']!r}: 'even', 'random' or a .scen "
+                    "file beside the map")
         return None
     return f"a map table needs a 'random' or a 'movingai' key, got {sorted(entry)}"
 
@@ -96,37 +107,54 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
             label += f"-d{density:g}"
         return SweepMap(label, grid_graph(grid.obstacles), grid.start, grid.goal)
     map_path = _find_movingai(entry["movingai"], base_dir)
-    scenarios = movingai.load_scenarios(_scenario_file(map_path))
+    obstacles = movingai.read_map(map_path)
+    scenario_path = _scenario_file(map_path, entry.get("scenario_file"))
+    scenarios = movingai.load_scenarios(scenario_path)
     row = entry["scenario"]
     if row >= len(scenarios):
-        raise ValueError(f"{map_path}: scenario {row} out of range ({len(scenarios)} rows)")
+        raise ValueError(f"{scenario_path}: scenario {row} out of range ({len(scenarios)} rows)")
     scenario = scenarios[row]
-    return SweepMap(f"{map_path.stem}#{row}", movingai.load_map(map_path), scenario.start,
+    movingai.check_scenario(scenario, obstacles, scenario_path)
+    return SweepMap(f"{map_path.stem}#{row}", grid_graph(obstacles), scenario.start,
                     scenario.goal)
 
 
+def check_query(sweep_map: SweepMap) -> None:
+    """Check that a resolved map's start and goal are on the map and free.
+
+    Raises:
+      ValueError: naming the endpoint (see :func:`jaxswarm.paths.as_node`).
+    """
+    as_node(sweep_map.graph, sweep_map.start, name="start")
+    as_node(sweep_map.graph, sweep_map.goal, name="goal")
+
+
 def _find_movingai(name: str, base_dir: Path | None) -> Path:
-    shared = Path(os.environ.get("JAXSWARM_SHARED",
-                                 Path(__file__).resolve().parents[3] / "shared"))
+    folder = os.environ.get(MOVINGAI_DATA)
     candidates = [Path(name)] if Path(name).is_absolute() else [
-        *([base_dir / name] if base_dir else []), shared / "benchdata" / "movingai" / name]
+        *([base_dir / name] if base_dir else []), *([Path(folder) / name] if folder else []),
+        *([] if base_dir else [Path(name)])]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
+    hint = "" if folder else f"; set {MOVINGAI_DATA} to the folder of the Moving AI maps"
     raise ValueError(f"Moving AI map {name!r} not found (looked in "
-                     f"{', '.join(str(c) for c in candidates)})")
+                     f"{', '.join(str(c) for c in candidates)}){hint}")
 
 
-def _scenario_file(map_path: Path) -> Path:
-    """``<map>.scen``, else the first ``<stem>*.scen`` beside the map (the MAPF set names them
-    ``<stem>-even-1.scen``)."""
-    beside = Path(str(map_path) + ".scen")
-    if beside.is_file():
-        return beside
-    found = sorted(map_path.parent.glob(f"{map_path.stem}*.scen"))
-    if not found:
-        raise ValueError(f"{map_path}: no scenario file beside it")
-    return found[0]
+def _scenario_file(map_path: Path, choice: str | None) -> Path:
+    """The scenario file of a map: ``choice`` "even" or "random" (the MAPF set's
+    ``<stem>-even-1.scen``, ``<stem>-random-1.scen``), a file name beside the map, or by default
+    ``<map>.scen``, else ``<stem>-even-1.scen``."""
+    if choice in (None, "even", "random"):
+        names = ([f"{map_path.name}.scen"] if choice is None else []) + [
+            f"{map_path.stem}-{choice or 'even'}-1.scen"]
+    else:
+        names = [choice]
+    for name in names:
+        if (map_path.parent / name).is_file():
+            return map_path.parent / name
+    raise ValueError(f"{map_path}: no scenario file {' or '.join(names)} beside it")
 
 
 def _int_at_least(value, low: int) -> bool:

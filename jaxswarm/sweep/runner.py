@@ -11,8 +11,8 @@ Maps of the same shape share the compiled program; each compile is logged. A run
 ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
 whatever the chunk size, the group size and the number of devices.
 
-Each map's optimum comes from the batched distance field, so every row carries its optimality
-gap. Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec
+Each map's optimum is Dijkstra's path measured as the swarms measure theirs
+(:func:`jaxswarm.exact.optimal_length`), so every row carries its optimality gap, never negative. Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec
 again skips them.
 """
 from __future__ import annotations
@@ -32,9 +32,9 @@ import pandas as pd
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
-from jaxswarm.exact.field import optimum
+from jaxswarm.exact import optimal_length
 from jaxswarm.swarm import definition, make, make_task, run
-from jaxswarm.sweep.maps import SweepMap, resolve_map
+from jaxswarm.sweep.maps import SweepMap, check_query, resolve_map
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
 
@@ -72,7 +72,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     """
     out = Path(out) if out is not None else default_out(spec)
     base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
-    maps = [resolve_map(entry, base_dir) for entry in spec.maps]
+    maps = _resolve_maps(spec, base_dir)  # every entry checked before anything is written
     writer = jax.process_index() == 0
     swarm = make(spec.algorithm, **spec.config)
     store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, swarm), writer=writer)
@@ -101,7 +101,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
             if not todo:
                 continue
             task = make_task(sweep_map.graph, sweep_map.start, sweep_map.goal)
-            best = float(optimum(sweep_map.graph, task.start, task.goal))
+            best = optimal_length(sweep_map.graph, sweep_map.start, sweep_map.goal)
             graph, task = jax.device_put((sweep_map.graph, task), replicated)
             program = _program_key(sweep_map.graph)
             if program not in compiled:
@@ -126,6 +126,23 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     finally:
         bar.close()
     return read_results(out)
+
+
+def _resolve_maps(spec: SweepSpec, base_dir: Path | None) -> list[SweepMap]:
+    """Every map of the spec, resolved and its start and goal checked.
+
+    Raises:
+      ValueError: naming the spec file, the entry (``sweep.maps[i]``) and the problem.
+    """
+    maps = []
+    for i, entry in enumerate(spec.maps):
+        try:
+            sweep_map = resolve_map(entry, base_dir)
+            check_query(sweep_map)
+        except ValueError as error:
+            raise ValueError(f"{spec.source}: sweep.maps[{i}] = {entry!r}: {error}") from None
+        maps.append(sweep_map)
+    return maps
 
 
 def _program_key(graph) -> tuple:

@@ -25,9 +25,11 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
 
 Params not named keep the swarm's defaults. Maps: a paper map name (``mosaic20`` ...), a seeded
 random grid ``{ random = SIZE, seed = S, density = 0.3 }``, or a Moving AI map with one row of its
-scenario file ``{ movingai = "PATH.map", scenario = ROW }`` (a relative PATH is looked up beside
-the spec, then under ``$JAXSWARM_SHARED/benchdata/movingai``). Every mistake raises
-:class:`SpecError` naming the file and the key.
+scenario file ``{ movingai = "PATH.map", scenario = ROW, scenario_file = "even" }`` (see
+:mod:`jaxswarm.sweep.maps`; a relative PATH is looked up beside the spec, then in the folder
+``$JAXSWARM_MOVINGAI`` names). Every mistake raises :class:`SpecError` naming the file and the
+key; a map whose file, scenario row, start or goal is wrong is named with its entry when the
+sweep starts, before anything is written.
 """
 from __future__ import annotations
 
