@@ -90,7 +90,7 @@ def run_sweep_command(args: argparse.Namespace) -> int:
     frame = run_sweep(spec, out, progress=not args.no_progress)
     swept = list(spec.params)
     if swept and not args.no_plots:
-        for path in plot_sweep(frame, swept, out):
+        for path in plot_sweep(frame, swept, out, spec.log_scale):
             print(f"wrote {path}")
     table = summary(frame, ["map", *swept])
     best = table.sort_values(["success", "gap"], ascending=[False, True]).groupby(

@@ -42,7 +42,8 @@ def heatmap_figure(frame: pd.DataFrame, x: str, y: str, metric: str = "success")
         raise ValueError(f"metric must be one of {', '.join(METRICS)}, got {metric!r}")
     table = summary(frame, ["map", y, x])
     maps = list(dict.fromkeys(frame["map"]))
-    fig, axes = plt.subplots(1, len(maps), figsize=(4.2 * len(maps), 3.8), squeeze=False)
+    fig, axes = plt.subplots(1, len(maps), figsize=(4.4 * len(maps), 3.8), squeeze=False,
+                             layout="constrained")  # keeps each colour bar clear of the next map
     for ax, name in zip(axes[0], maps):
         grid = table[table["map"] == name].pivot(index=y, columns=x, values=metric)
         image = ax.imshow(grid.to_numpy(dtype=float), origin="lower", aspect="auto",
@@ -58,37 +59,40 @@ def heatmap_figure(frame: pd.DataFrame, x: str, y: str, metric: str = "success")
             ax.text(col, row, "n/a" if np.isnan(value) else f"{value:.2f}", ha="center",
                     va="center", fontsize=7, color="black",
                     path_effects=[patheffects.withStroke(linewidth=2, foreground="white")])
-        fig.colorbar(image, ax=ax, shrink=0.8)
-    fig.tight_layout()
+        fig.colorbar(image, ax=ax, shrink=0.8, label=METRICS[metric])
     return fig
 
 
-def line_figure(frame: pd.DataFrame, x: str):
-    """A figure with one panel per map: the mean gap over param ``x`` with a band of one
-    standard deviation over seeds, and the success rate on a second axis."""
+def line_figure(frame: pd.DataFrame, x: str, *, log: bool = False):
+    """A figure with one panel per map: the mean gap over param ``x`` (on a log axis if
+    ``log``) with a band of one standard deviation over seeds, and the success rate on a second
+    axis."""
     table = summary(frame, ["map", x])
     maps = list(dict.fromkeys(frame["map"]))
-    fig, axes = plt.subplots(1, len(maps), figsize=(4.2 * len(maps), 3.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(maps), figsize=(4.4 * len(maps), 3.4), squeeze=False,
+                             layout="constrained")
     for ax, name in zip(axes[0], maps):
         rows = table[table["map"] == name]
         ax.plot(rows[x], rows["gap"], marker="o", color="tab:blue", label="mean gap")
         ax.fill_between(rows[x], rows["gap"] - rows["gap_std"], rows["gap"] + rows["gap_std"],
                         color="tab:blue", alpha=0.2)
         ax.set_xlabel(x)
+        if log:
+            ax.set_xscale("log")
         ax.set_ylabel("gap to the optimum", color="tab:blue")
         rate = ax.twinx()
         rate.plot(rows[x], rows["success"], marker="s", color="tab:green", label="success")
         rate.set_ylim(-0.05, 1.05)
         rate.set_ylabel("success rate", color="tab:green")
         ax.set_title(name, fontsize=10)
-    fig.tight_layout()
     return fig
 
 
-def plot_sweep(frame: pd.DataFrame, params: list[str], out_dir) -> list[Path]:
+def plot_sweep(frame: pd.DataFrame, params: list[str], out_dir,
+               log_scale=frozenset()) -> list[Path]:
     """Write the standard figures of a sweep next to its results and return their paths:
     heat maps of success and gap over the first two swept ``params`` (if two or more), and one
-    line figure per swept param."""
+    line figure per swept param (on a log axis for those in ``log_scale``, e.g. the spec's)."""
     out_dir = Path(out_dir)
     for name in params:
         _check_columns(frame, name)
@@ -101,7 +105,7 @@ def plot_sweep(frame: pd.DataFrame, params: list[str], out_dir) -> list[Path]:
             written.append(path)
     for name in params:
         path = out_dir / f"line_{name}.png"
-        _save(line_figure(frame, name), path)
+        _save(line_figure(frame, name, log=name in log_scale), path)
         written.append(path)
     return written
 

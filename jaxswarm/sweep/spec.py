@@ -80,6 +80,8 @@ class SweepSpec:
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).
       source: the file it came from (or "<dict>").
+      log_scale: the swept params given as a ``log = true`` range (figures draw them on a
+        log axis).
     """
 
     name: str
@@ -93,6 +95,7 @@ class SweepSpec:
     params: dict
     source: str = "<dict>"
     vmap_size: int = DEFAULT_VMAP_SIZE
+    log_scale: frozenset = frozenset()
 
     def grid(self) -> list[dict[str, float]]:
         """Every combination of the swept params, in a fixed order (the last param varies
@@ -206,7 +209,9 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         checked[key] = _values(value, f"params.{key}", fail)
     spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds,
                      iterations=iterations, patience=patience, chunk_size=chunk_size,
-                     vmap_size=vmap_size, config=dict(config), params=checked, source=source)
+                     vmap_size=vmap_size, config=dict(config), params=checked, source=source,
+                     log_scale=frozenset(k for k, v in params.items()
+                                         if isinstance(v, dict) and v.get("log", False)))
     for combination in spec.grid():  # out-of-range values fail here, before any compute
         try:
             swarm.check_params(swarm.default_params._replace(
