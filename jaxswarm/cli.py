@@ -46,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
                              "single runs on a few cores, see jaxswarm.cpu")
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
-    demo.add_argument("--map", default="maze50",
+    demo.add_argument("--map", default="mosaic50",
                       help=f"a paper map ({', '.join(PAPER_MAPS)}) or a Moving AI .map file")
     demo.add_argument("--start", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
@@ -55,7 +55,9 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--drops", type=int, default=256,
                       help="agents per swarm iteration (Improved Max-Min ACO keeps its 50)")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
-    demo.add_argument("--out", type=Path, default=Path("out/demo.png"), help="figure path")
+    demo.add_argument("--out", type=Path,
+                      help="figure path (default out/demo_MAP.png); each swarm's figure is "
+                           "written beside it with the swarm's name appended")
     sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
     sweep.add_argument("file", type=Path, help="the sweep spec (TOML)")
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
@@ -139,12 +141,13 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"optimum from the batched JAX distance field (float32): {_fmt(field)}")
     print("(paper): the paper's algorithm as written; (ours): jaxswarm's own algorithm\n"
           "no path: no agent reached the goal within the iterations")
-    fig = plot_solutions(graph, solutions, start=start, goal=goal, path=args.out,
+    figure = args.out if args.out is not None else Path("out") / f"demo_{name}.png"
+    fig = plot_solutions(graph, solutions, start=start, goal=goal, path=figure,
                          title=f"{name}: exact and swarm planners")
     plt.close(fig)
-    print(f"figure written to {args.out}")
+    print(f"figure written to {figure}")
     for label, (swarm, state, trace) in traces.items():
-        out = args.out.with_name(f"{args.out.stem}_{swarm.name}{args.out.suffix}")
+        out = figure.with_name(f"{figure.stem}_{swarm.name}{figure.suffix}")
         fig = plot_swarm_run(graph, swarm.memory(state), solutions[label], trace, start=start,
                              goal=goal, optimum=reference, field_label=swarm.memory_label,
                              title=f"{name}: {label}", path=out)

@@ -49,17 +49,18 @@ def test_demo_rejects_a_bad_map_in_one_line_with_exit_status_2(capsys, arguments
     assert message in error and "Traceback" not in error and len(error.splitlines()) == 1
 
 
-def test_demo_plans_on_a_moving_ai_map_between_given_cells(tmp_path, capsys):
+def test_demo_plans_on_a_moving_ai_map_between_given_cells(tmp_path, capsys, monkeypatch):
     from conftest import MOVINGAI
-    out = tmp_path / "demo.png"
+    monkeypatch.chdir(tmp_path)
     assert main(["demo", "--map", str(MOVINGAI / "mapf" / "empty-32-32.map"), "--start", "0,0",
-                 "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8",
-                 "--out", str(out)]) == 0
+                 "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8"]) == 0
+    out = tmp_path / "out" / "demo_empty-32-32.png"  # the figures carry the map's name
     text = capsys.readouterr().out
     assert text.startswith("map empty-32-32: 32x32, 1024 free cells, start (0, 0) -> goal (5, 3)")
     dijkstra_row = re.search(r"^Dijkstra\s+(\S+)\s+(\S+)", text, re.MULTILINE)
     assert dijkstra_row.groups() == (f"{2 + 3 * 2 ** 0.5:.2f}", "+0.00%")  # 3 diagonals, 2 east
     assert out.read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "out" / "demo_empty-32-32_rfd_graded.png").is_file()
 
 
 def test_an_interrupted_sweep_says_in_one_line_that_the_command_resumes(monkeypatch, capsys):
