@@ -82,7 +82,9 @@ def test_shape_and_endpoints(name):
 def test_optimum_near_paper(name):
     length = optimum(name)
     assert math.isfinite(length), "goal unreachable"
-    assert abs(length / PAPER_OPTIMA[name] - 1.0) <= 0.25, (length, PAPER_OPTIMA[name])
+    # Our maps are rebuilt from the paper's figures: every optimum is within 4.6 % of its
+    # Table 1 value (maze50, 218 against 228.52, is the farthest).
+    assert abs(length / PAPER_OPTIMA[name] - 1.0) <= 0.05, (length, PAPER_OPTIMA[name])
 
 
 @pytest.mark.parametrize("name", PAPER_MAPS)

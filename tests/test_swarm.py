@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from jaxswarm import swarm as swarms
-from jaxswarm.exact import dijkstra
+from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import Solution, is_valid_path, path_length
@@ -29,8 +29,8 @@ SMALL = dict(num_agents=32)
 def maze():
     chosen = paper_map("maze20")
     graph = chosen.graph()
-    return graph, make_task(graph, chosen.start, chosen.goal), dijkstra(graph, chosen.start,
-                                                                         chosen.goal).cost
+    return graph, make_task(graph, chosen.start, chosen.goal), optimal_length(
+        graph, chosen.start, chosen.goal)
 
 
 def leaves_equal(a, b):
@@ -60,8 +60,9 @@ def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
     for i in range(3):
         assert leaves_equal(key_data(jax.tree_util.tree_map(lambda x: x[i], batch)),
                             key_data(one[i]))
-    assert not leaves_equal(one[0][0].best_path, one[1][0].best_path) or \
-        not leaves_equal(key_data(one[0][0]).key, key_data(one[1][0]).key)
+    # Another key walks other agents: the memory or the share that arrived differs.
+    assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
+                            (swarm.memory(one[1][0]), one[1][1].arrived))
 
 
 @pytest.mark.parametrize("name", swarms.registered())
@@ -71,6 +72,7 @@ def test_results_are_valid_and_never_beat_the_optimum(name, maze):
     state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                        iterations=ITERATIONS)
     solution = swarm.best(state)
+    assert bool(solution.found)  # maze20 is found by every swarm within a few iterations
     assert all(np.isfinite(np.asarray(leaf)).all() for leaf in jax.tree_util.tree_leaves(state)
                if jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0)
     ran = int(trace.iterations)
@@ -78,12 +80,10 @@ def test_results_are_valid_and_never_beat_the_optimum(name, maze):
     best = np.asarray(trace.best_cost)
     assert np.isnan(best[ran:]).all()
     assert (best[1:ran] <= best[:ran - 1]).all()  # best so far never gets worse
-    if bool(solution.found):
-        assert bool(is_valid_path(graph, solution.path, task.start, task.goal))
-        assert float(path_length(graph, solution.path)) == pytest.approx(float(solution.cost),
-                                                                          rel=1e-5)
-        assert float(solution.cost) >= optimum * (1 - 1e-6)
-        assert float(solution.cost) == best[ran - 1]
+    assert bool(is_valid_path(graph, solution.path, task.start, task.goal))
+    assert float(path_length(graph, solution.path)) == float(solution.cost)  # measured alike
+    assert float(solution.cost) >= optimum
+    assert float(solution.cost) == best[ran - 1]
 
 
 @pytest.mark.parametrize("name", swarms.registered())
@@ -95,13 +95,15 @@ def test_a_sweep_over_sixteen_params_compiles_once(name, maze):
     counted = type(swarm)(**{**swarm.__dict__, "step": lambda *a: (traces.append(1),
                                                                      original_step(*a))[1]})
     first = swarm.default_params._fields[0]
-    values = jnp.linspace(1.5, 40.0, 16)
+    values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, 16)
+    for value in values:  # valid values: every run of the sweep is one the swarm accepts
+        swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
     grid = jax.tree_util.tree_map(lambda x: jnp.full((16,), x), counted.default_params)
-    grid = grid._replace(**{first: values})
+    grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
     sweep = jax.jit(jax.vmap(lambda p: run(counted, jax.random.key(0), graph, task, p,
                                            iterations=4)[0].best_cost))
     costs = sweep(grid)
-    sweep(grid._replace(**{first: values + 1.0}))  # new values, same shapes: no retrace
+    sweep(grid._replace(**{first: grid[0] * 0.9}))  # new values, same shapes: no retrace
     assert len(traces) == 1 and costs.shape == (16,)
 
 
@@ -117,23 +119,6 @@ def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once(maze):
     compiled(grid)
     compiled(jax.tree_util.tree_map(lambda x: x * 1.01, grid))
     assert compiled._cache_size() - before == 1
-
-
-def test_erosion_and_deposits_follow_the_paper(maze):
-    graph, task, _ = maze
-    swarm = make("rfd_star", num_agents=64)
-    params = swarm.default_params
-    state = swarm.init(jax.random.key(0), graph, task, params)
-    altitude = np.asarray(state.altitude)
-    assert altitude[int(task.goal)] == 0.0
-    others = np.arange(graph.num_nodes) != int(task.goal)
-    assert (altitude[others] == float(params.initial_height)).all()
-    for _ in range(5):
-        state, info = swarm.step(state, graph, task, params)
-    altitude = np.asarray(state.altitude)
-    assert altitude[int(task.goal)] == 0.0 and (altitude >= 0).all()
-    assert not np.allclose(altitude, float(params.initial_height))  # erosion or deposits acted
-    assert 0.0 <= float(info.arrived) <= 1.0
 
 
 @pytest.mark.parametrize("law", ["linear", "exponential"])
