@@ -184,6 +184,23 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
 
 
+def test_a_sweep_with_patience_stops_its_runs_as_run_does(tmp_path):
+    spec = spec_from_dict(tiny(sweep={"maps": ["mosaic20"], "seeds": 2, "iterations": 40,
+                                      "patience": 3},
+                               params={"p_base": [20.0], "alpha": [8.0]}))
+    frame = run_sweep(spec, tmp_path / "out", progress=False, log=lambda _: None)
+    chosen = paper_map("mosaic20")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    swarm = make("rfd_star", num_agents=8)
+    params = swarm.default_params._replace(p_base=np.float32(20.0), alpha=np.float32(8.0))
+    for _, row in frame.iterrows():
+        state, trace = run(swarm, jax.random.key(int(row.seed)), graph, task, params,
+                           iterations=40, patience=3)
+        assert row.iterations == int(trace.iterations) and row.cost == float(state.best_cost)
+    assert (frame["iterations"] < 40).all()  # patience, not the budget, stopped them
+
+
 def test_same_spec_resumes_without_recomputing_and_other_spec_is_refused(finished):
     spec, out, frame = finished
     stamps = {p.name: p.stat().st_mtime_ns for p in (out / "runs").glob("*.parquet")}
