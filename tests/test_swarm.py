@@ -510,6 +510,7 @@ SPREAD = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_spreading_the_agents_over_two_cpu_devices_changes_no_result():
     tests = Path(__file__).resolve().parent
     done = subprocess.run([sys.executable, "-c", SPREAD.format(tests=str(tests))],

@@ -272,8 +272,8 @@ def _colony(name: str, config, *, default_params, update, init_best=None, direct
         return ACOState(key=key, pheromone=pheromone, best_path=best_path,
                         best_cost=best_cost), info
 
-    return Swarm(name=name, config=config, init=init, step=step, best=best_solution,
-                 default_params=default_params, check_params=_check,
+    return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
+                 best=best_solution, default_params=default_params, check_params=_check,
                  memory=lambda state: state.pheromone.sum(axis=-1),
                  memory_label="pheromone on a node's edges")
 

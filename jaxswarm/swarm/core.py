@@ -69,7 +69,9 @@ class Swarm:
     """A swarm algorithm: pure functions over (State, Graph, Task, Params).
 
     Hashable by identity (it is a static argument of ``run``); factories are cached per Config, so
-    equal configs give the same Swarm and share compiled code.
+    equal configs give the same Swarm and share compiled code. ``init`` and ``step`` are jitted,
+    so stepping a swarm by hand (one iteration at a time, from Python) compiles once per map
+    shape too.
 
     Attributes:
       name: registry name.

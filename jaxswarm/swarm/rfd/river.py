@@ -88,8 +88,8 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
         return RFDState(key=key, altitude=altitude, best_path=best_path,
                         best_cost=best_cost), info
 
-    return Swarm(name=name, config=config, init=init, step=step, best=best_solution,
-                 default_params=default_params, check_params=check_params,
+    return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
+                 best=best_solution, default_params=default_params, check_params=check_params,
                  memory=lambda state: state.altitude, memory_label="altitude")
 
 
