@@ -26,11 +26,6 @@ from jaxswarm.paths import as_node, path_length
 from jaxswarm.swarm import make, make_task, registry, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
-OWN_POPULATION = {"improved_max_min_aco"}
-"""Swarms that keep their own agent count (the Max-Min ACO paper's populations of 50 ants)
-instead of ``--drops``."""
-
-
 def swarm_label(name: str) -> str:
     """A registered swarm's name in tables: its label and whether it is a paper's algorithm as
     written ("paper") or this project's own ("ours")."""
@@ -52,8 +47,9 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--repeats", type=int, default=5, help="runs per planner (median time)")
     demo.add_argument("--seed", type=int, default=0, help="PRNG seed of the swarm planners")
-    demo.add_argument("--drops", type=int, default=256,
-                      help="agents per swarm iteration (Improved Max-Min ACO keeps its 50)")
+    demo.add_argument("--drops", type=int,
+                      help="agents per swarm iteration (default: each swarm's own, e.g. 256 "
+                           "drops, the Max-Min ACO paper's 50 ants)")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
     demo.add_argument("--out", type=Path,
                       help="figure path (default out/demo_MAP.png); each swarm's figure is "
@@ -125,7 +121,7 @@ def run_demo(args: argparse.Namespace) -> int:
         rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
     for name_in_registry in registry.REGISTRY:
         label = swarm_label(name_in_registry)
-        config = {} if name_in_registry in OWN_POPULATION else dict(num_agents=args.drops)
+        config = {} if args.drops is None else dict(num_agents=args.drops)
         swarm = make(name_in_registry, **config)
         state, trace, milliseconds = _run_swarm(swarm, graph, start, goal, args)
         solution = solutions[label] = swarm.best(state)

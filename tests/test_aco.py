@@ -68,7 +68,7 @@ def test_bad_params_are_named():
 
 @pytest.mark.parametrize("first_ant", ["weighted", "greedy"])
 def test_improved_max_min_starts_from_its_first_ants_path_and_keeps_the_floor(first_ant):
-    from jaxswarm.swarm.bug2 import bug2_path
+    from jaxswarm.swarm.aco.bug2 import bug2_path
 
     chosen = paper_map("alley20")
     graph = chosen.graph()

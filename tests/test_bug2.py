@@ -5,7 +5,7 @@ from jaxswarm.exact import dijkstra
 from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.random import random_grid, random_path_map
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.bug2 import bug2_path
+from jaxswarm.swarm.aco.bug2 import bug2_path
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -25,7 +25,7 @@ from jaxswarm.exact import dijkstra
 from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.swarm import aco, make, make_task
-from jaxswarm.swarm.bug2 import first_ant_path
+from jaxswarm.swarm.aco.bug2 import first_ant_path
 from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDStarParams,
                                 blind_alleys, carve, erode_banks, erode_eq4, graded_transition,
                                 rfd_star_transition, rfd_transition, settle)

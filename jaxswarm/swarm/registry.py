@@ -13,8 +13,8 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from jaxswarm.swarm import aco
-from jaxswarm.swarm.core import Swarm
+from jaxswarm.swarm.aco import ant_system, improved, max_min
+from jaxswarm.swarm.core import Swarm, SwarmConfig
 from jaxswarm.swarm.rfd import graded, paper
 
 
@@ -37,18 +37,18 @@ class Entry(NamedTuple):
 
 
 REGISTRY: dict[str, Entry] = {
-    "rfd": Entry(paper.RFDConfig, paper.build_rfd, "RFD", "RFD paper, eqs. 1-5"),
+    "rfd": Entry(SwarmConfig, paper.build_rfd, "RFD", "RFD paper, eqs. 1-5"),
     "rfd_star": Entry(paper.RFDStarConfig, paper.build_rfd_star, "RFD*",
                       "RFD paper, eq. 6 with eqs. 4-5"),
     "rfd_graded": Entry(graded.GradedConfig, graded.build_rfd_graded, "RFD graded",
                         "jaxswarm: RFD*'s eq. 6 over a graded river bed", faithful=False),
-    "ant_system": Entry(aco.AntSystemConfig, aco.build_ant_system, "Ant System",
+    "ant_system": Entry(SwarmConfig, ant_system.build_ant_system, "Ant System",
                         "RFD paper, eqs. 7-9"),
-    "aco_star": Entry(aco.AntSystemConfig, aco.build_aco_star, "ACO*",
+    "aco_star": Entry(SwarmConfig, ant_system.build_aco_star, "ACO*",
                       "RFD paper, ACO*: eq. 7 over the goal distance"),
-    "max_min_aco": Entry(aco.MaxMinConfig, aco.build_max_min_aco, "Max-Min ACO",
+    "max_min_aco": Entry(max_min.MaxMinConfig, max_min.build_max_min_aco, "Max-Min ACO",
                          "Max-Min ACO paper, section 4"),
-    "improved_max_min_aco": Entry(aco.ImprovedConfig, aco.build_improved_max_min_aco,
+    "improved_max_min_aco": Entry(improved.ImprovedConfig, improved.build_improved_max_min_aco,
                                   "Improved Max-Min ACO", "Max-Min ACO paper, Algorithm 1"),
 }
 """Registered name -> :class:`Entry`."""

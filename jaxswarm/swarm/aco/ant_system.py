@@ -1,0 +1,73 @@
+"""The RFD paper's ant colonies: Ant System (eqs. 7-9) and ACO*.
+
+* ``ant_system``: each ant at ``i`` moves to ``j`` with probability ``tau_ij / sum_l tau_il``
+  (eq. 7: ``alpha = 1``, ``beta = 0``; ``eta_ij = 1 / length(i, j)`` with ``beta > 0`` is an
+  option). After the walk, evaporation ``tau <- (1 - rho) tau`` (eq. 9) and, for every ant that
+  reached the goal, ``Q / f(S)`` on each edge of its path ``S`` of length ``f(S)`` (eq. 8).
+* ``aco_star``: Ant System divided by ``d_j ** alpha_goal``, the straight-line distance from
+  ``j`` to the goal, "as in the denominator of eq. 6". It divides by ``d_goal = 0``, so the goal
+  is taken whenever adjacent.
+"""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.swarm.aco.colony import colony, deposit, f32
+from jaxswarm.swarm.core import Swarm, SwarmConfig
+
+
+class AntSystemParams(NamedTuple):
+    """Numbers of Ant System (f32 scalars, traced).
+
+    Attributes:
+      rho: evaporation rate in (0, 1] (eq. 9).
+      q: Q, the deposit numerator (eq. 8: a path of length f deposits Q / f per edge).
+      alpha: pheromone exponent (1 in eq. 7).
+      beta: exponent of eta = 1 / edge length (0 in eq. 7).
+      tau0: initial pheromone on every edge.
+    """
+
+    rho: jax.Array
+    q: jax.Array
+    alpha: jax.Array
+    beta: jax.Array
+    tau0: jax.Array
+
+
+class ACOStarParams(NamedTuple):
+    """Numbers of ACO*: Ant System's and ``alpha_goal``, the exponent of the goal distance."""
+
+    rho: jax.Array
+    q: jax.Array
+    alpha: jax.Array
+    beta: jax.Array
+    alpha_goal: jax.Array
+    tau0: jax.Array
+
+
+DEFAULT_ANT_SYSTEM = f32(AntSystemParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, tau0=1.0)
+DEFAULT_ACO_STAR = f32(ACOStarParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, alpha_goal=50.0,
+                       tau0=1.0)
+"""The paper gives eq. 7's exponents (alpha = 1, beta = 0); rho, Q, tau0 and alpha_goal are
+ours."""
+
+
+def ant_system_update(graph, pheromone, ants, best_path, best_cost, info, params):
+    """Eq. 9, then eq. 8 for every ant that arrived: f32[N, K] pheromone."""
+    return deposit(graph, (1.0 - params.rho) * pheromone, ants.path[:, :-1], ants.slots,
+                   jnp.where(ants.arrived, params.q / ants.length, 0.0))
+
+
+def build_ant_system(config: SwarmConfig) -> Swarm:
+    """Ant System (RFD paper eqs. 7-9), with :class:`AntSystemParams`."""
+    return colony("ant_system", config, default_params=DEFAULT_ANT_SYSTEM,
+                  update=ant_system_update)
+
+
+def build_aco_star(config: SwarmConfig) -> Swarm:
+    """ACO*: Ant System with the goal-distance heuristic, with :class:`ACOStarParams`."""
+    return colony("aco_star", config, default_params=DEFAULT_ACO_STAR,
+                  update=ant_system_update, goal_distance=True)
