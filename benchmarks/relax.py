@@ -1,6 +1,6 @@
 """Time of the two relaxations to a fixpoint: the batched distance field and rfd_graded's settling.
 
-Both run Jacobi sweeps over each node's cheapest neighbour (:func:`jaxswarm.graph.relax`):
+Both run Jacobi sweeps over each node's cheapest neighbour (:func:`jaxswarm.relax.relax`):
 
 * ``distance_field``: the distance from every node to the goal of each paper map (``--maps``),
   the optimum each sweep row carries;

@@ -5,14 +5,9 @@ An ``N``-node map whose nodes have at most ``K`` neighbours is stored as fixed-s
 derived on the fly by :meth:`Graph.valid_edges`, so blocking a cell or closing a thin wall is a
 write into ``free`` or ``open`` and never changes a shape (see :mod:`jaxswarm.edits`).
 
-Grid direction order (defined once, here): the four orthogonal moves first, then the diagonals,
-with ``y`` growing downwards (row index)::
-
-    k:   0  1  2  3   4   5   6   7
-         E  S  W  N   SE  SW  NW  NE
-
-so a 4-connected grid uses the first four slots and ``OPPOSITE[k]`` is the reverse move.
-Conventions follow the Moving AI benchmark: 8-connected, diagonal cost sqrt(2), no corner cutting.
+Direction slots and move lengths are in :mod:`jaxswarm.lattice`, the min-plus relaxation over
+neighbours in :mod:`jaxswarm.relax`. Conventions follow the Moving AI benchmark: 8-connected,
+diagonal cost sqrt(2), no corner cutting.
 """
 from __future__ import annotations
 
@@ -23,16 +18,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-DIRECTIONS = np.array(
-    [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)], dtype=np.int32
-)
-"""i32[8, 2]: the (dx, dy) of each grid direction slot."""
-DIRECTION_NAMES = ("E", "S", "W", "N", "SE", "SW", "NW", "NE")
-ORTHOGONAL_SLOTS = 4
-"""The first four slots are the orthogonal moves (length 1), the rest diagonal (sqrt 2)."""
-SQRT2 = np.float32(math.sqrt(2.0))
-OPPOSITE = np.array([2, 3, 0, 1, 6, 7, 4, 5], dtype=np.int32)
-"""i32[8]: ``OPPOSITE[k]`` is the slot of the move that undoes move ``k``."""
+from jaxswarm.lattice import DIRECTIONS, OPPOSITE
+
 NO_NODE = -1
 """Sentinel for 'no neighbour' in ``nbr``, ``corner`` and ``rev``, and for padding in paths."""
 MAX_DENSE_NODES = 4096
@@ -45,7 +32,7 @@ class Graph:
     Attributes:
       nbr: i32[N, K] neighbour node of each slot, ``NO_NODE`` (-1) where the lattice has none.
       cost: f32[N, K] edge length (on grids and path maps the length of the slot's move, 1 or
-        sqrt 2, see :func:`slot_lengths`; any positive weight on dense graphs); 0 where ``nbr``
+        sqrt 2, see :func:`jaxswarm.lattice.slot_lengths`; any positive weight on dense graphs); 0 where ``nbr``
         is -1.
       xy: f32[N, 2] node coordinates, x = column, y = row for grids.
       free: bool[N] passable nodes (edited at run time).
@@ -103,173 +90,6 @@ class Graph:
                       np.asarray(self.cost, dtype=np.float64)[rows, slots])
         np.fill_diagonal(dense, 0.0)
         return dense
-
-
-def straight_line(graph: Graph, node) -> jax.Array:
-    """f32[N]: the straight-line (Cartesian) distance from every node's ``xy`` to that of
-    ``node`` (i32[], may be traced): the goal-distance heuristic of RFD* and ACO*."""
-    return jnp.linalg.norm(graph.xy - graph.xy[node], axis=-1)
-
-
-def slot_offsets(graph: Graph) -> np.ndarray:
-    """i32[K] (static, host side): on a grid or path map, how far along the node numbering
-    each slot's neighbour lies, ``dx + W dy``: node ``i``'s slot-``k`` neighbour, when the
-    lattice has one, is node ``i + offsets[k]``."""
-    _require_lattice(graph)
-    return (DIRECTIONS[:graph.max_degree] @ np.array([1, graph.shape[1]])).astype(np.int32)
-
-
-def slot_lengths(graph: Graph) -> np.ndarray:
-    """f32[K] (static, host side): on a grid or path map, the length of a move in each slot
-    (1 orthogonal, sqrt 2 diagonal), the value of ``cost`` wherever the slot has a neighbour."""
-    _require_lattice(graph)
-    return np.hypot(*DIRECTIONS[:graph.max_degree].T).astype(np.float32)
-
-
-def move_lengths(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
-    """f32[...]: the length of each move, edge ``slots`` (i8/i16/i32, -1 for no move) out of
-    ``nodes`` (i32, same shape); 0 where the slot is -1. On grids and path maps the length is
-    looked up by slot alone (see :func:`slot_lengths`)."""
-    slot = jnp.maximum(slots, 0).astype(jnp.int32)
-    if graph.is_grid:
-        length = jnp.asarray(slot_lengths(graph))[slot]
-    else:
-        length = graph.cost[nodes, slot]
-    return jnp.where(slots >= 0, length, 0.0)
-
-
-def total_length(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
-    """f32[...]: the summed length of the moves along the last axis of ``slots`` (i8/i16/i32
-    [..., M], -1 for no move) out of ``nodes`` (i32[..., M]).
-
-    On grids and path maps the orthogonal and the diagonal moves are counted (the orthogonal
-    slots come first, see ``DIRECTIONS``) and the counts weighted by their lengths, so walks
-    that make the same moves in another order (on an 8-connected grid, many shortest paths do)
-    get bit-identical lengths, and a swarm never takes float rounding for an improvement. On
-    general graphs the lengths are summed.
-    """
-    if not graph.is_grid:
-        return jnp.sum(move_lengths(graph, nodes, slots), axis=-1)
-    return lattice_length(jnp.sum(slots >= 0, axis=-1),
-                          jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=-1))
-
-
-def lattice_length(moves: jax.Array, diagonal: jax.Array) -> jax.Array:
-    """f32[...]: the length of ``moves`` (i32[...]) moves on a grid or path map, ``diagonal``
-    (i32[...]) of them diagonal; equal counts give bit-identical lengths."""
-    return (moves - diagonal).astype(jnp.float32) + diagonal.astype(jnp.float32) * SQRT2
-
-
-def lowest_neighbour(graph: Graph, values: jax.Array, extra: jax.Array) -> jax.Array:
-    """f32[N]: ``min_k values[nbr[:, k]] + extra[:, k]``, the cheapest way to a neighbour.
-
-    Args:
-      graph: the map.
-      values: f32[N] a value per node.
-      extra: f32[N, K] a cost per edge slot; put ``inf`` where a slot must not count (no
-        neighbour, or an edge not valid now), since ``values`` is read there arbitrarily.
-
-    Returns:
-      f32[N]; ``inf`` for a node whose slots are all ``inf``.
-
-    On grids and path maps the neighbour of slot ``k`` is the cell shifted by ``DIRECTIONS[k]``,
-    so the values are read by slicing the [H, W] array; on general graphs by one gather per
-    slot. Both are several times faster on CPU than gathering the f32[N, K] table at once.
-    To apply it over and over, use :func:`relax` (it keeps the values in that layout).
-    """
-    return _lowest(graph, _pack(graph, values), _by_slot(graph, extra)).reshape(-1)
-
-
-def relax(graph: Graph, values: jax.Array, extra: jax.Array, update, *, max_sweeps: int,
-          sweeps_per_check: int = 1):
-    """Sweep ``values <- update(values, lowest_neighbour(graph, values, extra))`` until a
-    sweep changes nothing or ``max_sweeps`` sweeps have run.
-
-    Every sweep updates all nodes at once (Jacobi). The values stay in the layout the
-    neighbours are read from (on grids an [H + 2, W + 2] array with a border, updated in place),
-    which makes a sweep about twice as fast as calling :func:`lowest_neighbour` each time.
-
-    Args:
-      graph: the map.
-      values: f32[N] start values.
-      extra: f32[N, K] cost per edge slot, ``inf`` where a slot must not count.
-      update: ``(values, lowest) -> (new_values, changed)``, elementwise on arrays of one shape
-        (``[H, W]`` on grids, ``[N]`` otherwise): the new values and where they changed.
-      max_sweeps: most sweeps (static).
-      sweeps_per_check: sweeps between two tests of whether anything changed (static); the
-        extra sweeps after the last change change nothing.
-
-    Returns:
-      ``(f32[N] values, i32[] sweeps run)``.
-    """
-    by_slot = _by_slot(graph, extra)
-
-    def sweep(carry):
-        packed, sweeps, _ = carry
-        changed = False
-        for _ in range(sweeps_per_check):
-            here = _interior(graph, packed)
-            new, moved = update(here, _lowest(graph, packed, by_slot))
-            packed = _with_interior(graph, packed, new)
-            changed = changed | jnp.any(moved)
-        return packed, sweeps + sweeps_per_check, changed
-
-    def unsettled(carry):
-        _, sweeps, changed = carry
-        return changed & (sweeps < max_sweeps)
-
-    packed, sweeps, _ = jax.lax.while_loop(
-        unsettled, sweep, (_pack(graph, values), jnp.int32(0), jnp.array(True)))
-    return _unpack(graph, packed), sweeps
-
-
-def _pack(graph: Graph, values):
-    """Node values in the layout neighbours are read from: [H + 2, W + 2] (0 border) on grids,
-    [N] otherwise."""
-    return jnp.pad(values.reshape(graph.shape), 1) if graph.is_grid else values
-
-
-def _interior(graph: Graph, packed):
-    return packed[1:-1, 1:-1] if graph.is_grid else packed
-
-
-def _with_interior(graph: Graph, packed, values):
-    return packed.at[1:-1, 1:-1].set(values) if graph.is_grid else values
-
-
-def _unpack(graph: Graph, packed):
-    return _interior(graph, packed).reshape(-1)
-
-
-def _by_slot(graph: Graph, extra):
-    """Per-slot costs f32[N, K] in the layout of :func:`_lowest`: [K, H, W] on grids."""
-    return extra.T.reshape(-1, *graph.shape) if graph.is_grid else extra
-
-
-def _lowest(graph: Graph, packed, by_slot):
-    """``min_k`` (value of the slot-k neighbour + its cost), shaped like ``_interior``."""
-    if graph.is_grid:
-        height, width = graph.shape
-
-        def at_slot(k):
-            dx, dy = DIRECTIONS[k]
-            return packed[1 + dy:1 + dy + height, 1 + dx:1 + dx + width] + by_slot[k]
-    else:
-        heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-
-        def at_slot(k):
-            return packed[heads[:, k]] + by_slot[:, k]
-
-    lowest = at_slot(0)
-    for k in range(1, graph.max_degree):
-        lowest = jnp.minimum(lowest, at_slot(k))
-    return lowest
-
-
-def _require_lattice(graph: Graph) -> None:
-    if not graph.is_grid:
-        raise ValueError("this map is a general graph, not a grid or path map: its slots have "
-                         "no fixed offsets or lengths")
 
 
 @jax.jit

@@ -33,7 +33,8 @@ from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 
 from jaxswarm.atomic import atomic_path
-from jaxswarm.graph import OPPOSITE, Graph
+from jaxswarm.graph import Graph
+from jaxswarm.lattice import OPPOSITE
 from jaxswarm.paths import Solution, as_node, trim
 
 MASKED_COLOR = "0.6"

@@ -5,9 +5,10 @@ import numpy as np
 import pytest
 import scipy.sparse.csgraph as csgraph
 
-from jaxswarm.graph import (DIRECTIONS, OPPOSITE, dense_graph, grid_graph, lowest_neighbour,
-                            move_lengths, path_map_graph, relax, slot_lengths, slot_offsets,
-                            total_length)
+from jaxswarm.graph import dense_graph, grid_graph, path_map_graph
+from jaxswarm.lattice import (DIRECTIONS, OPPOSITE, move_lengths, slot_lengths, slot_offsets,
+                              total_length)
+from jaxswarm.relax import lowest_neighbour, relax
 from oracle import grid_adjacency
 
 

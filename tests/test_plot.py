@@ -13,7 +13,8 @@ from matplotlib.figure import Figure  # noqa: E402
 
 from jaxswarm import plot  # noqa: E402
 from jaxswarm.exact import astar, dijkstra, distance_field  # noqa: E402
-from jaxswarm.graph import DIRECTIONS, dense_graph, grid_graph, path_map_graph  # noqa: E402
+from jaxswarm.graph import dense_graph, grid_graph, path_map_graph  # noqa: E402
+from jaxswarm.lattice import DIRECTIONS  # noqa: E402
 from jaxswarm.maps.random import random_path_map  # noqa: E402
 from jaxswarm.paths import pad  # noqa: E402
 

@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import OPPOSITE, grid_graph, path_map_graph
+from jaxswarm.graph import grid_graph, path_map_graph
+from jaxswarm.lattice import OPPOSITE
 from jaxswarm.maps.random import random_grid, random_path_map
 
 

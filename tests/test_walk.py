@@ -3,7 +3,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import dense_graph, grid_graph, straight_line
+from jaxswarm.graph import dense_graph, grid_graph
+from jaxswarm.lattice import straight_line
 from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, edge_table, sample_masked, visited_nodes,
                                  walk)

@@ -10,7 +10,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, relax
+from jaxswarm.graph import Graph
+from jaxswarm.relax import relax
 
 SWEEPS_PER_CHECK = 4
 """Relaxation sweeps between two convergence tests (amortises the loop's overhead)."""

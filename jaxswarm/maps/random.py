@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from jaxswarm.graph import DIRECTIONS, OPPOSITE
+from jaxswarm.lattice import DIRECTIONS, OPPOSITE
 
 
 @dataclasses.dataclass(frozen=True)

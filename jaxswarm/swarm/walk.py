@@ -32,8 +32,8 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, PartitionSpec as P
 
-from jaxswarm.graph import (NO_NODE, ORTHOGONAL_SLOTS, Graph, lattice_length, slot_offsets,
-                            total_length)
+from jaxswarm.graph import NO_NODE, Graph
+from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 
 STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
@@ -61,7 +61,7 @@ class Walk(NamedTuple):
       slots: i16[A, L - 1] neighbour slot of each move (``path[a, t + 1] = nbr[path[a, t], slot]``),
         -1 after the agent stopped.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
-        counted by kind (:func:`jaxswarm.graph.lattice_length`), so the same moves in any order
+        counted by kind (:func:`jaxswarm.lattice.lattice_length`), so the same moves in any order
         give the same float; on general graphs the edge costs are summed.
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).

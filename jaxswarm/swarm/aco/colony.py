@@ -19,7 +19,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph, straight_line
+from jaxswarm.graph import Graph
+from jaxswarm.lattice import straight_line
 from jaxswarm.paths import step_slots
 from jaxswarm.swarm.aco.bug2 import direction_cosine
 from jaxswarm.swarm.core import Swarm, Task, best_solution, check_positive, keep_best

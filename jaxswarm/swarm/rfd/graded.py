@@ -43,7 +43,9 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, lowest_neighbour, move_lengths, relax
+from jaxswarm.graph import Graph
+from jaxswarm.lattice import move_lengths
+from jaxswarm.relax import lowest_neighbour, relax
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (check_greedy_drops, f32, goal_log_distance, gradients,

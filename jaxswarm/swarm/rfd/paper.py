@@ -44,7 +44,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph, move_lengths
+from jaxswarm.graph import Graph
+from jaxswarm.lattice import move_lengths
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, f32,

@@ -15,7 +15,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph, straight_line
+from jaxswarm.graph import Graph
+from jaxswarm.lattice import straight_line
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.walk import Walk, step_budget, walk
 
