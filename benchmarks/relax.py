@@ -31,7 +31,7 @@ from jaxswarm.exact import distance_field
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
-from jaxswarm.swarm.walk import step_budget, visited_nodes, walk
+from jaxswarm.swarm.walking import step_budget, visited_nodes, walk
 
 
 def median_ms(function, *args, repeats: int) -> float:

@@ -36,7 +36,7 @@ import jax.numpy as jnp
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task
 from jaxswarm.swarm import aco, rfd
-from jaxswarm.swarm.walk import step_budget, walk
+from jaxswarm.swarm.walking import step_budget, walk
 
 MiB = 2 ** 20
 

@@ -32,8 +32,8 @@ class Graph:
     Attributes:
       nbr: i32[N, K] neighbour node of each slot, ``NO_NODE`` (-1) where the lattice has none.
       cost: f32[N, K] edge length (on grids and path maps the length of the slot's move, 1 or
-        sqrt 2, see :func:`jaxswarm.lattice.slot_lengths`; any positive weight on dense graphs); 0 where ``nbr``
-        is -1.
+        sqrt 2, see :func:`jaxswarm.lattice.slot_lengths`; any positive weight on dense graphs);
+        0 where ``nbr`` is -1.
       xy: f32[N, 2] node coordinates, x = column, y = row for grids.
       free: bool[N] passable nodes (edited at run time).
       open: bool[N, K] passable edges, i.e. no thin wall (edited at run time).

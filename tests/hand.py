@@ -11,7 +11,7 @@ import math
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.walk import Walk
+from jaxswarm.swarm.walking import Walk
 
 # Slot order of the library's grids, written out by hand: E S W N SE SW NW NE, y grows down.
 SLOTS = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)]

@@ -30,7 +30,7 @@ from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDSta
                                 blind_alleys, carve, erode_banks, erode_eq4, graded_transition,
                                 rfd_star_transition, rfd_transition, settle)
 from jaxswarm.swarm.rfd.river import deposit_where_stuck
-from jaxswarm.swarm.walk import FORCED
+from jaxswarm.swarm.walking import FORCED
 
 REL = 1e-5
 NONE = -math.inf

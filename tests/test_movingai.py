@@ -134,7 +134,8 @@ def test_scenario_rows_are_checked_against_their_map(tmp_path):
     map_path.write_text("type octile\nheight 2\nwidth 3\nmap\n..@\n...\n")
     obstacles = read_map(map_path)
     good = "0\ttiny.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
-    rows = {"blocked start": ("0\ttiny.map\t3\t2\t2\t0\t0\t1\t2.0\n", "start (2, 0) is an obstacle"),
+    rows = {"blocked start": ("0\ttiny.map\t3\t2\t2\t0\t0\t1\t2.0\n",
+                              "start (2, 0) is an obstacle"),
             "goal outside": ("0\ttiny.map\t3\t2\t0\t0\t3\t1\t3.0\n",
                              "goal (3, 1) is outside the row's 3x2 map"),
             "other size": ("0\ttiny.map\t4\t2\t0\t0\t2\t1\t2.4\n",

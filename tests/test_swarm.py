@@ -19,7 +19,7 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.paths import Solution, is_valid_path, path_length
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
-from jaxswarm.swarm.walk import Walk
+from jaxswarm.swarm.walking import Walk
 
 ITERATIONS = 8
 SMALL = dict(num_agents=32)

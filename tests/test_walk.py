@@ -6,8 +6,8 @@ import pytest
 from jaxswarm.graph import dense_graph, grid_graph
 from jaxswarm.lattice import straight_line
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.walk import (FORCED, STEPS_PER_CHECK, edge_table, sample_masked, visited_nodes,
-                                 walk)
+from jaxswarm.swarm.walking import (FORCED, STEPS_PER_CHECK, edge_table, sample_masked,
+                                    visited_nodes, walk)
 
 
 def _uniform(seed, mask):
@@ -165,7 +165,7 @@ def test_excluded_and_invalid_edges_are_never_taken():
 
 
 def test_compacting_the_last_walkers_changes_no_walk(monkeypatch):
-    import jaxswarm.swarm.walk as walk_module
+    import jaxswarm.swarm.walking.loop as walk_module
 
     graph = grid_graph(np.zeros((16, 16), bool))
     logw = towards(graph, 255, 0.6)  # most agents arrive early, a few wander on

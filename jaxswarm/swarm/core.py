@@ -25,7 +25,7 @@ import numpy as np
 
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, as_node
-from jaxswarm.swarm.walk import check_devices
+from jaxswarm.swarm.walking import check_devices
 
 
 class Task(NamedTuple):
@@ -193,7 +193,7 @@ class SwarmConfig:
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
       devices: spread each walk's agents over this many devices (see
-        :func:`jaxswarm.swarm.walk.walk`); results are the same as with one.
+        :func:`jaxswarm.swarm.walking.walk`); results are the same as with one.
     """
 
     num_agents: int = 256
@@ -226,7 +226,7 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False):
     """The bookkeeping every swarm does after its agents walked.
 
     Args:
-      walk: the iteration's :class:`jaxswarm.swarm.walk.Walk`.
+      walk: the iteration's :class:`jaxswarm.swarm.walking.Walk`.
       best_path: i32[L] the best path so far; best_cost: f32[] its length.
       ties: take this iteration's best also when it only equals the best so far.
 

@@ -12,8 +12,9 @@ Maps of the same shape share the compiled program; each compile is logged. A run
 whatever the chunk size, the group size and the number of devices.
 
 Each map's optimum is Dijkstra's path measured as the swarms measure theirs
-(:func:`jaxswarm.exact.optimal_length`), so every row carries its optimality gap, never negative. Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec
-again skips them.
+(:func:`jaxswarm.exact.optimal_length`), so every row carries its optimality gap, never negative.
+Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec again
+skips them.
 """
 from __future__ import annotations
 

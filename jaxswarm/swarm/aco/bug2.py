@@ -18,14 +18,13 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.paths import path_length
-from jaxswarm.swarm.walk import sample_masked
+from jaxswarm.swarm.walking import heads, sample_masked
 
 
 def direction_cosine(graph: Graph, goal) -> jax.Array:
     """f32[N, K]: cosine of the angle between each move and the straight line to ``goal``
     (1 = straight at it, -1 = straight away; 1 for moves from the goal itself)."""
-    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-    move = graph.xy[heads] - graph.xy[:, None, :]
+    move = graph.xy[heads(graph)] - graph.xy[:, None, :]
     aim = (graph.xy[goal] - graph.xy)[:, None, :]
     norms = jnp.linalg.norm(move, axis=-1) * jnp.linalg.norm(aim, axis=-1)
     return jnp.where(norms > 0, jnp.sum(move * aim, axis=-1) / jnp.where(norms > 0, norms, 1.0),

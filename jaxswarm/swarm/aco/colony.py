@@ -20,11 +20,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
-from jaxswarm.lattice import straight_line
 from jaxswarm.paths import step_slots
 from jaxswarm.swarm.aco.bug2 import direction_cosine
 from jaxswarm.swarm.core import Swarm, Task, best_solution, check_positive, keep_best
-from jaxswarm.swarm.walk import FORCED, edge_table, step_budget, walk
+from jaxswarm.swarm.walking import (FORCED, edge_table, goal_log_distance, heads, step_budget,
+                                     walk)
 
 DIRECTION_FLOOR = 1e-3
 """Added to the direction desirability so that a move straight away from the goal stays possible."""
@@ -69,7 +69,6 @@ def transition_rule(graph: Graph, task: Task, pheromone, params, *, direction: b
       goal_distance: ACO*: divide by ``d_j ** alpha_goal``, the goal forced whenever adjacent.
       beta: the heuristic exponent, if not ``params.beta`` (the Improved first ant's).
     """
-    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
     if direction:
         eta = (1.0 + direction_cosine(graph, task.goal)) / 2.0 + DIRECTION_FLOOR
     else:
@@ -77,9 +76,9 @@ def transition_rule(graph: Graph, task: Task, pheromone, params, *, direction: b
     beta = params.beta if beta is None else beta
     logw = params.alpha * jnp.log(pheromone) + beta * jnp.log(eta)
     if goal_distance:
-        to_goal = straight_line(graph, task.goal)
-        logw = logw - params.alpha_goal * jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))[heads]
-        logw = jnp.where(heads == task.goal, FORCED, logw)
+        neighbour = heads(graph)
+        logw = logw - params.alpha_goal * goal_log_distance(graph, task.goal)[neighbour]
+        logw = jnp.where(neighbour == task.goal, FORCED, logw)
     return edge_table(graph, logw)
 
 

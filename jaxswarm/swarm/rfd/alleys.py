@@ -5,7 +5,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
-from jaxswarm.swarm.walk import Walk
+from jaxswarm.swarm.walking import Walk
 
 
 def blind_alleys(graph: Graph, log_weights, drops: Walk):

@@ -48,9 +48,9 @@ from jaxswarm.lattice import move_lengths
 from jaxswarm.relax import lowest_neighbour, relax
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import (check_greedy_drops, f32, goal_log_distance, gradients,
+from jaxswarm.swarm.rfd.river import (check_greedy_drops, f32, gradients,
                                       river_swarm)
-from jaxswarm.swarm.walk import FORCED, Walk, edge_table, visited_nodes
+from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, visited_nodes
 
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way

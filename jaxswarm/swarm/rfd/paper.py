@@ -49,8 +49,8 @@ from jaxswarm.lattice import move_lengths
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, f32,
-                                      goal_log_distance, gradients, river_swarm)
-from jaxswarm.swarm.walk import FORCED, Walk, edge_table
+                                      gradients, river_swarm)
+from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance
 
 EROSION_LAWS = ("linear", "exponential")
 """How ``rfd_star``'s arrived drops erode their paths: eq. 4, or its exponential form."""

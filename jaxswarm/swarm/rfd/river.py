@@ -2,7 +2,7 @@
 
 Every node has an altitude; the goal is the sea, fixed at 0, every other node starts at
 ``initial_height``. Each iteration all drops walk from the start over one table of transition
-log-weights (:mod:`jaxswarm.swarm.walk`: no drop visits a node twice, the RFD paper's per-drop
+log-weights (:mod:`jaxswarm.swarm.walking`: no drop visits a node twice, the RFD paper's per-drop
 neighbour sets), then the variant reshapes the altitudes from what the drops did, and the best
 arrived path is kept.
 """
@@ -16,9 +16,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
-from jaxswarm.lattice import straight_line
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
-from jaxswarm.swarm.walk import Walk, step_budget, walk
+from jaxswarm.swarm.walking import Walk, heads, step_budget, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -104,17 +103,9 @@ def check_greedy_drops(greedy_drops: int, num_agents: int) -> None:
 def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
     """``(heads i32[N, K], gradient f32[N, K])``: each slot's neighbour (0 where there is none)
     and the RFD paper's eq. 2, ``(altitude(i) - altitude(j)) / distance(i, j)``."""
-    heads = jnp.where(graph.nbr >= 0, graph.nbr, 0)
-    return heads, (altitude[:, None] - altitude[heads]) / jnp.where(graph.nbr >= 0, graph.cost,
-                                                                     1.0)
-
-
-def goal_log_distance(graph: Graph, goal) -> jax.Array:
-    """f32[N] ``log d_j``, the straight-line distance of each node to the goal (eq. 6); nodes at
-    distance 0 other than the goal (general graphs without coordinates) get 0, a neutral
-    heuristic, instead of ``log 0``."""
-    to_goal = straight_line(graph, goal)
-    return jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
+    neighbour = heads(graph)
+    return neighbour, (altitude[:, None] - altitude[neighbour]) / jnp.where(graph.nbr >= 0,
+                                                                             graph.cost, 1.0)
 
 
 def deposit_where_stuck(altitude: jax.Array, drops: Walk, sediment) -> jax.Array:

@@ -1,12 +1,12 @@
-"""The lockstep walker shared by drops and ants, and the single masked sampler.
+"""The lockstep walk loop shared by drops and ants.
 
 ``A`` agents start at one node. The algorithm hands the walker one log-weight per edge,
 ``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
 heuristics do not change while the agents walk). Each step, every still-walking agent gathers
 its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
 has not visited in this walk; on grids and path maps the neighbours are the node plus fixed
-slot offsets, so only the log-weights are gathered), and draws one slot through
-:func:`sample_masked` (a greedy agent takes its most likely slot instead, ties drawn at
+slot offsets, so only the log-weights are gathered), and draws one slot through the masked
+sampler (:mod:`.sampler`; a greedy agent takes its most likely slot instead, ties drawn at
 random). An agent stops when it reaches the goal, when it has no admissible neighbour ("stuck"),
 or when the step budget runs out. The walk is a ``lax.while_loop`` that ends as soon as every
 agent has stopped; once at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch
@@ -23,8 +23,6 @@ Batch sizes in sweeps must be chosen with that in mind.
 """
 from __future__ import annotations
 
-import functools
-import operator
 from typing import NamedTuple
 
 import jax
@@ -34,6 +32,8 @@ from jax.sharding import Mesh, PartitionSpec as P
 
 from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
+from jaxswarm.swarm.walking import bits
+from jaxswarm.swarm.walking.sampler import sample_masked
 
 STEPS_PER_CHECK = 64
 """Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
@@ -48,9 +48,6 @@ compaction does not change any walk."""
 
 AGENT_AXIS = "agents"
 """The mesh axis over which :func:`walk` spreads its agents (``devices > 1``)."""
-
-FORCED = 1e30
-"""A log-weight that wins every draw: use it for moves that must be taken (e.g. into the goal)."""
 
 
 class Walk(NamedTuple):
@@ -86,80 +83,7 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
     """bool[N]: the nodes on the paths of the agents selected by ``which`` (bool[A]; all
     agents when None), read from the walk's packed visited sets (cheaper than scattering the
     padded paths)."""
-    words = walk.visited if which is None else jnp.where(which[:, None], walk.visited, 0)
-    union = jax.lax.reduce(words, jnp.uint32(0), jax.lax.bitwise_or, (0,))
-    bits = (union[:, None] >> jnp.arange(32, dtype=jnp.uint32)) & 1
-    return bits.reshape(-1)[:num_nodes].astype(bool)
-
-
-def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
-                  greedy: jax.Array | None = None):
-    """Draw one slot per row among the masked-in slots, by inverse CDF.
-
-    Args:
-      uniform: f32[A] one uniform draw in [0, 1) per row (e.g. ``jax.random.uniform``).
-      log_weights: f32[A, K] unnormalised log-probabilities; ``-inf`` means probability 0 and
-        ``FORCED`` makes a slot certain.
-      mask: bool[A, K] slots that may be chosen.
-      greedy: optional bool[A]; a greedy row takes its most likely slot (ties drawn uniformly).
-
-    Returns:
-      ``(choice i32[A], has_choice bool[A])``. Rows with no admissible slot of positive weight get
-      ``has_choice = False`` and ``choice = -1``; they must not move (``jax.random.categorical``
-      would silently return slot 0 there).
-    """
-    masked = jnp.where(mask, log_weights, -jnp.inf)
-    top = jnp.max(masked, axis=-1, keepdims=True)
-    has_choice = jnp.isfinite(top[..., 0])  # False for no slot, all -inf, or NaN weights
-    weights = jnp.exp(masked - jnp.where(has_choice[..., None], top, 0.0))
-    if greedy is not None:
-        weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
-    # The first slot whose cumulative weight exceeds u (a slot of positive weight), capped at the
-    # last slot of positive weight in case rounding made u reach the total. The cumulative sums
-    # are unrolled over the (small, static) slots and counted on the fly: on CPU this fuses into
-    # one loop, cheaper than a cumsum (a reduce-window) and argmax (a variadic reduce).
-    columns = [weights[..., k] for k in range(weights.shape[-1])]
-    total = functools.reduce(operator.add, columns)
-    u = uniform * total
-    below_u = below_total = jnp.zeros(total.shape, jnp.int32)
-    running = jnp.zeros_like(total)
-    for column in columns:
-        running = running + column
-        below_u = below_u + (running <= u)
-        below_total = below_total + (running < total)
-    choice = jnp.minimum(below_u, below_total)
-    return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
-
-
-def step_budget(graph: Graph, max_steps: int | None) -> int:
-    """The step budget of a walk (static): ``max_steps``, or by default N - 1 (the longest walk
-    without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids."""
-    if max_steps is not None:
-        return max_steps
-    longest = max(graph.num_nodes - 1, 1)
-    return min(longest, 8 * sum(graph.shape)) if graph.is_grid else longest
-
-
-def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
-    """f32[N, K]: ``log_weights`` where the edge is valid on the current map, else ``-inf``.
-
-    Algorithms build their per-edge log-weights (any finite values, ``FORCED`` for must-take
-    moves, ``-inf`` to exclude) and pass them through this before :func:`walk`.
-    """
-    return jnp.where(graph.valid_edges(), log_weights, -jnp.inf)
-
-
-def _mark(bits: jax.Array, agents: jax.Array, nodes: jax.Array) -> jax.Array:
-    """Set bit ``nodes[a]`` in row ``agents[a]`` of a packed u32[A, ceil(N / 32)] bit set."""
-    words = nodes >> 5
-    updated = bits[agents, words] | (jnp.uint32(1) << (nodes & 31).astype(jnp.uint32))
-    return bits.at[agents, words].set(updated)
-
-
-def _is_marked(bits: jax.Array, nodes: jax.Array) -> jax.Array:
-    """bool[A, K]: whether node ``nodes[a, k]`` is in agent ``a``'s packed bit set."""
-    words = jnp.take_along_axis(bits, nodes >> 5, axis=1)
-    return ((words >> (nodes & 31).astype(jnp.uint32)) & 1).astype(bool)
+    return bits.union(walk.visited, num_nodes, which)
 
 
 def check_devices(devices: int, num_agents: int) -> None:
@@ -194,8 +118,9 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         same walk).
       graph: the map.
       log_weights: f32[N, K] unnormalised log-probability of each edge (see
-        :func:`edge_table`); ``-inf`` where the edge may not be taken (no neighbour, not valid
-        on the current map, or excluded by the algorithm), ``FORCED`` where it must be.
+        :func:`~jaxswarm.swarm.walking.tables.edge_table`); ``-inf`` where the edge may not be
+        taken (no neighbour, not valid on the current map, or excluded by the algorithm),
+        ``FORCED`` where it must be.
       start, goal: i32[] node indices (may be traced).
       num_agents: A (static).
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
@@ -230,6 +155,43 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
                          check_vma=False)(*args)
 
 
+class Lanes(NamedTuple):
+    """The per-agent state of a walk (a pytree; leading axis ``a``: the agents of a share, or
+    the few still walking once compacted).
+
+    Attributes:
+      position: i32[a] the node each agent is at.
+      visited: u32[a, ceil(N / 32)] the nodes on each agent's path (:mod:`.bits`).
+      slots: i8 or i16[a, C] the slot of each move so far, -1 after the agent stopped
+        (C = max_steps + STEPS_PER_CHECK columns, so a whole block always fits).
+      nodes: i16 or i32[a, C] the node each move reached, -1 after the agent stopped.
+      walking: bool[a] still moving.
+      arrived: bool[a] reached the goal.
+      stuck: bool[a] stopped with no admissible neighbour.
+      moves: i32[a] moves made (counted on grids and path maps, for the length).
+      diagonal: i32[a] diagonal moves among them.
+    """
+
+    position: jax.Array
+    visited: jax.Array
+    slots: jax.Array
+    nodes: jax.Array
+    walking: jax.Array
+    arrived: jax.Array
+    stuck: jax.Array
+    moves: jax.Array
+    diagonal: jax.Array
+
+
+class Carry(NamedTuple):
+    """The walk loop's carry: ``key`` (the PRNG key of the next block), ``step`` (i32[]
+    lockstep steps so far) and the agents' :class:`Lanes`."""
+
+    key: jax.Array
+    step: jax.Array
+    lanes: Lanes
+
+
 def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: int,
                 num_agents: int, max_steps: int, greedy_agents: int) -> Walk:
     """Walk agents ``first .. first + share - 1`` (``first`` may be traced) of a batch of
@@ -238,57 +200,54 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
     agents = jnp.arange(share)
     greedy = first + agents < greedy_agents if greedy_agents else None
     position = jnp.full((share,), start)
-    # The buffers get one spare chunk of columns so that a chunk's block always fits.
     columns = max_steps + STEPS_PER_CHECK
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
     node_dtype = jnp.int16 if n <= 32767 else jnp.int32
-    carry = dict(
-        key=key,
+    counts = jnp.zeros((share,), jnp.int32)
+    carry = Carry(key=key, step=jnp.array(0, jnp.int32), lanes=Lanes(
         position=position,
-        visited=_mark(jnp.zeros((share, (n + 31) // 32), jnp.uint32), agents, position),
+        visited=bits.mark(jnp.zeros((share, (n + 31) // 32), jnp.uint32), agents, position),
         slots=jnp.full((share, columns), -1, slot_dtype),
         nodes=jnp.full((share, columns), NO_NODE, node_dtype),
         walking=jnp.full((share,), start != goal),
         arrived=jnp.full((share,), start == goal),
         stuck=jnp.zeros((share,), bool),
-        step=jnp.array(0, jnp.int32),
-    )
-    if graph.is_grid:  # the moves of each kind, tallied per chunk, measure the walks' lengths
-        carry.update(moves=jnp.zeros((share,), jnp.int32), diagonal=jnp.zeros((share,), jnp.int32))
-    per_agent = [name for name in carry if name not in ("key", "step")]
+        moves=counts, diagonal=counts))
 
-    def keep_walking(c):
-        return (c["step"] < max_steps) & jnp.any(c["walking"])
+    def keep_walking(c: Carry):
+        return (c.step < max_steps) & jnp.any(c.lanes.walking)
 
-    def chunk(c, lanes, greedy):
-        """STEPS_PER_CHECK steps of the agents ``lanes`` (i32[a] ids within the share; None:
-        the whole share); their slots and nodes go to small step-major blocks (each step writes
-        one contiguous row) that are transposed into the buffers once per chunk."""
-        start_column = c["step"]
-        key, draw_key = jax.random.split(c["key"])
+    def block(c: Carry, lanes_ids, greedy) -> Carry:
+        """STEPS_PER_CHECK steps of the agents ``lanes_ids`` (i32[a] ids within the share;
+        None: the whole share); their slots and nodes go to small step-major blocks (each step
+        writes one contiguous row) that are transposed into the buffers once per block."""
+        key, draw_key = jax.random.split(c.key)
         # The whole batch's uniforms are drawn and each agent takes its own column, so that a
         # walk does not depend on how the batch was shared out or compacted.
         draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
         if share < num_agents:
             draws = jax.lax.dynamic_slice_in_dim(draws, first, share, axis=1)
-        if lanes is not None:
-            draws = draws[:, lanes]
-        rows = share if lanes is None else lanes.shape[0]
+        if lanes_ids is not None:
+            draws = draws[:, lanes_ids]
+        rows = c.lanes.position.shape[0]
 
         def step_into_blocks(i, inner):
-            c, slots, nodes = inner
-            c, slot, node = one_step(c, draws[i], greedy)
-            return c, slots.at[i].set(slot), nodes.at[i].set(node)
+            lanes, step, slots, nodes = inner
+            lanes, step, slot, node = one_step(lanes, step, draws[i], greedy)
+            return lanes, step, slots.at[i].set(slot), nodes.at[i].set(node)
 
         slots = jnp.full((STEPS_PER_CHECK, rows), -1, slot_dtype)
         nodes = jnp.full((STEPS_PER_CHECK, rows), NO_NODE, node_dtype)
-        c, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_CHECK, step_into_blocks,
-                                            (dict(c, key=key), slots, nodes))
+        lanes, step, slots, nodes = jax.lax.fori_loop(
+            0, STEPS_PER_CHECK, step_into_blocks, (c.lanes, c.step, slots, nodes))
         if graph.is_grid:
-            c = dict(c, moves=c["moves"] + jnp.sum(slots >= 0, axis=0),
-                     diagonal=c["diagonal"] + jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=0))
-        return dict(c, slots=jax.lax.dynamic_update_slice(c["slots"], slots.T, (0, start_column)),
-                    nodes=jax.lax.dynamic_update_slice(c["nodes"], nodes.T, (0, start_column)))
+            lanes = lanes._replace(moves=lanes.moves + jnp.sum(slots >= 0, axis=0),
+                                   diagonal=lanes.diagonal
+                                   + jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=0))
+        lanes = lanes._replace(
+            slots=jax.lax.dynamic_update_slice(lanes.slots, slots.T, (0, c.step)),
+            nodes=jax.lax.dynamic_update_slice(lanes.nodes, nodes.T, (0, c.step)))
+        return Carry(key=key, step=step, lanes=lanes)
 
     def neighbours_of(here):
         """i32[a, K] each agent's neighbours, clamped into the map: computed from the slot
@@ -298,52 +257,51 @@ def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: in
             return jnp.clip(here[:, None] + jnp.asarray(slot_offsets(graph)), 0, n - 1)
         return jnp.maximum(graph.nbr[here], 0)
 
-    def one_step(c, uniform, greedy):
-        here = c["position"]
+    def one_step(lanes: Lanes, step, uniform, greedy):
+        here = lanes.position
         neighbours = neighbours_of(here)
         row = log_weights[here]
-        seen = _is_marked(c["visited"], neighbours)
-        admissible = (row > -jnp.inf) & ~seen & c["walking"][:, None]
+        seen = bits.is_marked(lanes.visited, neighbours)
+        admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
         choice, has_choice = sample_masked(uniform, row, admissible, greedy)
-        moving = c["walking"] & has_choice & (c["step"] < max_steps)
+        moving = lanes.walking & has_choice & (step < max_steps)
         target = jnp.take_along_axis(neighbours, jnp.maximum(choice, 0)[:, None], axis=1)[:, 0]
         there = jnp.where(moving, target, here)
         arrived_now = moving & (there == goal)
-        c = dict(
-            c,
+        lanes = lanes._replace(
             position=there,
-            visited=_mark(c["visited"], jnp.arange(here.shape[0]), there),
+            visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there),
             walking=moving & ~arrived_now,
-            arrived=c["arrived"] | arrived_now,
-            stuck=c["stuck"] | (c["walking"] & ~has_choice),
-            step=jnp.minimum(c["step"] + 1, max_steps),
-        )
-        return (c, jnp.where(moving, choice, -1).astype(slot_dtype),
+            arrived=lanes.arrived | arrived_now,
+            stuck=lanes.stuck | (lanes.walking & ~has_choice))
+        return (lanes, jnp.minimum(step + 1, max_steps),
+                jnp.where(moving, choice, -1).astype(slot_dtype),
                 jnp.where(moving, there, NO_NODE).astype(node_dtype))
 
     compact_lanes = share // COMPACT_SHARE
     if compact_lanes == 0:
-        c = jax.lax.while_loop(keep_walking, lambda c: chunk(c, None, greedy), carry)
+        c = jax.lax.while_loop(keep_walking, lambda c: block(c, None, greedy), carry)
     else:
         c = jax.lax.while_loop(
-            lambda c: keep_walking(c) & (jnp.sum(c["walking"]) > compact_lanes),
-            lambda c: chunk(c, None, greedy), carry)
+            lambda c: keep_walking(c) & (jnp.sum(c.lanes.walking) > compact_lanes),
+            lambda c: block(c, None, greedy), carry)
         # At most ``compact_lanes`` agents still walk: they go on in a batch of that size.
-        ids = jnp.nonzero(c["walking"], size=compact_lanes, fill_value=share)[0]
+        ids = jnp.nonzero(c.lanes.walking, size=compact_lanes, fill_value=share)[0]
         held = jnp.minimum(ids, share - 1)  # padding lanes hold a copy, never walk
-        few = {name: c[name][held] for name in per_agent}
+        few = jax.tree_util.tree_map(lambda x: x[held], c.lanes)
+        few = c._replace(lanes=few._replace(walking=few.walking & (ids < share)))
         few = jax.lax.while_loop(
-            keep_walking, lambda f: chunk(f, held, None if greedy is None else greedy[held]),
-            dict(few, walking=few["walking"] & (ids < share), key=c["key"], step=c["step"]))
-        c = dict(c, step=few["step"], **{name: c[name].at[ids].set(few[name], mode="drop")
-                                         for name in per_agent})
-    path = jnp.concatenate([position[:, None], c["nodes"][:, :max_steps].astype(jnp.int32)],
+            keep_walking,
+            lambda f: block(f, held, None if greedy is None else greedy[held]), few)
+        c = Carry(key=few.key, step=few.step, lanes=jax.tree_util.tree_map(
+            lambda all_, part: all_.at[ids].set(part, mode="drop"), c.lanes, few.lanes))
+    lanes = c.lanes
+    path = jnp.concatenate([position[:, None], lanes.nodes[:, :max_steps].astype(jnp.int32)],
                            axis=1)
-    slots = c["slots"][:, :max_steps].astype(jnp.int16)
+    slots = lanes.slots[:, :max_steps].astype(jnp.int16)
     if graph.is_grid:
-        length = lattice_length(c["moves"], c["diagonal"])
+        length = lattice_length(lanes.moves, lanes.diagonal)
     else:
         length = total_length(graph, path[:, :-1], slots)
-    return Walk(path=path, slots=slots, length=length,
-                arrived=c["arrived"], stuck=c["stuck"], position=c["position"],
-                visited=c["visited"], steps=c["step"])
+    return Walk(path=path, slots=slots, length=length, arrived=lanes.arrived,
+                stuck=lanes.stuck, position=lanes.position, visited=lanes.visited, steps=c.step)
