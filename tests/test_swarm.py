@@ -16,9 +16,11 @@ from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.paths import Solution, is_valid_path, path_length
+from jaxswarm.paths import Solution
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
+from jaxswarm.swarm.testing import (check_compiles_once, check_reproducible,
+                                    check_valid_results)
 from jaxswarm.swarm.walking import Walk
 
 ITERATIONS = 8
@@ -33,78 +35,36 @@ def maze():
         graph, chosen.start, chosen.goal)
 
 
-def leaves_equal(a, b):
-    return all(np.array_equal(np.asarray(x), np.asarray(y), equal_nan=True)
-               for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
-
-
-def key_data(state):
-    """The state with PRNG keys turned into their raw data (comparable arrays)."""
-    return jax.tree_util.tree_map(
-        lambda x: jax.random.key_data(x) if jnp.issubdtype(x.dtype, jax.dtypes.prng_key) else x,
-        state)
-
-
-
-
 @pytest.mark.parametrize("name", swarms.registered())
 def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
     graph, task, _ = maze
-    swarm = make(name, **SMALL)
-    keys = jax.random.split(jax.random.key(7), 3)
-    one = [run(swarm, k, graph, task, swarm.default_params, iterations=ITERATIONS) for k in keys]
-    again = run(swarm, keys[0], graph, task, swarm.default_params, iterations=ITERATIONS)
-    assert leaves_equal(key_data(one[0]), key_data(again))
-    batch = jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
-                                   iterations=ITERATIONS))(keys)
-    for i in range(3):
-        assert leaves_equal(key_data(jax.tree_util.tree_map(lambda x: x[i], batch)),
-                            key_data(one[i]))
-    # Another key walks other agents: the memory or the share that arrived differs.
-    assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
-                            (swarm.memory(one[1][0]), one[1][1].arrived))
+    check_reproducible(make(name, **SMALL), graph, task, iterations=ITERATIONS)
 
 
 @pytest.mark.parametrize("name", swarms.registered())
 def test_results_are_valid_and_never_beat_the_optimum(name, maze):
     graph, task, optimum = maze
-    swarm = make(name, **SMALL)
-    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
-                       iterations=ITERATIONS)
-    solution = swarm.best(state)
-    assert bool(solution.found)  # maze20 is found by every swarm within a few iterations
-    assert all(np.isfinite(np.asarray(leaf)).all() for leaf in jax.tree_util.tree_leaves(state)
-               if jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0)
-    ran = int(trace.iterations)
-    assert 1 <= ran <= ITERATIONS
-    best = np.asarray(trace.best_cost)
-    assert np.isnan(best[ran:]).all()
-    assert (best[1:ran] <= best[:ran - 1]).all()  # best so far never gets worse
-    assert bool(is_valid_path(graph, solution.path, task.start, task.goal))
-    assert float(path_length(graph, solution.path)) == float(solution.cost)  # measured alike
-    assert float(solution.cost) >= optimum
-    assert float(solution.cost) == best[ran - 1]
+    check_valid_results(make(name, **SMALL), graph, task, optimum, iterations=ITERATIONS)
 
 
 @pytest.mark.parametrize("name", swarms.registered())
 def test_a_sweep_over_sixteen_params_compiles_once(name, maze):
     graph, task, _ = maze
-    swarm = make(name, **SMALL)
-    traces = []
-    original_step = swarm.step
-    counted = type(swarm)(**{**swarm.__dict__, "step": lambda *a: (traces.append(1),
-                                                                     original_step(*a))[1]})
-    first = swarm.default_params._fields[0]
-    values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, 16)
-    for value in values:  # valid values: every run of the sweep is one the swarm accepts
-        swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
-    grid = jax.tree_util.tree_map(lambda x: jnp.full((16,), x), counted.default_params)
-    grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
-    sweep = jax.jit(jax.vmap(lambda p: run(counted, jax.random.key(0), graph, task, p,
-                                           iterations=4)[0].best_cost))
-    costs = sweep(grid)
-    sweep(grid._replace(**{first: grid[0] * 0.9}))  # new values, same shapes: no retrace
-    assert len(traces) == 1 and costs.shape == (16,)
+    check_compiles_once(make(name, **SMALL), graph, task)
+
+
+def test_the_conformance_suite_catches_a_swarm_that_breaks_it(maze):
+    graph, task, optimum = maze
+    swarm = make("rfd_graded", **SMALL)
+    # A swarm whose best path claims a cost below its length, and one that ignores its key.
+    lying = dataclasses.replace(swarm, best=lambda state: dataclasses.replace(
+        swarm.best(state), cost=swarm.best(state).cost - 1.0))
+    with pytest.raises(AssertionError, match="cost is not the path's length"):
+        check_valid_results(lying, graph, task, optimum)
+    fixed = dataclasses.replace(swarm, step=lambda state, *a: swarm.step(
+        dataclasses.replace(state, key=jax.random.key(0)), *a))
+    with pytest.raises(AssertionError, match="two keys gave the same run"):
+        check_reproducible(fixed, graph, task)
 
 
 def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once(maze):
@@ -485,7 +445,7 @@ SPREAD = textwrap.dedent("""
     import sys, jax
     jax.config.update("jax_num_cpu_devices", 2)
     sys.path.insert(0, {tests!r})
-    from test_swarm import key_data, leaves_equal
+    from jaxswarm.swarm.testing import key_data, leaves_equal
     from jaxswarm.maps.paper import paper_map
     from jaxswarm.swarm import make, make_task, run
 

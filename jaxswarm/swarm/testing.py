@@ -1,0 +1,108 @@
+"""The conformance suite every swarm must pass, shipped so that anyone writing a swarm can run
+it: ``check_swarm(make("my_swarm", num_agents=32), graph, task, optimum)``.
+
+Each check raises ``AssertionError`` naming what failed:
+
+* :func:`check_reproducible`: the same key gives bit-identical results, ``vmap`` over keys
+  equals a loop over them, and another key gives another run.
+* :func:`check_valid_results`: the best path is a valid path from start to goal, its cost is
+  its length measured as :func:`jaxswarm.paths.path_length` measures it, never below the
+  optimum; the trace's best cost never rises; the memory stays finite.
+* :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
+  and new values of the same shapes do not compile again.
+
+Use a small map every agent reaches within a few iterations (the project's own suite uses the
+RFD paper's maze20 with 32 agents and 8 iterations).
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.graph import Graph
+from jaxswarm.paths import is_valid_path, path_length
+from jaxswarm.swarm.core import Swarm, Task, run
+
+
+def leaves_equal(a, b) -> bool:
+    """Whether two pytrees have bit-identical leaves (NaNs equal)."""
+    return all(np.array_equal(np.asarray(x), np.asarray(y), equal_nan=True)
+               for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
+
+
+def key_data(tree):
+    """``tree`` with its PRNG keys turned into their raw data (comparable arrays)."""
+    return jax.tree_util.tree_map(
+        lambda x: jax.random.key_data(x) if jnp.issubdtype(x.dtype, jax.dtypes.prng_key) else x,
+        tree)
+
+
+def check_reproducible(swarm: Swarm, graph: Graph, task: Task, *, iterations: int = 8,
+                       keys: int = 3) -> None:
+    """Same key, same result; ``vmap`` over ``keys`` keys equals the loop; keys differ."""
+    split = jax.random.split(jax.random.key(7), keys)
+    params = swarm.default_params
+    one = [run(swarm, k, graph, task, params, iterations=iterations) for k in split]
+    again = run(swarm, split[0], graph, task, params, iterations=iterations)
+    assert leaves_equal(key_data(one[0]), key_data(again)), f"{swarm.name}: same key differs"
+    batch = jax.vmap(lambda k: run(swarm, k, graph, task, params, iterations=iterations))(split)
+    for i in range(keys):
+        assert leaves_equal(key_data(jax.tree_util.tree_map(lambda x: x[i], batch)),
+                            key_data(one[i])), f"{swarm.name}: vmap row {i} differs from run"
+    # Another key walks other agents: the memory or the share that arrived differs.
+    assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
+                            (swarm.memory(one[1][0]), one[1][1].arrived)), (
+        f"{swarm.name}: two keys gave the same run")
+
+
+def check_valid_results(swarm: Swarm, graph: Graph, task: Task, optimum: float, *,
+                        iterations: int = 8) -> None:
+    """One run's best path is found, valid, measured right and never below ``optimum`` (the
+    optimum measured as swarm paths are, see :func:`jaxswarm.exact.optimal_length`)."""
+    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
+                       iterations=iterations)
+    solution = swarm.best(state)
+    assert bool(solution.found), f"{swarm.name}: no path within {iterations} iterations"
+    assert all(np.isfinite(np.asarray(leaf)).all() for leaf in jax.tree_util.tree_leaves(state)
+               if jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0), (
+        f"{swarm.name}: memory not finite")
+    ran = int(trace.iterations)
+    assert 1 <= ran <= iterations
+    best = np.asarray(trace.best_cost)
+    assert np.isnan(best[ran:]).all(), f"{swarm.name}: trace entries after the stop"
+    assert (best[1:ran] <= best[:ran - 1]).all(), f"{swarm.name}: best cost rose"
+    assert bool(is_valid_path(graph, solution.path, task.start, task.goal)), (
+        f"{swarm.name}: invalid path")
+    assert float(path_length(graph, solution.path)) == float(solution.cost), (
+        f"{swarm.name}: cost is not the path's length")
+    assert float(solution.cost) >= optimum, f"{swarm.name}: beats the optimum {optimum}"
+    assert float(solution.cost) == best[ran - 1], f"{swarm.name}: trace and state disagree"
+
+
+def check_compiles_once(swarm: Swarm, graph: Graph, task: Task, *, iterations: int = 4,
+                        runs: int = 16) -> None:
+    """A ``vmap`` of ``runs`` runs over valid values of the first param traces the swarm's step
+    once, and new values of the same shapes do not trace it again."""
+    traces = []
+    counted = type(swarm)(**{**swarm.__dict__,
+                             "step": lambda *a: (traces.append(1), swarm.step(*a))[1]})
+    first = swarm.default_params._fields[0]
+    values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, runs)
+    for value in values:  # valid values: every run of the sweep is one the swarm accepts
+        swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
+    grid = jax.tree_util.tree_map(lambda x: jnp.full((runs,), x), counted.default_params)
+    grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
+    sweep = jax.jit(jax.vmap(lambda p: run(counted, jax.random.key(0), graph, task, p,
+                                           iterations=iterations)[0].best_cost))
+    costs = sweep(grid)
+    sweep(grid._replace(**{first: grid[0] * 0.9}))  # new values, same shapes: no retrace
+    assert costs.shape == (runs,)
+    assert len(traces) == 1, f"{swarm.name}: traced {len(traces)} times"
+
+
+def check_swarm(swarm: Swarm, graph: Graph, task: Task, optimum: float) -> None:
+    """Every check of this module, with their defaults."""
+    check_reproducible(swarm, graph, task)
+    check_valid_results(swarm, graph, task, optimum)
+    check_compiles_once(swarm, graph, task)
