@@ -26,9 +26,8 @@ import time
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.cli import paper_maps_argument
 from jaxswarm.exact import distance_field
-from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.paper import paper_map, paper_maps_argument
 from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
 from jaxswarm.swarm.walking import step_budget, visited_nodes, walk

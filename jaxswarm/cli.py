@@ -21,7 +21,7 @@ import jax
 from jaxswarm.cpu import configure
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
 from jaxswarm.maps.movingai import load_map
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map, paper_map_names
+from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.paths import as_node, path_length
 from jaxswarm.swarm import make, make_task, registry, run
 
@@ -183,16 +183,6 @@ def _load(args):
         return Path(args.map).stem, load_map(args.map), args.start, args.goal
     raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)} or a .map file, "
                      f"got {args.map!r}")
-
-
-def paper_maps_argument(text: str) -> tuple[str, ...]:
-    """An argparse ``type`` for a ``--maps`` option of the scripts: the paper maps ``text`` names
-    (``"all"`` or comma-separated, see :func:`jaxswarm.maps.paper.paper_map_names`); a bad list
-    is reported as the option's error."""
-    try:
-        return paper_map_names(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def _point(text: str) -> tuple[int, int]:

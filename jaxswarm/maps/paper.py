@@ -27,6 +27,7 @@ paper's.
 """
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import math
 
@@ -135,6 +136,15 @@ def paper_map_names(text: str) -> tuple[str, ...]:
         problem = f"unknown paper maps {unknown}" if unknown else "no paper map named"
         raise ValueError(f"{problem}; choose from all or {', '.join(PAPER_MAPS)}")
     return names
+
+
+def paper_maps_argument(text: str) -> tuple[str, ...]:
+    """An argparse ``type`` for a ``--maps`` option of the scripts: the paper maps ``text`` names
+    (see :func:`paper_map_names`); a bad list is reported as the option's error."""
+    try:
+        return paper_map_names(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def paper_map(name: str) -> PaperMap:
