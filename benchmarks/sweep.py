@@ -9,7 +9,7 @@ a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. Prin
 * ``sweep``: one timed call of ``run_sweep`` (it takes minutes, so it is not repeated). Its
   compile time is the runner's own ``compiled ... in X s`` log line; the wall time and runs/s
   exclude it (they still include the map's optimum, the chunks' inputs and the Parquet writes).
-  The sum of the chunks' compute times (the rows' ``seconds``) is printed beside it.
+  The sum of the chunks' compute times (the rows' ``chunk_seconds``) is printed beside it.
 * ``loop``: ``run`` called per (params, seed) with ``jax.random.key(seed)`` and blocked on, after
   one warm-up call (params are traced, so the loop compiles once; that compile is printed and
   excluded). With ``--loop-runs N`` below the total only N runs, spread over the grid and the
@@ -94,8 +94,7 @@ def time_sweep(spec) -> dict:
                 for m in [re.search(r"compiled .* in ([\d.]+) s", line)] if m]
     compile_seconds = sum(compiles)
     frame = frame.sort_values("run").reset_index(drop=True)
-    chunk_seconds = float(frame.groupby("chunk")["seconds"].first().mul(
-        frame.groupby("chunk").size()).sum())
+    chunk_seconds = float(frame.groupby(["map", "chunk"])["chunk_seconds"].first().sum())
     return dict(frame=frame, wall=wall, compile=compile_seconds, compiles=len(compiles),
                 chunk_seconds=chunk_seconds, rss=peak_rss(), device=device_memory())
 

@@ -155,7 +155,11 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     assert len(frame) == 2 * spec.num_runs == 24
     assert not frame.duplicated(["map", "run"]).any()
     assert set(frame.columns) >= {"map", "algorithm", "seed", "p_base", "alpha", "cost",
-                                  "optimum", "gap", "found", "success", "iterations", "seconds"}
+                                  "optimum", "gap", "found", "success", "iterations", "chunk",
+                                  "chunk_seconds"}
+    # One wall time per chunk, repeated in each of its rows.
+    assert (frame.groupby(["map", "chunk"])["chunk_seconds"].nunique() == 1).all()
+    assert (frame["chunk_seconds"] > 0).all()
     chosen = paper_map("mosaic20")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)

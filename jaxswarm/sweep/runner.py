@@ -64,8 +64,10 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     Returns:
       DataFrame, one row per (map, params, seed): ``map``, ``map_index``, ``run``, ``algorithm``,
       ``seed``, one column per swept param, ``cost`` (inf if no path), ``optimum``, ``gap``
-      (relative), ``found``, ``success`` (gap < 1e-4), ``iterations`` (used), ``seconds`` (the
-      chunk's wall time divided by its runs, compile excluded), ``chunk``.
+      (relative), ``found``, ``success`` (gap < 1e-4), ``iterations`` (used), ``chunk`` (the
+      compiled batch the run was part of) and ``chunk_seconds`` (that whole chunk's wall time,
+      compile excluded: the same in each of its rows; runs of a chunk run together, so no run
+      has a time of its own).
 
     Raises:
       ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec
@@ -118,7 +120,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
                 began = time.perf_counter()
                 cost, iterations = _gather(compiled[program](*inputs, graph, task))
-                seconds = (time.perf_counter() - began) / count
+                seconds = time.perf_counter() - began
                 rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
                              cost[:count], iterations[:count], best, seconds)
                 if writer:
@@ -218,7 +220,7 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, c
         rows[name] = np.array([grid[r // len(seeds)][name] for r in runs], np.float64)
     rows.update(cost=cost, optimum=np.full(count, best), gap=gap, found=found,
                 success=found & (gap < SUCCESS_GAP), iterations=np.asarray(iterations, np.int32),
-                seconds=np.full(count, seconds), chunk=np.full(count, chunk, np.int32))
+                chunk_seconds=np.full(count, seconds), chunk=np.full(count, chunk, np.int32))
     return rows
 
 
