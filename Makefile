@@ -3,9 +3,9 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
-PYTEST := $(BIN)/python -m pytest -p no:cacheprovider -n 2
+PYTEST := $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile
 
-.PHONY: demo test test-slow bench clean
+.PHONY: demo test test-slow bench reproduce reproduce-quick clean
 
 $(INSTALLED): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -13,7 +13,7 @@ $(INSTALLED): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(INSTALLED)
 
-demo: $(INSTALLED)  ## plan on a paper map with every planner, print a table, write out/demo.png
+demo: $(INSTALLED)  ## plan on mosaic50 with every planner, print a table, write out/demo_mosaic50*.png
 	$(BIN)/jaxswarm demo
 
 test: $(INSTALLED)  ## the default test suite (minutes)
@@ -24,6 +24,39 @@ test-slow: $(INSTALLED)  ## the large-scale checks (every Moving AI scenario row
 
 bench: $(INSTALLED)  ## benchmark scripts (print figures; not tests)
 	$(BIN)/python benchmarks/exact.py
+
+# The generated tables of results/ (see results/README.md), one script each; every script writes
+# its Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and
+# sweeps/provenance.py then indexes them in results/README.md. The full run is the scripts'
+# paper-size defaults, spelled out: Table 1 and the RFD table on all nine paper maps with 20 seeds,
+# 100 iterations and 256 agents; the path maps 10x10, 20x20 and 40x25 with 10 runs of populations
+# of 50 ants; the A* study on 1000 grids per size 10..100. Measured: 23 min on 2 cores (AMD EPYC,
+# shared with other work, load 1.5-4): Table 1 6.5 min, RFD table 2.8 min, path maps 0.3 min,
+# A* study 13.6 min (29 min in an earlier run under load 3-6).
+RESULTS := results
+QUICK_OUT := out/reproduce-quick
+TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
+RFD_FULL := --maps all --seeds 20 --iterations 100 --agents 256
+PATHMAPS_FULL := --sizes 10x10,20x20,40x25 --runs 10 --ants 50 --max-ants 5000 --patience 20
+EXACT_FULL := --sizes 10:100:5 --grids 1000
+TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
+RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
+PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
+EXACT_QUICK := --sizes 10:20:5 --grids 5
+
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 min on 2 cores)
+	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
+	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
+	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
+	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
+	$(BIN)/python sweeps/provenance.py $(RESULTS)
+
+reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
+	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_QUICK) --out $(QUICK_OUT)/rfd_paper_table1
+	$(BIN)/python sweeps/rfd_static.py $(RFD_QUICK) --out $(QUICK_OUT)/rfd_static
+	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_QUICK) --out $(QUICK_OUT)/aco_pathmaps
+	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
+	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 
 clean:
 	rm -rf $(VENV) out *.egg-info

@@ -1,7 +1,7 @@
-"""Wall time of RFD* to solve each paper map, beside the RFD paper's Table 1.
+"""Wall time of ``rfd_graded`` (ours) to solve each paper map, beside the RFD paper's RFD* times.
 
-Each map is solved by RFD* once per seed (``--seeds``, default 20): at most 100 iterations, and a
-run stops after ``--patience`` iterations without improvement (default 30) or when every drop
+Each map is solved by ``rfd_graded`` once per seed (``--seeds``, default 20): at most 100
+iterations, and a run stops after ``--patience`` iterations without improvement (default 30) or when every drop
 follows the same path. Runs are jitted once per map (compile excluded) and timed one by one; the
 script prints the median wall time per run next to the paper's RFD* time (C#, Intel i7-3770, one
 drop at a time), the speed-up, and how many seeds reached the optimum (relative gap < 1e-4).
@@ -13,7 +13,7 @@ deterministic, so a repeat whose paths differ from the first stops the script.
 XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see :mod:`jaxswarm.cpu`: a
 run is thousands of tiny kernels in a row, and a second thread mostly adds hand-offs between the
 cores). With ``--devices N`` the CPU is split into N JAX devices and each walk's drops are spread
-over them (``make("rfd_star", devices=N)``), so one run uses N cores (and at least N threads);
+over them (``make("rfd_graded", devices=N)``), so one run uses N cores (and at least N threads);
 the results are bit-identical to one device.
 
 Run from the repository root::
@@ -81,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in maps:
         medians, first = [], None
         for _ in range(args.repeats):
-            rows = solve_map(name, "rfd_star", args.seeds, iterations=100,
+            rows = solve_map(name, "rfd_graded", args.seeds, iterations=100,
                              patience=args.patience, num_agents=args.agents,
                              devices=args.devices)
             medians.append(1e3 * statistics.median(r["seconds"] for r in rows))

@@ -51,6 +51,8 @@ def main(argv: list[str] | None = None) -> int:
                       help="agents per swarm iteration (default: each swarm's own, e.g. 256 "
                            "drops, the Max-Min ACO paper's 50 ants)")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
+    demo.add_argument("--swarms", type=_swarm_names, default=registry.registered(),
+                      help="comma-separated registered swarms (default: all)")
     demo.add_argument("--out", type=Path,
                       help="figure path (default out/demo_MAP.png); each swarm's figure is "
                            "written beside it with the swarm's name appended")
@@ -119,7 +121,7 @@ def run_demo(args: argparse.Namespace) -> int:
         solution = solutions[label] = runs[0]
         milliseconds = statistics.median(run.stats.wall_time for run in runs) * 1e3
         rows.append((label, solution.cost, solution.stats.expanded, "-", f"{milliseconds:.2f}"))
-    for name_in_registry in registry.REGISTRY:
+    for name_in_registry in args.swarms:
         label = swarm_label(name_in_registry)
         config = {} if args.drops is None else dict(num_agents=args.drops)
         swarm = make(name_in_registry, **config)
@@ -183,6 +185,16 @@ def _load(args):
         return Path(args.map).stem, load_map(args.map), args.start, args.goal
     raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)} or a .map file, "
                      f"got {args.map!r}")
+
+
+def _swarm_names(text: str) -> tuple[str, ...]:
+    names = tuple(name.strip() for name in text.split(",") if name.strip())
+    unknown = [name for name in names if name not in registry.REGISTRY]
+    if unknown or not names:
+        raise argparse.ArgumentTypeError(
+            f"unknown swarms {unknown}; registered: {', '.join(registry.registered())}"
+            if unknown else "name at least one swarm")
+    return names
 
 
 def _point(text: str) -> tuple[int, int]:

@@ -24,7 +24,11 @@ Outputs (in ``--out``, default ``out/exact_study/``, each written atomically):
 * ``summary.csv``: per (size, planner) the mean and sample standard deviation (ddof=1) of
   iterations, expanded, generated and time_ms,
 * ``exact_study.png``: three panels (iterations, visited nodes, time in ms against grid size), a
-  mean line and a shaded +-1 std band per planner.
+  mean line and a shaded +-1 std band per planner;
+* ``table.md``: the provenance (:mod:`provenance`), then the summary as a Markdown table;
+* ``provenance.json``: the provenance and the arguments.
+
+``make reproduce`` writes them to ``results/exact_study/``.
 
 The planners are plain Python, so the full default run (19 sizes x 1000 grids) takes tens of
 minutes; an estimate is printed first. ``--grids 20`` takes about a minute.
@@ -46,10 +50,15 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import atomic_path, write_csv
+from jaxswarm.atomic import atomic_path, write_atomically, write_csv
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
+
+HERE = str(Path(__file__).resolve().parent)
+if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
+    sys.path.insert(0, HERE)
+import provenance  # noqa: E402
 
 PLANNERS: dict[str, Callable] = {
     "dijkstra": dijkstra,
@@ -64,6 +73,16 @@ SUMMARY_COLUMNS = ("size", "planner", "grids") + tuple(
     f"{metric}_{stat}" for metric in METRICS for stat in ("mean", "std"))
 COST_RTOL = 1e-9
 LABELS = {"dijkstra": "Dijkstra", "astar": "A*", "bidirectional_astar": "Bidirectional A*"}
+TITLE = "Dijkstra vs A* vs bidirectional A* on random grids (the A* report's study)"
+"""Title of table.md."""
+ABOUT = (
+    "Rows: the three exact planners of `jaxswarm.exact` (Dijkstra, A*, bidirectional A*; all "
+    "published algorithms, none of this project's own) on random 8-connected grids with a "
+    "guaranteed corner-to-corner path. Per grid size and planner: the mean +- sample standard "
+    "deviation over the grids of the main-loop iterations (queue pops), the expanded (visited) "
+    "nodes, the generated (pushed) nodes and the search time; the three planners' path costs "
+    "agree on every grid.")
+"""What the rows are (the paragraph under the provenance)."""
 
 
 class CostMismatch(RuntimeError):
@@ -228,7 +247,21 @@ def format_summary(summary: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def summary_markdown(summary: list[dict]) -> str:
+    """The summary as a Markdown table (mean +- std per size and planner)."""
+    lines = ["| size | planner | grids | iterations | expanded | generated | time ms |",
+             "| ---: | --- | ---: | ---: | ---: | ---: | ---: |"]
+    for e in summary:
+        cells = [f"{e[f'{m}_mean']:.1f} +- {e[f'{m}_std']:.1f}"
+                 for m in ("iterations", "expanded", "generated")]
+        cells.append(f"{e['time_ms_mean']:.3f} +- {e['time_ms_std']:.3f}")
+        lines.append(f"| {e['size']} | {LABELS[e['planner']]} | {e['grids']} | "
+                     + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", type=parse_sizes, default=parse_sizes("10:100:5"),
                         help="grid sides, start:stop:step (stop included) or a comma list "
@@ -246,6 +279,7 @@ def main(argv: list[str] | None = None) -> int:
     if not 0.0 <= args.density < 1.0:
         parser.error("--density must be in [0, 1)")
 
+    record = provenance.begin(__file__, argv)
     sizes = args.sizes
     print(f"exact study: sizes {sizes[0]}..{sizes[-1]} ({len(sizes)} sizes) x {args.grids} grids, "
           f"density {args.density}, seed {args.seed} -> {args.out}")
@@ -255,14 +289,17 @@ def main(argv: list[str] | None = None) -> int:
     began = time.perf_counter()
     rows = run_study(sizes, args.grids, args.density, args.seed)
     summary = summarise(rows)
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args))
     write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
     write_csv(args.out / "summary.csv", summary, SUMMARY_COLUMNS)
     plot_summary(summary, args.out / "exact_study.png")
+    write_atomically(args.out / "table.md", record.document(summary_markdown(summary)))
+    record.write(args.out)
 
     print("\n" + format_summary(summary))
     print(f"\n{len(rows)} runs in {time.perf_counter() - began:.0f} s; costs of the three planners "
           f"agree on every grid. Wrote {args.out / 'runs.csv'}, {args.out / 'summary.csv'}, "
-          f"{args.out / 'exact_study.png'}")
+          f"{args.out / 'exact_study.png'}, {args.out / 'table.md'}")
     return 0
 
 

@@ -1,12 +1,17 @@
-"""RFD and RFD* on the nine paper maps, static environment (the RFD paper's Table 1 set-up).
+"""RFD, RFD* and RFD graded on the nine paper maps, static environment (the RFD paper's Table 1
+set-up).
 
-For every map, each algorithm runs once per seed (``--seeds``, default 20) for at most 100
-iterations (``--iterations``; a run also stops when every drop follows the same path, and, if
-``--patience`` is given, after that many iterations without improvement). Each run is jitted once
-per map and algorithm and then timed on its own (compile excluded). Printed per map: the optimum
-(Dijkstra), each algorithm's mean best length over the seeds, its success count (relative gap
-< 1e-4 to the optimum) and the median wall time of one run. Written to ``--out`` (default
-``out/rfd_static``): ``runs.csv`` (one row per map, algorithm and seed) and ``table.md``.
+Three rows per map: the RFD paper's RFD (``rfd``, eqs. 1-5) and RFD* (``rfd_star``, eq. 6 with the
+erosion of eqs. 4-5), and this project's own law ``rfd_graded`` (RFD*'s transitions over a graded
+river bed; registered as ``rfd_star`` until jaxswarm 0.2.0). Each runs with its default params once
+per seed (``--seeds``, default 20) for at most 100 iterations (``--iterations``; a run also stops
+when every drop follows the same path, and, if ``--patience`` is given, after that many iterations
+without improvement). Each run is jitted once per map and algorithm and then timed on its own
+(compile excluded). Reported per map and algorithm: the optimum (Dijkstra), the mean best length
+over the seeds, the success count (relative gap < 1e-4 to the optimum) and the median wall time
+of one run. Written to ``--out`` (default ``out/rfd_static``; ``make reproduce`` uses
+``results/rfd_static``), each file atomically: ``runs.csv`` (one row per map, algorithm and
+seed), ``table.md`` (the provenance, then the table) and ``provenance.json``.
 
 Run from the repository root::
 
@@ -17,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -24,14 +30,32 @@ import jax
 
 from jaxswarm.atomic import write_atomically, write_csv
 from jaxswarm.exact import dijkstra
-from jaxswarm.cli import paper_maps_argument
-from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.swarm import definition, make, make_task, run
 
-ALGORITHMS = ("rfd", "rfd_star")
+HERE = str(Path(__file__).resolve().parent)
+if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
+    sys.path.insert(0, HERE)
+import provenance  # noqa: E402
+
+SOURCES = {"rfd": "RFD paper", "rfd_star": "RFD paper", "rfd_graded": "ours"}
+"""Registered swarm -> where its algorithm comes from, in table order."""
+ALGORITHMS = tuple(SOURCES)
+"""The registered swarms of the table, in order."""
 SUCCESS_GAP = 1e-4
+"""A run succeeds when its relative gap to the optimum is below this."""
 COLUMNS = ("map", "algorithm", "seed", "optimum", "cost", "gap", "success", "iterations",
            "first_optimal_iteration", "seconds")
+"""Columns of runs.csv."""
+TITLE = "RFD, RFD* and RFD graded on the RFD paper's nine maps (static environment)"
+"""Title of table.md."""
+ABOUT = (
+    "Rows: `rfd` (the RFD paper's RFD, eqs. 1-5) and `rfd_star` (the paper's RFD*: eq. 6 with "
+    "the erosion of eqs. 4-5, as written) are the paper's algorithms; `rfd_graded` is ours, not "
+    "the paper's: RFD*'s transitions over a graded river bed (registered as `rfd_star` until "
+    "jaxswarm 0.2.0). Each runs with its default params; success means a best length within a "
+    "relative 1e-4 of the optimum (Dijkstra).")
+"""What the rows are (the paragraph under the provenance)."""
 
 
 def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patience: int | None,
@@ -66,28 +90,32 @@ def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patienc
     return rows
 
 
+def summary_cells(runs: list[dict]) -> list[str]:
+    """Mean length (of the runs that found a path; "n/a" if none did, with the found count if
+    some did not), success count and median time [ms] of one map's and algorithm's runs."""
+    finite = [r["cost"] for r in runs if r["cost"] != float("inf")]
+    mean = f"{statistics.mean(finite):.2f}" if finite else "n/a"
+    if finite and len(finite) < len(runs):
+        mean += f" ({len(finite)} found)"
+    return [mean, f"{sum(r['success'] for r in runs)}/{len(runs)}",
+            f"{1e3 * statistics.median(r['seconds'] for r in runs):.0f}"]
+
+
 def table(rows: list[dict], maps: tuple[str, ...]) -> str:
-    """Markdown table: per map, the optimum and each algorithm's mean length, success, time."""
-    header = "| map | optimum | " + " | ".join(
-        f"{a} mean length | {a} success | {a} median ms" for a in ALGORITHMS) + " |"
-    lines = [header, "|" + " --- |" * (2 + 3 * len(ALGORITHMS))]
+    """Markdown table: per map and algorithm, the optimum, mean length, success and time."""
+    lines = ["| map | optimum | algorithm | source | mean length | success | median ms |",
+             "| --- | ---: | --- | --- | ---: | ---: | ---: |"]
     for name in maps:
-        cells = [name]
         for algorithm in ALGORITHMS:
             mine = [r for r in rows if r["map"] == name and r["algorithm"] == algorithm]
-            if not cells[1:]:
-                cells.append(f"{mine[0]['optimum']:.2f}")
-            finite = [r["cost"] for r in mine if r["cost"] != float("inf")]
-            mean = f"{statistics.mean(finite):.2f}" if finite else "n/a"
-            if finite and len(finite) < len(mine):
-                mean += f" ({len(finite)} found)"
-            cells += [mean, f"{sum(r['success'] for r in mine)}/{len(mine)}",
-                      f"{1e3 * statistics.median(r['seconds'] for r in mine):.0f}"]
-        lines.append("| " + " | ".join(cells) + " |")
+            cells = [name, f"{mine[0]['optimum']:.2f}", algorithm, SOURCES[algorithm],
+                     *summary_cells(mine)]
+            lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", type=paper_maps_argument, default="all",
                         help="comma-separated paper maps, or all")
@@ -97,10 +125,13 @@ def main(argv: list[str] | None = None) -> int:
                         help="also stop after this many iterations without improvement "
                              "(default: never, the paper's plain 100 iterations)")
     parser.add_argument("--agents", type=int, default=256, help="drops per iteration")
-    parser.add_argument("--out", type=Path, default=Path("out/rfd_static"))
+    parser.add_argument("--out", type=Path, default=Path("out/rfd_static"),
+                        help="output folder (make reproduce: results/rfd_static)")
     args = parser.parse_args(argv)
-    if args.seeds < 1:
-        parser.error("--seeds must be at least 1")
+    for option in ("seeds", "iterations", "agents"):
+        if getattr(args, option) < 1:
+            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    record = provenance.begin(__file__, argv)
     rows = []
     for name in args.maps:
         for algorithm in ALGORITHMS:
@@ -108,11 +139,14 @@ def main(argv: list[str] | None = None) -> int:
             mine = solve_map(name, algorithm, args.seeds, iterations=args.iterations,
                              patience=args.patience, num_agents=args.agents)
             rows += mine
-            print(f"{name:10} {algorithm:9} success {sum(r['success'] for r in mine):2d}/"
+            print(f"{name:10} {algorithm:10} success {sum(r['success'] for r in mine):2d}/"
                   f"{args.seeds} ({time.perf_counter() - began:.0f} s)", flush=True)
+    swarms = {a: definition(make(a, num_agents=args.agents)) for a in ALGORITHMS}
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args), swarms=swarms)
     write_csv(args.out / "runs.csv", rows, COLUMNS)
     markdown = table(rows, args.maps)
-    write_atomically(args.out / "table.md", markdown + "\n")
+    write_atomically(args.out / "table.md", record.document(markdown))
+    record.write(args.out)
     print("\n" + markdown)
     return 0
 

@@ -40,20 +40,22 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     (["--map", "nowhere"], "--map must be one of"),
     (["--map", "nosuch.map", "--start", "1,1", "--goal", "2,2"], "--map nosuch.map: no such file"),
     (["--map", "nosuch.map"], "--start and --goal are required with a .map file"),
+    (["--swarms", "rfd,bees"], "unknown swarms ['bees']; registered: aco_star"),
 ])
-def test_demo_rejects_a_bad_map_in_one_line_with_exit_status_2(capsys, arguments, message):
+def test_demo_rejects_a_bad_map_or_swarm_in_a_line_with_exit_status_2(capsys, arguments, message):
     with pytest.raises(SystemExit) as stop:
         main(["demo", *arguments])
     assert stop.value.code == 2
     error = capsys.readouterr().err
-    assert message in error and "Traceback" not in error and len(error.splitlines()) == 1
+    assert message in error.splitlines()[-1] and "Traceback" not in error
 
 
 def test_demo_plans_on_a_moving_ai_map_between_given_cells(tmp_path, capsys, monkeypatch):
     from conftest import MOVINGAI
     monkeypatch.chdir(tmp_path)
     assert main(["demo", "--map", str(MOVINGAI / "mapf" / "empty-32-32.map"), "--start", "0,0",
-                 "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8"]) == 0
+                 "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8",
+                 "--swarms", "rfd_graded"]) == 0
     out = tmp_path / "out" / "demo_empty-32-32.png"  # the figures carry the map's name
     text = capsys.readouterr().out
     assert text.startswith("map empty-32-32: 32x32, 1024 free cells, start (0, 0) -> goal (5, 3)")

@@ -1,0 +1,265 @@
+"""The reproduction of results/: the shared provenance helper (sweeps/provenance.py), every table
+script's provenance header at a tiny size, the path-map table beside the Max-Min ACO paper's
+(sweeps/aco_pathmaps.py), the results index, and the Makefile's reproduce targets."""
+from __future__ import annotations
+
+import csv
+import importlib.metadata
+import json
+import math
+import os
+import platform
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+
+import jax
+import numpy as np
+import pytest
+
+from repo_scripts import ROOT, load_script
+
+provenance = load_script("sweeps/provenance.py")
+pathmaps = load_script("sweeps/aco_pathmaps.py")
+
+# Folder -> (script, tiny arguments): the quick reproduction, smaller still than the Makefile's.
+# Both RFD tables run alley20 with the same sizes, so rfd_static reuses compiled runs.
+TINY = {
+    "rfd_paper_table1": ("sweeps/rfd_paper_static.py",
+                         ["--maps", "alley20", "--seeds", "1", "--iterations", "2",
+                          "--agents", "8"]),
+    "rfd_static": ("sweeps/rfd_static.py",
+                   ["--maps", "alley20", "--seeds", "1", "--iterations", "2", "--agents", "8"]),
+    "aco_pathmaps": ("sweeps/aco_pathmaps.py",
+                     ["--sizes", "10x10", "--runs", "2", "--max-ants", "200"]),
+    "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
+}
+
+
+def git_head() -> str | None:
+    """HEAD of the repository, asked of git independently of the helper (None without one)."""
+    try:
+        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    """A results folder written by every table script at a tiny size, then indexed; with each
+    script's wall time as measured here."""
+    folder = tmp_path_factory.mktemp("results")
+    seconds = {}
+    for name, (script, argv) in TINY.items():
+        began = time.perf_counter()
+        assert load_script(script).main([*argv, "--out", str(folder / name)]) == 0
+        seconds[name] = time.perf_counter() - began
+    assert provenance.main([str(folder)]) == 0
+    return folder, seconds
+
+
+def read_csv(path) -> list[dict]:
+    with open(path, newline="", encoding="utf-8") as f:
+        return list(csv.DictReader(f))
+
+
+def test_command_is_relative_to_the_root_and_quoted():
+    script = str(ROOT / "sweeps" / "rfd_static.py")
+    assert provenance.command(script, ["--maps", "maze20,alley20", "--out", "a b"]) == (
+        "python sweeps/rfd_static.py --maps maze20,alley20 --out 'a b'")
+
+
+def test_cpu_model_comes_from_cpuinfo(tmp_path):
+    cpuinfo = tmp_path / "cpuinfo"
+    cpuinfo.write_text("processor\t: 0\nvendor_id\t: Made Up\nmodel name\t: Test CPU 9000 @ 1GHz\n"
+                       "processor\t: 1\nmodel name\t: Test CPU 9000 @ 1GHz\n")
+    assert provenance.cpu_model(cpuinfo) == "Test CPU 9000 @ 1GHz"
+    assert provenance.cpu_model(tmp_path / "missing") == (platform.processor() or "unknown")
+
+
+@pytest.mark.parametrize("seconds, text", [
+    (None, "unknown"), (0.4, "0 s"), (119, "119 s"), (750, "12.5 min"), (9000, "2.50 h")])
+def test_format_seconds(seconds, text):
+    assert provenance.format_seconds(seconds) == text
+
+
+def test_versions_name_the_installed_packages():
+    versions = provenance.versions()
+    assert versions["jaxswarm"] == importlib.metadata.version("jaxswarm")
+    assert (versions["jax"], versions["numpy"], versions["python"]) == (
+        jax.__version__, np.__version__, platform.python_version())
+    # The source tree's version is named only when it differs from the installed one.
+    source = provenance.source_version()
+    assert ("jaxswarm (pyproject.toml)" in versions) == (source != versions["jaxswarm"])
+
+
+def test_git_state_names_the_checkout_commit():
+    commit, dirty = provenance.git_state()
+    if git_head() is None:
+        assert (commit, dirty) == (None, None)
+        return
+    assert commit == git_head() and len(commit) == 40
+    assert not any(path.startswith("results/") for path in dirty)  # the tables being written
+    assert provenance.describe_tree([]) == "working tree clean"
+    assert "2 paths differ" in provenance.describe_tree(["a.py", "b.py"])
+
+
+def test_every_table_starts_with_its_provenance(quick):
+    folder, seconds = quick
+    commit = git_head()
+    for name, (script, argv) in TINY.items():
+        text = (folder / name / "table.md").read_text(encoding="utf-8")
+        record = json.loads((folder / name / "provenance.json").read_text(encoding="utf-8"))
+        command = shlex.join(["python", script, *argv, "--out", str(folder / name)])
+        assert record["command"] == command
+        assert text.startswith(f"# {record['title']}\n\nGenerated by `{command}`"), name
+        header = text.split("\n\n")[2]  # the provenance table, right under the command
+        assert f"| commit | {commit or 'unknown'}" in header, name
+        for package in ("jax", "jaxlib", "numpy", "python"):
+            assert f"{package} {record['versions'][package]}" in header, (name, package)
+        assert f"{os.cpu_count()} cores" in header
+        assert record["commit"] == commit and record["started"] in text
+        assert 0 < record["seconds"] <= seconds[name] + 1, name
+        assert record["about"] and record["about"] in text
+
+
+def test_index_lists_every_table_in_the_order_they_ran(quick):
+    folder, _ = quick
+    text = (folder / "README.md").read_text(encoding="utf-8")
+    sections = [line for line in text.splitlines() if line.startswith("## ")]
+    assert [line.split("`")[1] for line in sections] == [f"{name}/" for name in TINY]
+    records = [provenance.load(folder / name) for name in TINY]
+    for record in records:
+        assert f"* command: `{record['command']}`" in text
+    total = sum(record["seconds"] for record in records)
+    assert f"took {provenance.format_seconds(total)} in all" in text
+    assert "except `rfd_graded`" in text
+
+
+def test_index_of_a_folder_without_tables_is_an_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        provenance.main([str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert "nothing to index" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_path_map_ratios_are_to_ant_system(quick):
+    folder, _ = quick
+    rows = read_csv(folder / "aco_pathmaps" / "results.csv")
+    assert [(r["map"], r["algorithm"]) for r in rows] == [
+        ("10x10", label) for label in pathmaps.ALGORITHMS]
+    baseline = rows[0]
+    for r in rows:
+        optimum, minimum = float(r["optimum"]), float(r["min_length"])
+        assert minimum >= optimum * (1 - 1e-6)
+        assert float(r["min_ratio"]) == pytest.approx(minimum / optimum)
+        assert int(r["found"]) <= int(r["runs"]) == 2
+        for column, ours in (("min", "min_length"), ("mean", "mean_length"),
+                             ("seconds", "mean_seconds")):
+            assert float(r[f"{column}_vs_ant_system"]) == pytest.approx(
+                float(r[ours]) / float(baseline[ours]))
+
+
+def test_path_map_table_has_the_papers_values_beside_ours(quick):
+    folder, _ = quick
+    rows = {(r["map"], r["algorithm"]): r for r in read_csv(folder / "aco_pathmaps" /
+                                                            "results.csv")}
+    improved = rows["10x10", "Improved Max-Min ACO"]
+    assert (float(improved["paper_min_length"]), float(improved["paper_mean_length"]),
+            float(improved["paper_seconds"])) == (289.7, 297.9, 1.17)
+    assert float(improved["paper_mean_vs_ant_system"]) == pytest.approx(297.9 / 352.3)
+    assert float(improved["paper_seconds_vs_ant_system"]) == pytest.approx(1.17 / 14.6)
+    lines = (folder / "aco_pathmaps" / "table.md").read_text(encoding="utf-8").splitlines()
+    assert any(line.startswith("| Improved Max-Min ACO | paper | 289.7 | 297.9 | 0.825 | 0.846 |")
+               for line in lines)
+    assert any("compare ratios, not lengths" in line for line in lines)
+
+
+def test_a_map_the_paper_did_not_run_has_no_paper_values():
+    rows = [dict(map="4x3", algorithm=label, optimum=5.0, min_length=length, mean_length=length,
+                 mean_seconds=seconds, min_ratio=length / 5, mean_ratio=length / 5, found=1,
+                 runs=1, mean_populations=3.0)
+            for label, length, seconds in zip(pathmaps.ALGORITHMS, (8.0, 6.0, math.inf),
+                                              (2.0, 1.0, 0.5))]
+    rows = pathmaps.add_ratios(rows)
+    assert [r["mean_vs_ant_system"] for r in rows[:2]] == [1.0, 0.75]
+    assert math.isnan(rows[2]["min_vs_ant_system"])  # no path found: no ratio
+    assert rows[2]["seconds_vs_ant_system"] == 0.25
+    assert {r["paper_mean_length"] for r in rows} == {r["paper_seconds_vs_ant_system"]
+                                                      for r in rows} == {""}
+    lines = pathmaps.map_table(rows)
+    assert "| Max-Min ACO | paper |" + " - |" * 10 in lines
+    assert lines[lines.index("| Max-Min ACO | paper |" + " - |" * 10) + 1].startswith(
+        "| Improved Max-Min ACO | ours | n/a | n/a | n/a | n/a |")
+
+
+def test_paper_values_cover_the_papers_three_maps_and_algorithms():
+    assert list(pathmaps.PAPER_TABLE1) == ["10x10", "20x20", "40x25"]
+    for values in pathmaps.PAPER_TABLE1.values():
+        assert list(values) == list(pathmaps.ALGORITHMS)
+        assert all(len(v) == 3 and min(v) > 0 for v in values.values())
+
+
+def test_bad_sizes_are_an_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        pathmaps.main(["--sizes", "10x10,20by20", "--out", str(tmp_path)])
+    assert exit_info.value.code == 2
+    assert "expected WIDTHxHEIGHT, got '20by20'" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
+
+
+def test_a_script_run_from_the_root_finds_the_helper(tmp_path):
+    # python sweeps/NAME.py: the way make reproduce runs them (sweeps/ first on sys.path).
+    done = subprocess.run([sys.executable, "sweeps/exact_study.py", "--sizes", "10",
+                           "--grids", "1", "--out", str(tmp_path)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    record = provenance.load(tmp_path)
+    assert record["command"] == shlex.join(["python", "sweeps/exact_study.py", "--sizes", "10",
+                                            "--grids", "1", "--out", str(tmp_path)])
+
+
+def make_commands(target: str, *variables: str) -> list[list[str]]:
+    """The script commands ``make -n TARGET`` would run (the venv set-up lines left out), each
+    as [script, arguments...]."""
+    if shutil.which("make") is None:
+        pytest.skip("make is not installed")
+    done = subprocess.run(["make", "-n", target, *variables], cwd=ROOT, capture_output=True,
+                          text=True, check=True, timeout=60)
+    commands = [shlex.split(line) for line in done.stdout.splitlines() if " sweeps/" in line]
+    return [words[1:] for words in commands]  # without the interpreter
+
+
+def out_folders(commands: list[list[str]]) -> list[str]:
+    """The --out of each table command and the folder the last one (the index) is given."""
+    *tables, index = commands
+    assert index[0] == "sweeps/provenance.py"
+    return [words[words.index("--out") + 1] for words in tables] + [index[1]]
+
+
+def test_reproduce_writes_results_and_the_quick_target_never_does():
+    full, quick = make_commands("reproduce"), make_commands("reproduce-quick")
+    assert [words[0] for words in full] == [words[0] for words in quick] == [
+        *(script for script, _ in TINY.values()), "sweeps/provenance.py"]
+    assert out_folders(full) == [*(f"results/{name}" for name in TINY), "results"]
+    assert out_folders(quick) == [*(f"out/reproduce-quick/{name}" for name in TINY),
+                                  "out/reproduce-quick"]
+    # The full target spells out the paper-size arguments it runs.
+    assert full[0][1:full[0].index("--out")] == ["--maps", "all", "--seeds", "20",
+                                                 "--iterations", "100", "--agents", "256"]
+
+
+@pytest.mark.slow
+def test_the_quick_target_runs(tmp_path):
+    # Each command of make reproduce-quick, as make would run it, into a scratch folder.
+    commands = make_commands("reproduce-quick", f"QUICK_OUT={tmp_path}")
+    for script, *argv in commands:
+        assert load_script(script).main(argv) == 0, script
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*TINY, "README.md"])
+    for name in TINY:
+        assert provenance.load(tmp_path / name)["seconds"] > 0
+        assert (tmp_path / name / "table.md").read_text(encoding="utf-8").startswith("# ")
