@@ -6,7 +6,7 @@ import pytest
 
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.paths import is_valid_path, path_length
+from jaxswarm.paths import is_valid_path, path_length, step_slots
 from jaxswarm.swarm import make, make_task, run
 
 
@@ -86,8 +86,15 @@ def test_improved_max_min_starts_from_its_first_ants_path_and_keeps_the_floor(fi
         np.testing.assert_array_equal(nodes, np.asarray(path)[: len(nodes)])
     # Algorithm 1: nothing is deposited before the first population has walked.
     np.testing.assert_array_equal(np.asarray(state.pheromone), float(params.tau0))
-    step = jax.jit(swarm.step)
-    for _ in range(40):
-        state, _ = step(state, graph, task, params)
-    assert float(state.best_cost) <= float(path_length(graph, jnp.asarray(first)))
-    assert np.asarray(state.pheromone).min() >= float(params.tau_min) * (1 - 1e-6)
+    for _ in range(60):
+        state, _ = swarm.step(state, graph, task, params)
+    # The last update floored every edge and added delta on the best path's: each of its edges
+    # holds at least tau_min + q. An edge off every best path decays by 0.9 ** 60 and rests on
+    # the floor: most edges do.
+    tau = np.asarray(state.pheromone)
+    on_best = tau[np.asarray(state.best_path[:-1])[np.asarray(state.best_path[1:]) >= 0],
+                  np.asarray(step_slots(graph, state.best_path))[np.asarray(
+                      state.best_path[1:]) >= 0]]
+    assert on_best.min() >= float(params.tau_min + params.q) * (1 - 1e-6)
+    assert np.median(tau[np.asarray(graph.valid_edges())]) == pytest.approx(
+        float(params.tau_min))

@@ -22,7 +22,7 @@ def successes(name: str) -> int:
     swarm = make("rfd_graded")
     keys = jax.random.split(jax.random.key(0), SEEDS)
     states, _ = jax.jit(jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
-                                               iterations=100)))(keys)
+                                               iterations=100, patience=30)))(keys)
     gaps = (np.asarray(states.best_cost) - optimum) / optimum
     assert (gaps > -1e-6).all()  # never better than the optimum
     return int((gaps < 1e-4).sum())
