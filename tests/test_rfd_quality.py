@@ -14,7 +14,9 @@ SEEDS = 20
 NEEDED = 19  # the issue's bar: the optimum (gap < 1e-4) in at least 19 of 20 seeds
 
 
-def successes(name: str) -> int:
+def successes(name: str, patience: int | None = None) -> int:
+    """Seeds of 20 in which rfd_graded reaches the optimum of paper map ``name`` within 100
+    iterations (and ``patience`` iterations without gain, if given)."""
     chosen = paper_map(name)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
@@ -22,7 +24,7 @@ def successes(name: str) -> int:
     swarm = make("rfd_graded")
     keys = jax.random.split(jax.random.key(0), SEEDS)
     states, _ = jax.jit(jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
-                                               iterations=100, patience=30)))(keys)
+                                               iterations=100, patience=patience)))(keys)
     gaps = (np.asarray(states.best_cost) - optimum) / optimum
     assert (gaps > -1e-6).all()  # never better than the optimum
     return int((gaps < 1e-4).sum())
@@ -30,7 +32,9 @@ def successes(name: str) -> int:
 
 @pytest.mark.parametrize("name", [n for n in PAPER_MAPS if n.endswith("20")])
 def test_rfd_graded_reaches_the_optimum_on_20x20_maps(name):
-    assert successes(name) >= NEEDED
+    # Patience 30 stops a 20x20 run early without a miss (20 of 20 on each); on mosaic50 it
+    # costs two seeds (18 of 20), so the larger maps run their 100 iterations.
+    assert successes(name, patience=30) >= NEEDED
 
 
 @pytest.mark.slow
@@ -60,7 +64,7 @@ def test_rfd_graded_keeps_its_quality_on_moving_ai_maps_it_was_never_tuned_on(mo
                   key=lambda r: r.optimal_length)
         task = make_task(graph, row.start, row.goal)
         states, _ = jax.jit(jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
-                                                   iterations=100, patience=30)))(keys)
+                                                   iterations=100, patience=patience)))(keys)
         gaps = (np.asarray(states.best_cost) - row.optimal_length) / row.optimal_length
         assert (gaps > -1e-6).all(), name  # the published optimum is never beaten
         optimal += int((gaps < 1e-4).sum())
