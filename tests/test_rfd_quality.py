@@ -64,7 +64,7 @@ def test_rfd_graded_keeps_its_quality_on_moving_ai_maps_it_was_never_tuned_on(mo
                   key=lambda r: r.optimal_length)
         task = make_task(graph, row.start, row.goal)
         states, _ = jax.jit(jax.vmap(lambda k: run(swarm, k, graph, task, swarm.default_params,
-                                                   iterations=100, patience=patience)))(keys)
+                                                   iterations=100, patience=30)))(keys)
         gaps = (np.asarray(states.best_cost) - row.optimal_length) / row.optimal_length
         assert (gaps > -1e-6).all(), name  # the published optimum is never beaten
         optimal += int((gaps < 1e-4).sum())
