@@ -1,6 +1,6 @@
 """Swarm planners on the graph tensors: the protocol and run loop (``core``), the lockstep walker
-(``walk``), the algorithms (``rfd``, ``aco``) and the registry of names (``registry``:
-``make(name, **config)``)."""
+(``walking``), the algorithms (``rfd``, ``aco``), the registry of names (``registry``:
+``make(name, **config)``) and the conformance suite every swarm passes (``testing``)."""
 from jaxswarm.swarm.core import Swarm, Task, Trace, make_task, run
 from jaxswarm.swarm.registry import config_options, definition, make, registered
 
