@@ -204,6 +204,12 @@ class SwarmConfig:
         check_sizes(self.num_agents, self.max_steps, self.devices)
 
 
+def default_params(params_type, **values):
+    """A Params tuple of NumPy float32 scalars, not JAX arrays: importing a swarm must not start
+    JAX's backend (see :func:`jaxswarm.cpu.configure`); jit and vmap take them as f32 arrays."""
+    return params_type(**{name: np.float32(value) for name, value in values.items()})
+
+
 def best_solution(state) -> Solution:
     """The best path so far of a swarm state with ``best_path`` i32[L] and ``best_cost`` f32[]
     (inf until an agent arrived), as a Solution."""

@@ -15,8 +15,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.aco.colony import colony, deposit, f32
-from jaxswarm.swarm.core import Swarm, SwarmConfig
+from jaxswarm.swarm.aco.colony import colony, deposit
+from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
 
 
 class AntSystemParams(NamedTuple):
@@ -48,9 +48,10 @@ class ACOStarParams(NamedTuple):
     tau0: jax.Array
 
 
-DEFAULT_ANT_SYSTEM = f32(AntSystemParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, tau0=1.0)
-DEFAULT_ACO_STAR = f32(ACOStarParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0, alpha_goal=50.0,
-                       tau0=1.0)
+DEFAULT_ANT_SYSTEM = default_params(AntSystemParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0,
+                                    tau0=1.0)
+DEFAULT_ACO_STAR = default_params(ACOStarParams, rho=0.1, q=1.0, alpha=1.0, beta=0.0,
+                                  alpha_goal=50.0, tau0=1.0)
 """The paper gives eq. 7's exponents (alpha = 1, beta = 0); rho, Q, tau0 and alpha_goal are
 ours."""
 

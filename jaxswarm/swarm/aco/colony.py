@@ -30,12 +30,6 @@ DIRECTION_FLOOR = 1e-3
 """Added to the direction desirability so that a move straight away from the goal stays possible."""
 
 
-def f32(params_type, **values):
-    """Default params as NumPy float32 scalars: importing a colony must not start JAX's backend
-    (see :func:`jaxswarm.cpu.configure`)."""
-    return params_type(**{name: np.float32(value) for name, value in values.items()})
-
-
 @dataclasses.dataclass(frozen=True)
 class ACOState:
     """Memory of an ant colony run (a pytree).

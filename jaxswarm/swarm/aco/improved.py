@@ -23,8 +23,8 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.bug2 import first_ant_path
-from jaxswarm.swarm.aco.colony import colony, f32, reinforce, transition_rule
-from jaxswarm.swarm.core import Swarm, SwarmConfig
+from jaxswarm.swarm.aco.colony import colony, reinforce, transition_rule
+from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
 
 FIRST_ANTS = ("weighted", "greedy")
 """How the first ant chooses among its admissible moves: drawn by its weights (the paper), or
@@ -71,8 +71,8 @@ class ImprovedParams(NamedTuple):
     tau_min: jax.Array
 
 
-DEFAULT_IMPROVED = f32(ImprovedParams, rho=0.1, q=0.1, alpha=1.0, beta=1.0, beta_first=5.0,
-                       tau0=1.0, tau_min=0.01)
+DEFAULT_IMPROVED = default_params(ImprovedParams, rho=0.1, q=0.1, alpha=1.0, beta=1.0,
+                                  beta_first=5.0, tau0=1.0, tau_min=0.01)
 """alpha, beta, beta_first and tau0 are the paper's; rho, delta = rho * tau0 (the best path's
 pheromone stays at tau0 while every other edge decays to the floor) and tau_min are ours."""
 

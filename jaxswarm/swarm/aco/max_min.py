@@ -20,8 +20,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.aco.colony import colony, f32, reinforce
-from jaxswarm.swarm.core import Swarm, SwarmConfig
+from jaxswarm.swarm.aco.colony import colony, reinforce
+from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,8 +59,8 @@ class MaxMinParams(NamedTuple):
     tau_max: jax.Array
 
 
-DEFAULT_MAX_MIN = f32(MaxMinParams, rho=0.1, q=1.0, alpha=1.0, beta=1.0, tau0=1.0, tau_min=0.01,
-                      tau_max=10.0)
+DEFAULT_MAX_MIN = default_params(MaxMinParams, rho=0.1, q=1.0, alpha=1.0, beta=1.0, tau0=1.0,
+                                 tau_min=0.01, tau_max=10.0)
 """alpha = beta = 1 as the paper; the rest are ours."""
 
 

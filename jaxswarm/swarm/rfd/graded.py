@@ -46,10 +46,9 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.lattice import move_lengths
 from jaxswarm.relax import lowest_neighbour, relax
-from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
+from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import (check_greedy_drops, f32, gradients,
-                                      river_swarm)
+from jaxswarm.swarm.rfd.river import check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, visited_nodes
 
 SETTLE_SWEEPS = 1024
@@ -106,8 +105,8 @@ class GradedParams(NamedTuple):
     repose: jax.Array
 
 
-DEFAULT_GRADED = GradedParams(**f32(p_base=100.0, alpha=12.0, initial_height=1e4, erosion=1.0,
-                                    sediment=1.0, climb=0.0, repose=0.05))
+DEFAULT_GRADED = default_params(GradedParams, p_base=100.0, alpha=12.0, initial_height=1e4,
+                                erosion=1.0, sediment=1.0, climb=0.0, repose=0.05)
 """Tuned on the nine paper maps (see ``sweeps/rfd_static.py``)."""
 
 

@@ -46,10 +46,10 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
 from jaxswarm.lattice import move_lengths
-from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive
+from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, f32,
-                                      gradients, river_swarm)
+from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, gradients,
+                                      river_swarm)
 from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance
 
 EROSION_LAWS = ("linear", "exponential")
@@ -126,10 +126,10 @@ class RFDStarParams(NamedTuple):
     sediment: jax.Array
 
 
-DEFAULT_RFD = RFDParams(**f32(initial_height=1.0, erosion=1.0, sediment=0.1, omega=0.1,
-                              delta=0.1))
-DEFAULT_RFD_STAR = RFDStarParams(**f32(p_base=50.0, alpha=50.0, initial_height=1.0,
-                                       erosion=50.0, sediment=0.3))
+DEFAULT_RFD = default_params(RFDParams, initial_height=1.0, erosion=1.0, sediment=0.1,
+                             omega=0.1, delta=0.1)
+DEFAULT_RFD_STAR = default_params(RFDStarParams, p_base=50.0, alpha=50.0, initial_height=1.0,
+                                  erosion=50.0, sediment=0.3)
 
 
 def rfd_transition(graph: Graph, task: Task, altitude, params: RFDParams):

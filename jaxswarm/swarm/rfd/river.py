@@ -13,7 +13,6 @@ from typing import Callable
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
@@ -46,12 +45,6 @@ Transition = Callable[[Graph, Task, jax.Array, object], jax.Array]
 Reshape = Callable[[Graph, Task, jax.Array, jax.Array, Walk, object], jax.Array]
 """``(graph, task, altitude f32[N], table f32[N, K], drops, params) -> f32[N]`` the altitudes
 after one iteration's erosion and sediment."""
-
-
-def f32(**values) -> dict:
-    """Default params as NumPy float32 scalars, not JAX arrays: importing a swarm must not start
-    JAX's backend (see :func:`jaxswarm.cpu.configure`); jit and vmap take them as f32 arrays."""
-    return {name: np.float32(value) for name, value in values.items()}
 
 
 def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
