@@ -12,14 +12,12 @@ deterministic, so a repeat whose paths differ from the first stops the script.
 
 XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see :mod:`jaxswarm.cpu`: a
 run is thousands of tiny kernels in a row, and a second thread mostly adds hand-offs between the
-cores). With ``--devices N`` the CPU is split into N JAX devices and each walk's drops are spread
-over them (``make("rfd_graded", devices=N)``), so one run uses N cores (and at least N threads);
-the results are bit-identical to one device.
+cores).
 
 Run from the repository root::
 
     python benchmarks/rfd.py
-    python benchmarks/rfd.py --maps mosaic100,alley100,maze100 --seeds 5 --devices 2
+    python benchmarks/rfd.py --maps mosaic100,alley100,maze100 --seeds 5
     python benchmarks/rfd.py --maps maze100 --repeats 5 --threads 2
 """
 from __future__ import annotations
@@ -51,8 +49,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--patience", type=int, default=30)
     parser.add_argument("--agents", type=int, default=256)
-    parser.add_argument("--devices", type=int, default=1,
-                        help="CPU devices to spread each walk's drops over")
     parser.add_argument("--threads", type=int, default=1,
                         help="XLA:CPU intra-op threads (jaxswarm.cpu.configure)")
     parser.add_argument("--repeats", type=int, default=1,
@@ -62,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     # Before JAX's first computation.
     try:
-        configure(devices=args.devices, threads=args.threads)
+        configure(threads=args.threads)
     except ValueError as error:
         parser.error(str(error))
     try:
@@ -72,18 +68,15 @@ def main(argv: list[str] | None = None) -> int:
 
     paper_ms = PAPER_TABLE1_MS["RFD*"]  # the paper's Table 1, RFD* time [ms], static
     solve_map = _rfd_static().solve_map
-    threads = max(args.threads, args.devices)  # XLA gives each device a thread at least
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
-          f"({jax.default_backend()}, {threads} XLA thread(s), drops spread over "
-          f"{args.devices} device(s))")
+          f"({jax.default_backend()}, {args.threads} XLA thread(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
           f"{'mean iterations':>16} {'range ms':>12}")
     for name in maps:
         medians, first = [], None
         for _ in range(args.repeats):
             rows = solve_map(name, "rfd_graded", args.seeds, iterations=100,
-                             patience=args.patience, num_agents=args.agents,
-                             devices=args.devices)
+                             patience=args.patience, num_agents=args.agents)
             medians.append(1e3 * statistics.median(r["seconds"] for r in rows))
             outcome = [(r["cost"], r["iterations"]) for r in rows]
             if first is not None and outcome != first:

@@ -1,44 +1,61 @@
-"""Throughput and memory of the lockstep walker with the rfd_graded and ACO* transition rules, on
-maze100.
+"""Moves per second of the walker with the rfd_graded and ACO* transition rules on maze100,
+beside a scalar C loop of the same rule.
 
-For each swarm (``--swarms``, default rfd_graded and ACO*) and each total agent count (agents x
-seeds: 64 = 64 x 1, 1,024 = 256 x 4, 16,384 = 256 x 64 by default) one walk per seed is run under
-``vmap`` from the swarm's initial memory (flat altitudes, uniform pheromone), jitted, after one
-warm-up call (compile excluded). Printed per configuration, as the median over ``--repeats``
-runs:
+For each swarm (``--swarms``), each memory (``initial``: the swarm's first altitudes or pheromone;
+``converged``: its memory after ``--converge`` iterations of a run, when most agents follow a
+river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 and 16,384 =
+256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents share one
+queue over the walker's lanes), jitted, after one warm-up call (compile excluded). Printed, the
+median over ``--repeats`` runs:
 
-* ``lockstep steps``: iterations of the walk's ``while_loop`` (under ``vmap`` every lane runs
-  until the slowest lane's agents have all stopped),
-* ``agent-steps/s``: total agents x lockstep steps / wall time (the rate at which the batch
-  steps; the last steps of a walk run on a compacted batch once few agents still walk),
-* ``moves/s``: moves actually made by agents / wall time (agents that stopped early idle),
-* ``peak MiB``: XLA's buffer estimate for the compiled walk (arguments + outputs + temporaries),
-  and the process's peak resident memory so far.
+* ``moves``: moves agents made (one agent changing node is one move), and ``busy``: the share
+  of the loop's lane-steps that were moves (the rest idled: an agent that stopped waits for its
+  lane's next refill, and the last agents' lanes wait for the slowest),
+* ``M moves/s``: moves / wall time,
+* ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
+  (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -fopenmp``, agents
+  shared out over threads; it writes each path's nodes into a buffer filled with -1 before the
+  clock starts), and ``share``: ours as a share of the reference on all cores. The
+  reference draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents
+  whose paths are identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may
+  send an agent elsewhere at a tie of cumulative weights).
 
 Run from the repository root::
 
     python benchmarks/walk.py
-    python benchmarks/walk.py --layouts 256x1,256x16 --repeats 3
+    python benchmarks/walk.py --layouts 256x1,256x16 --repeats 3 --swarms rfd_graded
 """
 from __future__ import annotations
 
 import argparse
+import ctypes
 import functools
 import os
 import platform
-import resource
 import statistics
+import subprocess
+import sys
+import tempfile
 import time
+from pathlib import Path
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
+from jaxswarm.lattice import slot_offsets
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import make, make_task
-from jaxswarm.swarm import aco, rfd
+from jaxswarm.swarm import aco, make, make_task, rfd, run
 from jaxswarm.swarm.walking import step_budget, walk
 
-MiB = 2 ** 20
+SCALAR_SOURCE = Path(__file__).parent / "scalar" / "walk.c"
+
+TRANSITION_RULES = {
+    "rfd_graded": (rfd.graded_transition, lambda state: state.altitude),
+    "aco_star": (functools.partial(aco.transition_rule, goal_distance=True),
+                 lambda state: state.pheromone),
+}
+"""The walks measured: each swarm's transition table of its memory, and its memory."""
 
 
 def machine() -> str:
@@ -46,56 +63,84 @@ def machine() -> str:
             f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()})")
 
 
-TRANSITION_RULES = {
-    "rfd_graded": rfd.graded_transition,
-    "aco_star": functools.partial(aco.transition_rule, goal_distance=True),
-}
-"""The walks measured: each swarm's transition table of its memory."""
+def build_scalar(directory: str) -> ctypes.CDLL:
+    """The scalar reference, compiled into ``directory``; exits naming the compiler's error."""
+    library = Path(directory) / "walk.so"
+    command = [os.environ.get("CC", "cc"), "-O3", "-march=native", "-fopenmp", "-shared",
+               "-fPIC", str(SCALAR_SOURCE), "-o", str(library), "-lm"]
+    try:
+        subprocess.run(command, check=True, capture_output=True, text=True)
+    except (OSError, subprocess.CalledProcessError) as error:
+        detail = getattr(error, "stderr", "") or error
+        sys.exit(f"cannot build the scalar reference with {' '.join(command)}: {detail}")
+    scalar = ctypes.CDLL(str(library))
+    pointer, i32, u32 = ctypes.c_void_p, ctypes.c_int32, ctypes.c_uint32
+    scalar.walk_all.argtypes = [pointer, i32, i32, pointer, i32, i32, i32, i32, u32, u32,
+                                pointer, pointer]
+    scalar.walk_all.restype = ctypes.c_int64
+    scalar.set_threads.argtypes = [i32]
+    return scalar
 
 
-def make_walks(swarm_name: str, map_name: str, drops: int, seeds: int):
-    """A jitted function keys -> Walk (vmapped over ``seeds`` keys) and its inputs."""
-    chosen = paper_map(map_name)
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
+def memories(swarm_name: str, graph, task, drops: int, converge: int) -> dict:
+    """The swarm's memory at its start and after ``converge`` iterations of a run (key 0)."""
     swarm = make(swarm_name, num_agents=drops)
     params = swarm.default_params
-    steps = step_budget(graph, swarm.config.max_steps)
-    rule = TRANSITION_RULES[swarm_name]
-
-    def one(key):
-        state = swarm.init(key, graph, task, params)
-        memory = state.altitude if swarm_name == "rfd_graded" else state.pheromone
-        table = rule(graph, task, memory, params)
-        return walk(key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps)
-
-    walks = jax.jit(jax.vmap(one))
-    keys = jax.random.split(jax.random.key(0), seeds)
-    return walks, keys
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    later, _ = run(swarm, jax.random.key(0), graph, task, params, iterations=converge)
+    _, memory = TRANSITION_RULES[swarm_name]
+    return {"initial": memory(state), "converged": memory(later)}
 
 
-def measure(swarm_name: str, map_name: str, drops: int, seeds: int, repeats: int) -> dict:
-    walks, keys = make_walks(swarm_name, map_name, drops, seeds)
-    compiled = walks.lower(keys).compile()
-    memory = compiled.memory_analysis()
-    buffers = (memory.argument_size_in_bytes + memory.output_size_in_bytes
-               + memory.temp_size_in_bytes) if memory is not None else float("nan")
+def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int,
+            repeats: int) -> dict:
+    params = make(swarm_name, num_agents=drops).default_params
+    rule, _ = TRANSITION_RULES[swarm_name]
+    table = rule(graph, task, memory, params)
+    steps = step_budget(graph, None)
+
+    @jax.jit
+    def walks(keys):
+        return jax.vmap(lambda key: walk(key, graph, table, task.start, task.goal,
+                                         num_agents=drops, max_steps=steps))(keys)
+
+    keys = jax.random.split(jax.random.key(1), seeds)
     jax.block_until_ready(walks(keys))  # warm-up
-    times, steps, moves = [], [], []
-    for repeat in range(repeats):
-        fresh = jax.random.split(jax.random.key(repeat + 1), seeds)
+    times = []
+    for _ in range(repeats):
         began = time.perf_counter()
-        result = jax.block_until_ready(walks(fresh))
+        result = jax.block_until_ready(walks(keys))
         times.append(time.perf_counter() - began)
-        steps.append(int(jnp.max(result.steps)))
-        moves.append(int(jnp.sum(result.slots >= 0)))
     seconds = statistics.median(times)
-    agents = drops * seeds
-    return dict(agents=agents, drops=drops, seeds=seeds, seconds=seconds,
-                steps=statistics.median(steps),
-                agent_steps=agents * statistics.median(steps) / seconds,
-                moves=statistics.median(moves) / seconds, buffers=buffers / MiB,
-                rss=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+    moves = int(result.moves.sum())
+
+    # The walker's per-walk seeds: two words drawn from each walk's key.
+    words = np.asarray(jax.vmap(lambda key: jax.random.bits(key, (1, 2), jnp.uint32))(keys))
+    flat_table = np.ascontiguousarray(np.asarray(table, np.float32))
+    offsets = np.ascontiguousarray(np.asarray(slot_offsets(graph), np.int32))
+    scalar_moves = np.zeros((seeds, drops), np.int32)
+    paths = np.full((seeds, drops, steps + 1), -1, np.int32)
+
+    def run_scalar(threads: int) -> float:
+        scalar.set_threads(threads)
+        paths.fill(-1)
+        began = time.perf_counter()
+        for s in range(seeds):
+            scalar.walk_all(
+                flat_table.ctypes.data, graph.num_nodes, graph.max_degree, offsets.ctypes.data,
+                int(task.start), int(task.goal), drops, steps, int(words[s, 0, 0]),
+                int(words[s, 0, 1]), scalar_moves[s].ctypes.data,
+                paths[s].ctypes.data)
+        return time.perf_counter() - began
+
+    reference = {}
+    for threads in (1, os.cpu_count()):
+        wall = statistics.median(run_scalar(threads) for _ in range(repeats))
+        reference[threads] = scalar_moves.sum() / wall
+    same = int(np.all(paths == np.asarray(result.path), axis=-1).sum())
+    return dict(agents=drops * seeds, seconds=seconds, moves=moves,
+                busy=moves / int(result.lane_steps[0]), rate=moves / seconds,
+                one_core=reference[1], all_cores=reference[os.cpu_count()], same=same)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -103,23 +148,35 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--map", default="maze100")
     parser.add_argument("--swarms", default="rfd_graded,aco_star",
                         help=f"comma-separated, from {', '.join(TRANSITION_RULES)}")
-    parser.add_argument("--layouts", default="64x1,256x4,256x64",
-                        help="comma-separated DROPSxSEEDS")
+    parser.add_argument("--layouts", default="256x4,256x64", help="comma-separated DROPSxSEEDS")
+    parser.add_argument("--converge", type=int, default=30,
+                        help="iterations run for the converged memory")
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args(argv)
+    chosen = paper_map(args.map)
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
     print(f"machine: {machine()}")
-    print(f"walks on {args.map} from the initial memory, median of {args.repeats} runs "
-          "after a warm-up compile")
-    print(f"{'swarm':9} {'agents':>7} {'per x seeds':>12} {'ms':>9} {'lockstep steps':>15} "
-          f"{'agent-steps/s':>14} {'moves/s':>11} {'XLA MiB':>8} {'peak RSS MiB':>13}")
-    for swarm_name in args.swarms.split(","):
-        for layout in args.layouts.split(","):
-            drops, seeds = (int(part) for part in layout.split("x"))
-            r = measure(swarm_name, args.map, drops, seeds, args.repeats)
-            print(f"{swarm_name:9} {r['agents']:>7} {f'{drops} x {seeds}':>12} "
-                  f"{1e3 * r['seconds']:>9.1f} {r['steps']:>15.0f} "
-                  f"{r['agent_steps'] / 1e6:>12.1f} M {r['moves'] / 1e6:>9.1f} M "
-                  f"{r['buffers']:>8.0f} {r['rss']:>13.0f}", flush=True)
+    print(f"walks on {args.map}, median of {args.repeats} runs after a warm-up compile; "
+          f"reference: {SCALAR_SOURCE.name} on 1 and {os.cpu_count()} cores")
+    print(f"{'swarm':10} {'memory':9} {'agents':>7} {'ms':>8} {'moves':>9} {'busy':>5} "
+          f"{'M moves/s':>9} {'ref 1 / all':>12} {'share':>6} {'same':>12}")
+    with tempfile.TemporaryDirectory() as directory:
+        scalar = build_scalar(directory)
+        for swarm_name in args.swarms.split(","):
+            layouts = [tuple(int(part) for part in layout.split("x"))
+                       for layout in args.layouts.split(",")]
+            states = memories(swarm_name, graph, task, layouts[0][0], args.converge)
+            for memory_name, memory in states.items():
+                for drops, seeds in layouts:
+                    r = measure(scalar, swarm_name, graph, task, memory, drops, seeds,
+                                args.repeats)
+                    print(f"{swarm_name:10} {memory_name:9} {r['agents']:>7} "
+                          f"{1e3 * r['seconds']:>8.1f} {r['moves']:>9} {r['busy']:>5.2f} "
+                          f"{r['rate'] / 1e6:>9.1f} "
+                          f"{r['one_core'] / 1e6:>5.1f} / {r['all_cores'] / 1e6:<5.1f} "
+                          f"{r['rate'] / r['all_cores']:>6.2f} "
+                          f"{r['same']:>6}/{r['agents']:<5}", flush=True)
     return 0
 
 

@@ -59,14 +59,13 @@ ABOUT = (
 
 
 def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patience: int | None,
-              num_agents: int, devices: int = 1) -> list[dict]:
-    """Run ``algorithm`` on paper map ``name`` once per seed, with its drops spread over
-    ``devices`` devices; one row per seed."""
+              num_agents: int) -> list[dict]:
+    """Run ``algorithm`` on paper map ``name`` once per seed; one row per seed."""
     chosen = paper_map(name)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
     optimum = dijkstra(graph, chosen.start, chosen.goal).cost
-    swarm = make(algorithm, num_agents=num_agents, devices=devices)
+    swarm = make(algorithm, num_agents=num_agents)
 
     def one_run(key):
         return run(swarm, key, graph, task, swarm.default_params, iterations=iterations,

@@ -102,4 +102,6 @@ def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: 
                 arrived=jnp.asarray(np.array(arrived, bool)),
                 stuck=jnp.asarray(np.array(stuck, bool)),
                 position=jnp.asarray(np.array([p[-1] for p in paths], np.int32)),
-                visited=jnp.asarray(visited), steps=jnp.int32(longest - 1))
+                visited=jnp.asarray(visited),
+                moves=jnp.asarray(np.array([len(p) - 1 for p in paths], np.int32)),
+                lane_steps=jnp.int32(agents * (longest - 1)))

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +18,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+SNIPPET_OUTPUTS = ["out/my_study"]
+"""What the snippets write under the repository root."""
+
 SNIPPET = re.compile(r"(?:<!-- skip: (?P<skip>[^>]*) -->\n)?```python\n(?P<code>.*?)```",
                      re.DOTALL)
 
@@ -38,6 +42,10 @@ def test_every_snippet_runs_as_written(document, tmp_path):
     code = "\n".join(code for skip, code in snippets(document) if skip is None)
     if not code:
         pytest.skip(f"{document.name} has no Python snippet")
+    # The snippets run from the repository root, as a reader would; what an earlier version
+    # wrote there would be refused as another swarm definition.
+    for written in SNIPPET_OUTPUTS:
+        shutil.rmtree(ROOT / written, ignore_errors=True)
     script = tmp_path / f"{document.stem}_snippets.py"
     script.write_text(code)
     done = subprocess.run([sys.executable, str(script)], cwd=ROOT, capture_output=True,

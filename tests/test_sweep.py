@@ -81,7 +81,6 @@ def test_spec_grid_ranges_and_seeds():
     (dict(sweep={"colour": "red"}), "sweep.colour: unknown key"),
     (dict(config={"num_ants": 4}), "config.num_ants: unknown config of rfd_star"),
     (dict(config={"num_agents": 0}), r"\[config\]: num_agents must be at least 1"),
-    (dict(config={"devices": 2}), "config.devices: a sweep spreads its runs over the devices"),
     (dict(extra={"x": 1}), "extra: unknown section"),
 ])
 def test_bad_specs_name_the_key(changes, message):

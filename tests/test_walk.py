@@ -6,7 +6,7 @@ import pytest
 from jaxswarm.graph import dense_graph, grid_graph
 from jaxswarm.lattice import straight_line
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.walking import (FORCED, STEPS_PER_CHECK, edge_table, sample_masked,
+from jaxswarm.swarm.walking import (FORCED, STEPS_PER_REFILL, edge_table, sample_masked,
                                     visited_nodes, walk)
 
 
@@ -85,7 +85,9 @@ def test_walks_are_valid_self_avoiding_and_measured():
         nodes = set(path[a][path[a] >= 0].tolist())
         here = int(result.position[a])
         assert all(nbr[here, k] in nodes for k in range(8) if valid[here, k])
-    assert int(result.steps) <= 60
+    moves = np.asarray(result.moves)
+    assert moves.max() <= 60 and (moves == (path >= 0).sum(axis=1) - 1).all()
+    assert moves.sum() <= int(result.lane_steps) <= 64 * 60 + 64 * STEPS_PER_REFILL
     np.testing.assert_array_equal(np.asarray(result.slots) >= 0, path[:, 1:] >= 0)
 
 
@@ -135,9 +137,10 @@ def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
     assert bool(result.stuck.all()) and not bool(result.arrived.any())
     np.testing.assert_array_equal(result.position, [8, 8, 8])
     np.testing.assert_array_equal(result.path[:, :5], [[5, 6, 7, 8, -1]] * 3)
-    assert int(result.steps) == min(STEPS_PER_CHECK, 10)  # one chunk, capped by the budget
+    # One block of 3 lanes: all are stuck after three moves, so the loop ends there.
+    assert int(result.lane_steps) == 3 * STEPS_PER_REFILL
     at_goal = walk(jax.random.key(0), graph, uniform(graph), 6, 6, num_agents=2, max_steps=5)
-    assert bool(at_goal.arrived.all()) and int(at_goal.steps) == 0
+    assert bool(at_goal.arrived.all()) and int(at_goal.lane_steps) == 0
 
 
 def test_greedy_agents_descend_deterministically_and_the_others_do_not():
@@ -164,7 +167,8 @@ def test_excluded_and_invalid_edges_are_never_taken():
     assert bool(result.arrived.any())
 
 
-def test_compacting_the_last_walkers_changes_no_walk(monkeypatch):
+@pytest.mark.parametrize("lanes, compact", [(8, 4), (64, 10 ** 9), (5, 2)])
+def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact):
     import jaxswarm.swarm.walking.loop as walk_module
 
     graph = grid_graph(np.zeros((16, 16), bool))
@@ -174,13 +178,34 @@ def test_compacting_the_last_walkers_changes_no_walk(monkeypatch):
         return jax.jit(lambda key: walk(key, graph, logw, 0, 255, num_agents=64, max_steps=255,
                                         greedy_agents=2))(jax.random.key(0))
 
-    compacted = walks()
-    moves = np.asarray((compacted.slots >= 0).sum(axis=1))
-    # The case under test: after the first chunk at most 64 / COMPACT_SHARE agents still walk,
-    # and one of them needs two more chunks.
-    assert 0 < (moves > STEPS_PER_CHECK).sum() <= 64 // walk_module.COMPACT_SHARE
-    assert (moves > 2 * STEPS_PER_CHECK).any() and int(compacted.steps) == 3 * STEPS_PER_CHECK
-    monkeypatch.setattr(walk_module, "COMPACT_SHARE", 10 ** 9)  # no compaction
-    whole = walks()
-    for name, value in compacted._asdict().items():
-        np.testing.assert_array_equal(value, getattr(whole, name), err_msg=name)
+    default = walks()
+    moves = np.asarray(default.moves)
+    # The case under test: agents of very different lengths, so lanes are refilled unevenly.
+    assert moves.max() - moves.min() > 4 * STEPS_PER_REFILL
+    monkeypatch.setattr(walk_module, "LANES", lanes)
+    monkeypatch.setattr(walk_module, "COMPACT_SHARE", compact)
+    shared = walks()
+    assert int(shared.lane_steps) != int(default.lane_steps)  # another schedule ...
+    for name, value in default._asdict().items():  # ... the same walks
+        if name != "lane_steps":
+            np.testing.assert_array_equal(value, getattr(shared, name), err_msg=name)
+
+
+def test_a_batch_of_walks_shares_one_queue_and_walks_as_each_alone():
+    graph = grid_graph(np.random.default_rng(3).random((12, 12)) < 0.2)
+    logw = towards(graph, 143, 0.3)
+    keys = jax.random.split(jax.random.key(7), 4)
+    starts = jnp.array([0, 0, 143, 13])  # the third run is already at its goal
+
+    @jax.jit
+    def one(key, start):
+        return walk(key, graph, logw, start, 143, num_agents=24, max_steps=100)
+
+    batch = jax.jit(jax.vmap(one))(keys, starts)
+    for i in range(4):
+        alone = one(keys[i], starts[i])
+        for name, value in alone._asdict().items():
+            if name != "lane_steps":
+                np.testing.assert_array_equal(value, getattr(batch, name)[i], err_msg=name)
+    assert int(batch.moves.sum()) <= int(batch.lane_steps[0])  # one loop's count for all
+    assert int(one(keys[2], 143).lane_steps) == 0 and bool(batch.arrived[2].all())

@@ -25,7 +25,6 @@ import numpy as np
 
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, as_node
-from jaxswarm.swarm.walking import check_devices
 
 
 class Task(NamedTuple):
@@ -169,7 +168,12 @@ def _run(swarm, key, graph, task, params, iterations, patience):
     def one_iteration(carry):
         state, trace, stale, _ = carry
         before = swarm.best(state).cost
-        state, info = swarm.step(state, graph, task, params)
+        # Under vmap every run of the batch goes through this body until the last one stops,
+        # and a stopped run's result is dropped. Giving it the task "from the start to the start"
+        # makes its walk empty, so the walker's lanes go to the runs still going.
+        going = keep_going(carry)
+        state, info = swarm.step(state, graph, task._replace(
+            goal=jnp.where(going, task.goal, task.start)), params)
         after = swarm.best(state).cost
         t = trace.iterations
         trace = Trace(best_cost=trace.best_cost.at[t].set(after),
@@ -192,16 +196,13 @@ class SwarmConfig:
       num_agents: agents (drops, ants) per iteration.
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
-      devices: spread each walk's agents over this many devices (see
-        :func:`jaxswarm.swarm.walking.walk`); results are the same as with one.
     """
 
     num_agents: int = 256
     max_steps: int | None = None
-    devices: int = 1
 
     def __post_init__(self):
-        check_sizes(self.num_agents, self.max_steps, self.devices)
+        check_sizes(self.num_agents, self.max_steps)
 
 
 def default_params(params_type, **values):
@@ -217,15 +218,12 @@ def best_solution(state) -> Solution:
                     found=jnp.isfinite(state.best_cost))
 
 
-def check_sizes(num_agents: int, max_steps: int | None, devices: int = 1) -> None:
-    """Static config check shared by the swarms: at least one agent and one step, and a
-    device count that divides the agents (whether JAX has that many is checked when the
-    swarm first walks)."""
+def check_sizes(num_agents: int, max_steps: int | None) -> None:
+    """Static config check shared by the swarms: at least one agent and one step."""
     if num_agents < 1:
         raise ValueError(f"num_agents must be at least 1, got {num_agents}")
     if max_steps is not None and max_steps < 1:
         raise ValueError(f"max_steps must be at least 1, got {max_steps}")
-    check_devices(devices, num_agents)
 
 
 def keep_best(walk, best_path, best_cost, *, ties: bool = False):

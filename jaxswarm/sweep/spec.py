@@ -190,9 +190,6 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         if key not in accepted:
             fail(f"config.{key}", f"unknown config of {algorithm}; accepted: "
                  f"{', '.join(accepted)}")
-    if config.get("devices", 1) != 1:
-        fail("config.devices", "a sweep spreads its runs over the devices itself; leave the "
-             "agents of each run on one device (devices = 1)")
     try:
         swarm = swarm_registry.make(algorithm, **config)
     except (TypeError, ValueError) as error:

@@ -109,7 +109,7 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
 
     Args:
       name: registry name.
-      config: the colony's Config (``num_agents``, ``max_steps``, ``devices`` are read).
+      config: the colony's Config (``num_agents`` and ``max_steps`` are read).
       default_params: its default Params.
       update: the pheromone update (see :data:`Update`).
       init_best: optional ``(key, graph, task, pheromone, params, length) -> (path i32[length],
@@ -132,7 +132,7 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
                                 goal_distance=goal_distance)
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
-                    max_steps=step_budget(graph, config.max_steps), devices=config.devices)
+                    max_steps=step_budget(graph, config.max_steps))
         best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
                                                ties=ties)
         pheromone = update(graph, state.pheromone, ants, best_path, best_cost, info, params)

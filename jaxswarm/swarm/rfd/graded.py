@@ -179,7 +179,7 @@ def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
     n = altitude.shape[0]
     num_agents, width = drops.path.shape
     blocks = -(-width // CARVE_COLUMNS)
-    walked_blocks = (drops.steps + CARVE_COLUMNS) // CARVE_COLUMNS  # blocks holding nodes
+    walked_blocks = (jnp.max(drops.moves) + CARVE_COLUMNS) // CARVE_COLUMNS  # holding nodes
 
     def one_block(carry):
         block, after, best, carved = carry

@@ -53,7 +53,7 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
 
     Args:
       name: registry name.
-      config: the variant's static config (``num_agents``, ``max_steps`` and ``devices`` are read).
+      config: the variant's static config (``num_agents`` and ``max_steps`` are read).
       transition: the log-weight table of the current altitudes.
       reshape: erosion and sediment after a walk.
       greedy_drops: how many drops (the first ones) take their most likely move.
@@ -73,7 +73,7 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
         table = transition(graph, task, state.altitude, params)
         drops = walk(walk_key, graph, table, task.start, task.goal,
                      num_agents=config.num_agents,
-                     max_steps=step_budget(graph, config.max_steps), devices=config.devices,
+                     max_steps=step_budget(graph, config.max_steps),
                      greedy_agents=greedy_drops)
         altitude = reshape(graph, task, state.altitude, table, drops, params)
         altitude = jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)

@@ -1,60 +1,71 @@
-"""The lockstep walk loop shared by drops and ants.
+"""The walk loop shared by drops and ants: agents queued over a fixed set of busy lanes.
 
 ``A`` agents start at one node. The algorithm hands the walker one log-weight per edge,
 ``f32[N, K]`` (its transition rule evaluated once per walk: pheromone, altitude gradients and
-heuristics do not change while the agents walk). Each step, every still-walking agent gathers
-its node's row, keeps the admissible slots (an edge with a finite log-weight to a node the agent
-has not visited in this walk; on grids and path maps the neighbours are the node plus fixed
-slot offsets, so only the log-weights are gathered), and draws one slot through the masked
-sampler (:mod:`.sampler`; a greedy agent takes its most likely slot instead, ties drawn at
-random). An agent stops when it reaches the goal, when it has no admissible neighbour ("stuck"),
-or when the step budget runs out. The walk is a ``lax.while_loop`` that ends as soon as every
-agent has stopped; once at most ``A // COMPACT_SHARE`` agents still walk, it goes on with a batch
-of just those.
-With ``devices > 1`` the agents are shared out over that many devices, each running its own
-loop (``shard_map``); every agent draws the same uniforms either way, so neither compaction nor
-the number of devices changes a walk.
+heuristics do not change while the agents walk). At each move an agent gathers its node's row,
+keeps the admissible slots (an edge with a finite log-weight to a node it has not visited in this
+walk; on grids and path maps the neighbours are the node plus fixed slot offsets, so only the
+log-weights are gathered), and draws one slot through the masked sampler (:mod:`.sampler`; a
+greedy agent takes its most likely slot instead, ties drawn at random). An agent stops when it
+reaches the goal, when it has no admissible neighbour ("stuck"), or when its step budget runs out.
 
-Memory: while walking, the visited sets are bit sets ``u32[A, ceil(N / 32)]``, the chosen slots
-``i8[A, L - 1]`` and the nodes ``i16[A, L - 1]`` (i32 above 32,767 nodes; ``L = max_steps + 1``),
-written a block of ``STEPS_PER_CHECK`` steps at a time; the paths come out as ``i32[A, L]``
-and the visited sets with them (:func:`visited_nodes` reads them).
-Batch sizes in sweeps must be chosen with that in mind.
+Agents do not each keep a lane until the slowest one finishes. The loop steps a fixed number of
+lanes (at most ``LANES``) ``STEPS_PER_REFILL`` moves at a time; then up to a quarter of the lanes
+whose agent stopped hand its results to the output buffers and take the next agent of the queue.
+Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, those go on in a
+batch of that many lanes.
+
+Random streams belong to agents, not lanes: agent ``a``'s ``m``-th move draws a uniform hashed
+from the walk's key, ``a`` and ``m`` (:func:`uniforms`). So neither the number of lanes, nor the
+order in which agents get one, nor batching walks together changes any walk.
+
+Batching: :func:`walk` has its own ``vmap`` rule (``jax.custom_batching``). A ``vmap`` of walks
+(a batch of runs in a sweep, a batch of seeds) becomes one queue holding every run's agents over
+one set of lanes, instead of one lockstep loop per run that runs until the slowest run's slowest
+agent stops. A run whose task has ``start == goal`` adds no agent to the queue: the run loop
+gives a finished run of a batch that task, so its lanes go to the runs still going.
+
+Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs are each
+agent's visited set (same layout), slots ``i8`` and nodes ``i16`` (i32 above 32,767 nodes)
+, and the paths ``i32[A, max_steps + 1]``, written in place as agents move.
 """
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
-from jax.sharding import Mesh, PartitionSpec as P
+from jax.custom_batching import custom_vmap
 
 from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.sampler import sample_masked
 
-STEPS_PER_CHECK = 64
-"""Steps per test of the walk's stop condition. Under ``vmap`` a ``while_loop`` selects between
-the old and new carry of every lane at each iteration, copying the buffers; testing every 64
-steps amortises that copy (agents that stopped simply idle in between)."""
+LANES = 1024
+"""Lanes of one walk loop (fewer when the walk has fewer agents). Measured on maze100 on a 2-core
+machine (``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited
+sets leave the caches), fewer leave the loop's fixed cost per step unshared."""
+
+STEPS_PER_REFILL = 8
+"""Moves a lane makes between two refills (an agent that stops within them idles until then)."""
+
+REFILL_SHARE = 4
+"""At most ``lanes // REFILL_SHARE`` lanes take a new agent per refill: copying a stopped agent's
+visited set out costs a row of words, so the copy is sized for the usual number of stops, and
+any more stopped lanes wait for the next refill."""
 
 COMPACT_SHARE = 8
-"""When at most ``A // COMPACT_SHARE`` agents still walk, the walk goes on with only them, in a
-batch of that many lanes: in a formed river most agents arrive together and a few stragglers
-would otherwise keep the whole batch stepping. The uniforms stay those of the full batch, so
-compaction does not change any walk."""
-
-AGENT_AXIS = "agents"
-"""The mesh axis over which :func:`walk` spreads its agents (``devices > 1``)."""
-
+"""When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
+goes on with only them, in a batch of that many lanes."""
 
 class Walk(NamedTuple):
     """What a walk produced (a pytree).
 
     Attributes:
-      path: i32[A, L] nodes visited, starting with the start node, -1 padded.
+      path: i32[A, L] nodes visited, starting with the start node, -1 padded
+        (``L = max_steps + 1``).
       slots: i16[A, L - 1] neighbour slot of each move (``path[a, t + 1] = nbr[path[a, t], slot]``),
         -1 after the agent stopped.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
@@ -65,8 +76,10 @@ class Walk(NamedTuple):
       position: i32[A] the node each agent stopped at.
       visited: u32[A, ceil(N / 32)] the nodes on each agent's path as a packed bit set (bit
         ``n % 32`` of word ``n // 32`` is node ``n``); see :func:`visited_nodes`.
-      steps: i32[] lockstep steps executed: the slowest agent's move count rounded up to a
-        multiple of ``STEPS_PER_CHECK``, at most ``max_steps``.
+      moves: i32[A] moves each agent made.
+      lane_steps: i32[] lane-steps the loop executed (lanes times steps, summed over the loop's
+        phases); ``sum(moves) / lane_steps`` is the share of the machine's work that moved an
+        agent. A batch of walks shares one loop, so each gets the batch's total.
     """
 
     path: jax.Array
@@ -76,7 +89,8 @@ class Walk(NamedTuple):
     stuck: jax.Array
     position: jax.Array
     visited: jax.Array
-    steps: jax.Array
+    moves: jax.Array
+    lane_steps: jax.Array
 
 
 def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) -> jax.Array:
@@ -86,36 +100,34 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
     return bits.union(walk.visited, num_nodes, which)
 
 
-def check_devices(devices: int, num_agents: int) -> None:
-    """Static check of a device count for ``num_agents`` agents: at least one, dividing the
-    agents (whether JAX has that many devices is checked when the walk is traced)."""
-    if devices < 1:
-        raise ValueError(f"devices must be at least 1, got {devices}")
-    if num_agents % devices:
-        raise ValueError(f"devices ({devices}) must divide num_agents ({num_agents})")
+def uniforms(seed: jax.Array, agent: jax.Array, move: jax.Array) -> jax.Array:
+    """f32[...] in [0, 1): the uniform of agent ``agent``'s move ``move`` (i32[...] each) in a
+    walk keyed by ``seed`` (u32[..., 2]).
+
+    A counter-based hash (MurmurHash3's 32-bit finaliser, twice, keyed by the two seed words),
+    so a draw depends on the agent and the move only, never on the lane that makes it; about a
+    tenth of the arithmetic of a Threefry draw.
+    """
+    counter = (agent.astype(jnp.uint32) * jnp.uint32(0x9E3779B1)) ^ move.astype(jnp.uint32)
+    mixed = _finalise(_finalise(counter ^ seed[..., 0]) ^ seed[..., 1])
+    return (mixed >> 8).astype(jnp.float32) * jnp.float32(2.0 ** -24)
 
 
-def _agent_mesh(devices: int, num_agents: int) -> Mesh:
-    """A 1-D mesh (axis ``AGENT_AXIS``) of the first ``devices`` devices for ``num_agents``
-    agents, or a ValueError naming what does not fit."""
-    check_devices(devices, num_agents)
-    available = jax.devices()
-    if devices > len(available):
-        raise ValueError(
-            f"devices={devices} but JAX sees {len(available)} {jax.default_backend()} "
-            "device(s); on CPU call jax.config.update('jax_num_cpu_devices', n) before JAX's "
-            "first use")
-    return Mesh(np.array(available[:devices]), (AGENT_AXIS,))
+def _finalise(x: jax.Array) -> jax.Array:
+    """MurmurHash3's fmix32 on u32: every input bit flips each output bit with probability ~1/2."""
+    x = x ^ (x >> 16)
+    x = x * jnp.uint32(0x85EBCA6B)
+    x = x ^ (x >> 13)
+    x = x * jnp.uint32(0xC2B2AE35)
+    return x ^ (x >> 16)
 
 
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
-         max_steps: int, greedy_agents: int = 0, devices: int = 1) -> Walk:
-    """Walk ``num_agents`` agents from ``start`` towards ``goal`` in lockstep.
+         max_steps: int, greedy_agents: int = 0) -> Walk:
+    """Walk ``num_agents`` agents from ``start`` towards ``goal``.
 
     Args:
-      key: PRNG key (split once per ``STEPS_PER_CHECK`` steps, which draw their uniforms in one
-        batch: generating them one step at a time cost a third of a step; the same key gives the
-        same walk).
+      key: PRNG key; the same key gives the same walk (see :func:`uniforms`).
       graph: the map.
       log_weights: f32[N, K] unnormalised log-probability of each edge (see
         :func:`~jaxswarm.swarm.walking.tables.edge_table`); ``-inf`` where the edge may not be
@@ -126,182 +138,276 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
       greedy_agents: how many agents (the first ones; static) always take their most likely
         admissible move, ties drawn at random, instead of sampling.
-      devices: spread the agents evenly over the first ``devices`` of ``jax.devices()``
-        (static), each walking its share in its own loop; the result, replicated on those
-        devices, is bit-identical to ``devices=1``. On CPU this uses several cores for one
-        walk (set ``jax.config.update("jax_num_cpu_devices", n)`` before JAX's first use).
-
     Returns:
-      A :class:`Walk`.
-
-    Raises:
-      ValueError: ``devices`` below 1, more than JAX has, or not dividing ``num_agents``.
+      A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
     """
-    args = (key, graph, log_weights, jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32))
+    seed = jax.random.bits(key, (1, 2), jnp.uint32)
+    walks = _batched_walk(num_agents, max_steps, greedy_agents)(
+        seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
+        jnp.asarray(goal, jnp.int32)[None])
+    return jax.tree_util.tree_map(lambda x: x[0], walks)
+
+
+@functools.lru_cache(maxsize=None)
+def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int):
+    """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R]) -> Walk``
+    with a leading run axis R, whose ``vmap`` folds the mapped axis into R."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
-    if devices == 1:
-        return _walk_share(*args, first=0, share=num_agents, **shape)
-    mesh = _agent_mesh(devices, num_agents)
-    share = num_agents // devices
 
-    def walk_share(*args):
-        first = jax.lax.axis_index(AGENT_AXIS) * share
-        part = _walk_share(*args, first=first, share=share, **shape)
-        gathered = {name: jax.lax.all_gather(getattr(part, name), AGENT_AXIS, tiled=True)
-                    for name in part._fields if name != "steps"}
-        return Walk(steps=jax.lax.pmax(part.steps, AGENT_AXIS), **gathered)
+    @custom_vmap
+    def walk_runs(seed, graph, log_weights, start, goal):
+        return _walk_runs(seed, graph, log_weights, start, goal, **shape)
 
-    return jax.shard_map(walk_share, mesh=mesh, in_specs=P(), out_specs=P(),
-                         check_vma=False)(*args)
+    @walk_runs.def_vmap
+    def fold_runs(axis_size, in_batched, seed, graph, log_weights, start, goal):
+        seed_b, graph_b, *rest_b = in_batched
+        if any(jax.tree_util.tree_leaves(graph_b)):
+            # Walks on different maps cannot share a table of offsets: one loop per map.
+            plain = functools.partial(_walk_runs, **shape)
+            axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
+                         for b in in_batched)
+            out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal)
+            return out, jax.tree_util.tree_map(lambda _: True, out)
+        runs = (seed, log_weights, start, goal)
+        runs = [x if b else jnp.broadcast_to(x, (axis_size,) + x.shape)
+                for x, b in zip(runs, [seed_b, *rest_b])]
+        folded = [x.reshape((-1,) + x.shape[2:]) for x in runs]
+        seed, log_weights, start, goal = folded
+        out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
+                                     walk_runs(seed, graph, log_weights, start, goal))
+        return out, jax.tree_util.tree_map(lambda _: True, out)
+
+    return walk_runs
 
 
 class Lanes(NamedTuple):
-    """The per-agent state of a walk (a pytree; leading axis ``a``: the agents of a share, or
-    the few still walking once compacted).
+    """The state of the loop's lanes (a pytree; leading axis ``l``, the lanes).
 
     Attributes:
-      position: i32[a] the node each agent is at.
-      visited: u32[a, ceil(N / 32)] the nodes on each agent's path (:mod:`.bits`).
-      slots: i8 or i16[a, C] the slot of each move so far, -1 after the agent stopped
-        (C = max_steps + STEPS_PER_CHECK columns, so a whole block always fits).
-      nodes: i16 or i32[a, C] the node each move reached, -1 after the agent stopped.
-      walking: bool[a] still moving.
-      arrived: bool[a] reached the goal.
-      stuck: bool[a] stopped with no admissible neighbour.
-      moves: i32[a] moves made (counted on grids and path maps, for the length).
-      diagonal: i32[a] diagonal moves among them.
+      agent: i32[l] the lane's agent, as its row in the loop's results; the number of rows
+        when the lane holds none.
+      run: i32[l] the run (of a batch of walks) the agent belongs to.
+      position: i32[l] the node the agent is at.
+      visited: u32[l, ceil(N / 32)] the nodes on its path (:mod:`.bits`).
+      moves: i32[l] moves made.
+      diagonal: i32[l] diagonal moves among them (grids and path maps).
+      walking: bool[l] still moving.
+      arrived: bool[l] reached the goal.
+      stuck: bool[l] stopped with no admissible neighbour.
     """
 
+    agent: jax.Array
+    run: jax.Array
     position: jax.Array
     visited: jax.Array
-    slots: jax.Array
-    nodes: jax.Array
+    moves: jax.Array
+    diagonal: jax.Array
     walking: jax.Array
     arrived: jax.Array
     stuck: jax.Array
+
+
+class Results(NamedTuple):
+    """What each agent of a loop did (leading axis: its agents), written as it walks (``path``,
+    ``slots``) and when it stops (the rest); the fields are the :class:`Walk`'s."""
+
+    path: jax.Array
+    slots: jax.Array
+    position: jax.Array
+    visited: jax.Array
     moves: jax.Array
     diagonal: jax.Array
+    arrived: jax.Array
+    stuck: jax.Array
 
 
-class Carry(NamedTuple):
-    """The walk loop's carry: ``key`` (the PRNG key of the next block), ``step`` (i32[]
-    lockstep steps so far) and the agents' :class:`Lanes`."""
+class Loop(NamedTuple):
+    """The loop's carry: the lanes, the results, the queue's next entry and the lane-steps."""
 
-    key: jax.Array
-    step: jax.Array
     lanes: Lanes
+    results: Results
+    next_queued: jax.Array
+    lane_steps: jax.Array
 
 
-def _walk_share(key, graph: Graph, log_weights, start, goal, *, first, share: int,
-                num_agents: int, max_steps: int, greedy_agents: int) -> Walk:
-    """Walk agents ``first .. first + share - 1`` (``first`` may be traced) of a batch of
-    ``num_agents``: their uniforms are their columns of the batch's draws."""
+def _walk_runs(seed, graph: Graph, log_weights, start, goal, *, num_agents: int, max_steps: int,
+               greedy_agents: int) -> Walk:
+    """The walks of R runs on one map through one queue (leading axis R on every input)."""
+    runs = start.shape[0]
+    results, lane_steps = _walk_agents(
+        runs * num_agents, seed, graph, log_weights.reshape(-1, graph.max_degree), start, goal,
+        num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
+    if graph.is_grid:
+        length = lattice_length(results.moves, results.diagonal)
+    else:
+        length = total_length(graph, results.path[:, :-1], results.slots)
+    per_agent = dict(path=results.path, slots=results.slots, length=length,
+                     arrived=results.arrived, stuck=results.stuck, position=results.position,
+                     visited=results.visited, moves=results.moves)
+    return Walk(**{name: x.reshape((runs, num_agents) + x.shape[1:])
+                   for name, x in per_agent.items()},
+                lane_steps=jnp.full((runs,), lane_steps, jnp.int32))
+
+
+def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, num_agents: int,
+                 max_steps: int, greedy_agents: int):
+    """Walk the ``count`` agents of a batch of runs (agent ``f`` is agent ``f % num_agents`` of
+    run ``f // num_agents``) in one loop: the agents of runs with somewhere to go are queued,
+    the others keep their initial results.
+
+    Returns:
+      ``(Results, lane_steps i32[])``, the results' rows in agent order.
+    """
     n = graph.num_nodes
-    agents = jnp.arange(share)
-    greedy = first + agents < greedy_agents if greedy_agents else None
-    position = jnp.full((share,), start)
-    columns = max_steps + STEPS_PER_CHECK
+    words = (n + 31) // 32
+    num_lanes = min(LANES, count)
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
-    node_dtype = jnp.int16 if n <= 32767 else jnp.int32
-    counts = jnp.zeros((share,), jnp.int32)
-    carry = Carry(key=key, step=jnp.array(0, jnp.int32), lanes=Lanes(
-        position=position,
-        visited=bits.mark(jnp.zeros((share, (n + 31) // 32), jnp.uint32), agents, position),
-        slots=jnp.full((share, columns), -1, slot_dtype),
-        nodes=jnp.full((share, columns), NO_NODE, node_dtype),
-        walking=jnp.full((share,), start != goal),
-        arrived=jnp.full((share,), start == goal),
-        stuck=jnp.zeros((share,), bool),
-        moves=counts, diagonal=counts))
+    offsets = jnp.asarray(slot_offsets(graph)) if graph.is_grid else None
+    rows = jnp.arange(count, dtype=jnp.int32)
+    run_of_row = rows // num_agents
+    live_row = start[run_of_row] != goal[run_of_row]
+    queue = jnp.argsort(~live_row, stable=True).astype(jnp.int32)  # rows that walk first
+    live = jnp.sum(live_row)
 
-    def keep_walking(c: Carry):
-        return (c.step < max_steps) & jnp.any(c.lanes.walking)
+    def start_visited(nodes):
+        return bits.mark(jnp.zeros((nodes.shape[0], words), jnp.uint32),
+                         jnp.arange(nodes.shape[0]), nodes)
 
-    def block(c: Carry, lanes_ids, greedy) -> Carry:
-        """STEPS_PER_CHECK steps of the agents ``lanes_ids`` (i32[a] ids within the share;
-        None: the whole share); their slots and nodes go to small step-major blocks (each step
-        writes one contiguous row) that are transposed into the buffers once per block."""
-        key, draw_key = jax.random.split(c.key)
-        # The whole batch's uniforms are drawn and each agent takes its own column, so that a
-        # walk does not depend on how the batch was shared out or compacted.
-        draws = jax.random.uniform(draw_key, (STEPS_PER_CHECK, num_agents))
-        if share < num_agents:
-            draws = jax.lax.dynamic_slice_in_dim(draws, first, share, axis=1)
-        if lanes_ids is not None:
-            draws = draws[:, lanes_ids]
-        rows = c.lanes.position.shape[0]
+    here = start[run_of_row]
+    results = Results(
+        path=jnp.full((count, max_steps + 1), NO_NODE, jnp.int32).at[:, 0].set(here),
+        slots=jnp.full((count, max_steps), -1, slot_dtype),
+        position=here, visited=start_visited(here),
+        moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
+        arrived=here == goal[run_of_row], stuck=jnp.zeros((count,), bool))
 
-        def step_into_blocks(i, inner):
-            lanes, step, slots, nodes = inner
-            lanes, step, slot, node = one_step(lanes, step, draws[i], greedy)
-            return lanes, step, slots.at[i].set(slot), nodes.at[i].set(node)
-
-        slots = jnp.full((STEPS_PER_CHECK, rows), -1, slot_dtype)
-        nodes = jnp.full((STEPS_PER_CHECK, rows), NO_NODE, node_dtype)
-        lanes, step, slots, nodes = jax.lax.fori_loop(
-            0, STEPS_PER_CHECK, step_into_blocks, (c.lanes, c.step, slots, nodes))
-        if graph.is_grid:
-            lanes = lanes._replace(moves=lanes.moves + jnp.sum(slots >= 0, axis=0),
-                                   diagonal=lanes.diagonal
-                                   + jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=0))
-        lanes = lanes._replace(
-            slots=jax.lax.dynamic_update_slice(lanes.slots, slots.T, (0, c.step)),
-            nodes=jax.lax.dynamic_update_slice(lanes.nodes, nodes.T, (0, c.step)))
-        return Carry(key=key, step=step, lanes=lanes)
+    def fresh_lanes(queued):
+        """Lanes holding the queue's entries ``queued`` (i32[l]; ``>= live``: none), at the
+        start node."""
+        holds = queued < live
+        agent = jnp.where(holds, queue[jnp.minimum(queued, count - 1)], count)
+        run = run_of_row[jnp.minimum(agent, count - 1)]
+        zeros = jnp.zeros(queued.shape, jnp.int32)
+        return Lanes(agent=agent, run=run, position=start[run], visited=start_visited(start[run]),
+                     moves=zeros, diagonal=zeros, walking=holds,
+                     arrived=jnp.zeros(queued.shape, bool), stuck=jnp.zeros(queued.shape, bool))
 
     def neighbours_of(here):
-        """i32[a, K] each agent's neighbours, clamped into the map: computed from the slot
-        offsets on grids (no gather), read from ``nbr`` otherwise. A slot without a neighbour
-        yields some node there, never used: its log-weight is -inf."""
+        """i32[l, K] each lane's neighbours, clamped into the map: the slot offsets on grids
+        (no gather), ``nbr`` otherwise. A slot without a neighbour yields some node there,
+        never used: its log-weight is -inf."""
         if graph.is_grid:
-            return jnp.clip(here[:, None] + jnp.asarray(slot_offsets(graph)), 0, n - 1)
+            return jnp.clip(here[:, None] + offsets, 0, n - 1)
         return jnp.maximum(graph.nbr[here], 0)
 
-    def one_step(lanes: Lanes, step, uniform, greedy):
+    def one_step(lanes: Lanes):
         here = lanes.position
         neighbours = neighbours_of(here)
-        row = log_weights[here]
+        row = log_weights[lanes.run * n + here]
         seen = bits.is_marked(lanes.visited, neighbours)
         admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
+        within_run = lanes.agent % num_agents
+        uniform = uniforms(seed[lanes.run], within_run, lanes.moves)
+        greedy = within_run < greedy_agents if greedy_agents else None
         choice, has_choice = sample_masked(uniform, row, admissible, greedy)
-        moving = lanes.walking & has_choice & (step < max_steps)
+        moving = lanes.walking & has_choice
         target = jnp.take_along_axis(neighbours, jnp.maximum(choice, 0)[:, None], axis=1)[:, 0]
         there = jnp.where(moving, target, here)
-        arrived_now = moving & (there == goal)
+        moves = lanes.moves + moving
+        arrived_now = moving & (there == goal[lanes.run])
         lanes = lanes._replace(
             position=there,
             visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there),
-            walking=moving & ~arrived_now,
+            moves=moves,
+            diagonal=lanes.diagonal + (moving & (choice >= ORTHOGONAL_SLOTS)),
+            walking=moving & ~arrived_now & (moves < max_steps),
             arrived=lanes.arrived | arrived_now,
             stuck=lanes.stuck | (lanes.walking & ~has_choice))
-        return (lanes, jnp.minimum(step + 1, max_steps),
-                jnp.where(moving, choice, -1).astype(slot_dtype),
-                jnp.where(moving, there, NO_NODE).astype(node_dtype))
+        return lanes, jnp.where(moving, choice, -1).astype(slot_dtype), jnp.where(moving, there,
+                                                                                  NO_NODE)
 
-    compact_lanes = share // COMPACT_SHARE
-    if compact_lanes == 0:
-        c = jax.lax.while_loop(keep_walking, lambda c: block(c, None, greedy), carry)
-    else:
-        c = jax.lax.while_loop(
-            lambda c: keep_walking(c) & (jnp.sum(c.lanes.walking) > compact_lanes),
-            lambda c: block(c, None, greedy), carry)
-        # At most ``compact_lanes`` agents still walk: they go on in a batch of that size.
-        ids = jnp.nonzero(c.lanes.walking, size=compact_lanes, fill_value=share)[0]
-        held = jnp.minimum(ids, share - 1)  # padding lanes hold a copy, never walk
-        few = jax.tree_util.tree_map(lambda x: x[held], c.lanes)
-        few = c._replace(lanes=few._replace(walking=few.walking & (ids < share)))
-        few = jax.lax.while_loop(
-            keep_walking,
-            lambda f: block(f, held, None if greedy is None else greedy[held]), few)
-        c = Carry(key=few.key, step=few.step, lanes=jax.tree_util.tree_map(
-            lambda all_, part: all_.at[ids].set(part, mode="drop"), c.lanes, few.lanes))
-    lanes = c.lanes
-    path = jnp.concatenate([position[:, None], lanes.nodes[:, :max_steps].astype(jnp.int32)],
-                           axis=1)
-    slots = lanes.slots[:, :max_steps].astype(jnp.int16)
-    if graph.is_grid:
-        length = lattice_length(lanes.moves, lanes.diagonal)
-    else:
-        length = total_length(graph, path[:, :-1], slots)
-    return Walk(path=path, slots=slots, length=length, arrived=lanes.arrived,
-                stuck=lanes.stuck, position=lanes.position, visited=lanes.visited, steps=c.step)
+    def block(loop: Loop) -> Loop:
+        """``STEPS_PER_REFILL`` moves of every lane; the moves go to small step-major blocks
+        (one contiguous row per step), written into the results as one window per lane
+        (columns past the budget are dropped)."""
+        lanes = loop.lanes
+        width = lanes.agent.shape[0]
+
+        def step_into_blocks(i, inner):
+            lanes, slots, nodes = inner
+            lanes, slot, node = one_step(lanes)
+            return lanes, slots.at[i].set(slot), nodes.at[i].set(node)
+
+        first_move = lanes.moves
+        slots = jnp.full((STEPS_PER_REFILL, width), -1, slot_dtype)
+        nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
+        lanes, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_REFILL, step_into_blocks,
+                                                (lanes, slots, nodes))
+        row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
+        column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
+        results = loop.results._replace(
+            slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
+            path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
+        return loop._replace(lanes=lanes, results=results,
+                             lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
+
+    def retire(results: Results, lanes: Lanes, which) -> Results:
+        """``results`` with the agents of lanes ``which`` (i32[r], ``>= l`` for none) stored."""
+        width = lanes.agent.shape[0]
+        held = jnp.minimum(which, width - 1)
+        row = jnp.where(which < width, lanes.agent[held], count)
+        return results._replace(**{
+            name: getattr(results, name).at[row].set(getattr(lanes, name)[held], mode="drop")
+            for name in ("position", "visited", "moves", "diagonal", "arrived", "stuck")})
+
+    def stopped(lanes: Lanes):
+        return (lanes.agent < count) & ~lanes.walking
+
+    def refill(loop: Loop) -> Loop:
+        """Up to ``l // REFILL_SHARE`` lanes whose agent stopped store it and take the next
+        (or are emptied when the queue is)."""
+        lanes = loop.lanes
+        width = lanes.agent.shape[0]
+        which = jnp.nonzero(stopped(lanes), size=max(width // REFILL_SHARE, 1),
+                            fill_value=width)[0]
+        results = retire(loop.results, lanes, which)
+        taken = which < width
+        fresh = fresh_lanes(jnp.where(taken, loop.next_queued + jnp.cumsum(taken) - 1, count))
+        lanes = jax.tree_util.tree_map(
+            lambda old, new: old.at[jnp.where(taken, which, width)].set(new, mode="drop"),
+            lanes, fresh)
+        return loop._replace(lanes=lanes, results=results,
+                             next_queued=jnp.minimum(loop.next_queued + jnp.sum(taken), live))
+
+    def walking_count(loop: Loop):
+        return jnp.sum(loop.lanes.walking)
+
+    def flush(loop: Loop) -> Loop:
+        """Every stopped agent still in a lane stored, its lane emptied."""
+        lanes = loop.lanes
+        width = lanes.agent.shape[0]
+        done = stopped(lanes)
+        results = retire(loop.results, lanes, jnp.where(done, jnp.arange(width), width))
+        return loop._replace(results=results,
+                             lanes=lanes._replace(agent=jnp.where(done, count, lanes.agent)))
+
+    loop = Loop(lanes=fresh_lanes(jnp.arange(num_lanes)), results=results,
+                next_queued=jnp.minimum(jnp.int32(num_lanes), live), lane_steps=jnp.int32(0))
+    few = num_lanes // COMPACT_SHARE
+
+    def keep_queueing(loop: Loop):
+        queue_left = loop.next_queued < live
+        return (queue_left | (walking_count(loop) > few)) & (queue_left
+                                                             | (walking_count(loop) > 0))
+
+    loop = flush(jax.lax.while_loop(keep_queueing, lambda loop: refill(block(loop)), loop))
+    if few:
+        # The queue is empty and at most ``few`` agents still walk: they go on in ``few`` lanes.
+        which = jnp.nonzero(loop.lanes.walking, size=few, fill_value=num_lanes)[0]
+        lanes = jax.tree_util.tree_map(lambda x: x[jnp.minimum(which, num_lanes - 1)],
+                                       loop.lanes)
+        lanes = lanes._replace(walking=lanes.walking & (which < num_lanes),
+                               agent=jnp.where(which < num_lanes, lanes.agent, count))
+        loop = flush(jax.lax.while_loop(lambda loop: walking_count(loop) > 0, block,
+                                        loop._replace(lanes=lanes)))
+    return loop.results, loop.lane_steps

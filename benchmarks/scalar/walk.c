@@ -1,0 +1,88 @@
+/* A scalar reference of jaxswarm's walk on grids: one agent at a time, the same transition
+ * rule (inverse CDF over exp(log-weight - max) of the admissible slots), visited sets as bits,
+ * the same counter-based uniforms (jaxswarm.swarm.walking.uniforms), so it walks the same paths.
+ * Built and timed by benchmarks/walk.py; agents are shared out over threads with OpenMP. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+/* Threads for the next walk_all (OpenMP; one when built without it). */
+void set_threads(int32_t threads) {
+#ifdef _OPENMP
+  omp_set_num_threads(threads);
+#else
+  (void)threads;
+#endif
+}
+
+static inline uint32_t finalise(uint32_t x) {
+  x ^= x >> 16; x *= 0x85EBCA6Bu; x ^= x >> 13; x *= 0xC2B2AE35u; x ^= x >> 16;
+  return x;
+}
+
+static inline float uniform(uint32_t s0, uint32_t s1, uint32_t agent, uint32_t move) {
+  uint32_t counter = (agent * 0x9E3779B1u) ^ move;
+  return (float)(finalise(finalise(counter ^ s0) ^ s1) >> 8) * 0x1p-24f;
+}
+
+/* Walks agents 0..agents-1 from start; writes each agent's moves and its path into paths
+ * (i32[agents, max_steps + 1], filled with -1 by the caller) and returns the total number of
+ * moves. */
+int64_t walk_all(const float *log_weights, int32_t num_nodes, int32_t degree,
+                 const int32_t *offsets, int32_t start, int32_t goal, int32_t agents,
+                 int32_t max_steps, uint32_t s0, uint32_t s1, int32_t *moves_out,
+                 int32_t *paths) {
+  int32_t words = (num_nodes + 31) / 32;
+  int64_t total = 0;
+#pragma omp parallel reduction(+ : total)
+  {
+    uint32_t *visited = malloc(sizeof(uint32_t) * words);
+    float weight[64];
+    int32_t neighbour[64];
+#pragma omp for schedule(dynamic, 16)
+    for (int32_t a = 0; a < agents; a++) {
+      int32_t *path = paths + (int64_t)a * (max_steps + 1);
+      memset(visited, 0, sizeof(uint32_t) * words);
+      int32_t here = start, moves = 0;
+      path[0] = here;
+      visited[here >> 5] |= 1u << (here & 31);
+      while (here != goal && moves < max_steps) {
+        const float *row = log_weights + (int64_t)here * degree;
+        float top = -INFINITY;
+        for (int32_t k = 0; k < degree; k++) {
+          int32_t nb = here + offsets[k];
+          nb = nb < 0 ? 0 : (nb >= num_nodes ? num_nodes - 1 : nb);
+          neighbour[k] = nb;
+          int seen = (visited[nb >> 5] >> (nb & 31)) & 1u;
+          weight[k] = (row[k] > -INFINITY && !seen) ? row[k] : -INFINITY;
+          if (weight[k] > top) top = weight[k];
+        }
+        if (!isfinite(top)) break; /* stuck */
+        float sum = 0.0f;
+        for (int32_t k = 0; k < degree; k++) {
+          weight[k] = expf(weight[k] - top);
+          sum += weight[k];
+        }
+        float u = uniform(s0, s1, (uint32_t)a, (uint32_t)moves) * sum, running = 0.0f;
+        int32_t below_u = 0, below_total = 0;
+        for (int32_t k = 0; k < degree; k++) {
+          running += weight[k];
+          below_u += running <= u;
+          below_total += running < sum;
+        }
+        int32_t choice = below_u < below_total ? below_u : below_total;
+        here = neighbour[choice];
+        visited[here >> 5] |= 1u << (here & 31);
+        path[++moves] = here;
+      }
+      moves_out[a] = moves;
+      total += moves;
+    }
+    free(visited);
+  }
+  return total;
+}
