@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
 PYTEST := $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile
 
-.PHONY: demo test test-slow bench reproduce reproduce-quick clean
+.PHONY: demo test test-slow bench performance reproduce reproduce-quick clean
 
 $(INSTALLED): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -24,6 +24,9 @@ test-slow: $(INSTALLED)  ## the large-scale checks (every Moving AI scenario row
 
 bench: $(INSTALLED)  ## benchmark scripts (print figures; not tests)
 	$(BIN)/python benchmarks/exact.py
+
+performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md (~15 min on 2 cores)
+	$(BIN)/python benchmarks/report.py
 
 # The generated tables of results/ (see results/README.md), one script each; every script writes
 # its Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and

@@ -1,31 +1,32 @@
 """Throughput and memory of the batched sweep runner beside the same runs done one at a time.
 
-An rfd_graded sweep of ``p_base`` x ``alpha`` (``--values`` x ``--values`` values: ``p_base``
+For each agent count of ``--agents`` (default 16 and 64: the small swarms of parameter studies),
+an rfd_graded sweep of ``p_base`` x ``alpha`` (``--values`` x ``--values`` values: ``p_base``
 geometric from 2 to 200, ``alpha`` linear from 1 to 20) x ``--seeds`` seeds on ``--map``
-(default mosaic50, 8 x 8 x 20 = 1,280 runs of 100 iterations with 64 agents) is run by
+(default mosaic50, 8 x 8 x 20 = 1,280 runs of 100 iterations) is run by
 :func:`jaxswarm.sweep.run_sweep` into a fresh temporary store, then the same runs are done one at
-a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. Printed:
+a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The CPU is split into
+``--devices`` JAX devices (default: one per core, each with one XLA thread; see
+:mod:`jaxswarm.cpu`), so the sweep runs one shard of each chunk per core. Printed per agent count:
 
-* ``sweep``: one timed call of ``run_sweep`` (it takes minutes, so it is not repeated). Its
-  compile time is the runner's own ``compiled ... in X s`` log line; the wall time and runs/s
-  exclude it (they still include the map's optimum, the chunks' inputs and the Parquet writes).
-  The sum of the chunks' compute times (the rows' ``chunk_seconds``) is printed beside it.
+* ``sweep``: one timed call of ``run_sweep`` (not repeated: it takes a while). Its compile time
+  is the runner's own ``compiled ... in X s`` log line; the wall time and runs/s exclude it (they
+  still include the map's optimum, the chunks' inputs and the Parquet writes). Before it, a
+  sweep of a quarter of the seeds is run, so that the peak resident memory (``ru_maxrss``) after
+  each shows whether memory grows with the number of runs.
 * ``loop``: ``run`` called per (params, seed) with ``jax.random.key(seed)`` and blocked on, after
-  one warm-up call (params are traced, so the loop compiles once; that compile is printed and
-  excluded). With ``--loop-runs N`` below the total only N runs, spread over the grid and the
-  seeds, are timed and the loop's wall time is extrapolated to all runs; the output says so.
-* the speed-up (loop wall / sweep wall, compile excluded on both sides), the process's peak
-  resident memory after the sweep (``ru_maxrss``) and XLA's device memory stats when the backend
-  has them (the CPU backend usually has none), and whether the goals hold: sweep >= 20x the loop,
-  peak memory < 4 GiB.
-* a correctness check: the sweep's cost equals the loop's cost (bit for bit, float32) for every
-  run measured in both; the number of mismatches is printed.
+  one warm-up call (params are traced, so the loop compiles once; that compile is excluded), on
+  the first device. With ``--loop-runs N`` below the total only N runs, spread over the grid and
+  the seeds, are timed and the loop's wall time is extrapolated to all runs; the output says so.
+* the speed-up (loop wall / sweep wall, compile excluded on both sides) against the goal (5x for
+  16 agents, 1.5x for 64), the peak memory against 4 GiB, and a correctness check: the sweep's
+  cost equals the loop's cost (bit for bit, float32) for every run measured in both.
 
 Run from the repository root::
 
     python benchmarks/sweep.py
-    python benchmarks/sweep.py --loop-runs 64
-    python benchmarks/sweep.py --values 2 --seeds 2 --iterations 5 --agents 16 --loop-runs 4
+    python benchmarks/sweep.py --agents 16 --loop-runs 64
+    python benchmarks/sweep.py --values 2 --seeds 4 --iterations 5 --agents 16 --loop-runs 4
 """
 from __future__ import annotations
 
@@ -41,14 +42,15 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.cpu import configure
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep import run_sweep, spec_from_dict
-from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE, DEFAULT_VMAP_SIZE
+from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
 
 GiB = 2 ** 30
 MiB = 2 ** 20
-GOAL_SPEEDUP = 20.0
+GOAL_SPEEDUP = {16: 5.0, 64: 1.5}
 GOAL_MEMORY = 4 * GiB
 
 
@@ -58,11 +60,13 @@ def machine() -> str:
             f"{len(jax.devices())} device(s))")
 
 
-def sweep_document(args) -> dict:
-    return {"sweep": {"name": "bench", "algorithm": "rfd_graded", "maps": [args.map],
-                      "seeds": args.seeds, "iterations": args.iterations,
-                      "chunk_size": args.chunk_size, "vmap_size": args.vmap_size},
-            "config": {"num_agents": args.agents},
+def sweep_document(args, agents: int, seeds: int) -> dict:
+    sweep = {"name": "bench", "algorithm": "rfd_graded", "maps": [args.map], "seeds": seeds,
+             "iterations": args.iterations, "chunk_size": args.chunk_size}
+    if args.vmap_size is not None:
+        sweep["vmap_size"] = args.vmap_size
+    return {"sweep": sweep,
+            "config": {"num_agents": agents},
             "params": {"p_base": {"start": 2, "stop": 200, "num": args.values, "log": True},
                        "alpha": {"start": 1, "stop": 20, "num": args.values}}}
 
@@ -82,13 +86,9 @@ def device_memory() -> dict | None:
 def time_sweep(spec) -> dict:
     lines = []
 
-    def log(line: str):
-        lines.append(line)
-        print(f"  [run_sweep] {line}", flush=True)
-
     with tempfile.TemporaryDirectory(prefix="jaxswarm-bench-sweep-") as out:
         began = time.perf_counter()
-        frame = run_sweep(spec, out, progress=False, log=log)
+        frame = run_sweep(spec, out, progress=False, log=lines.append)
         wall = time.perf_counter() - began
     compiles = [float(m.group(1)) for line in lines
                 for m in [re.search(r"compiled .* in ([\d.]+) s", line)] if m]
@@ -137,88 +137,66 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
     return dict(costs=costs, wall=wall, compile=compile_seconds, iterations=iterations)
 
 
+def measure(args, agents: int) -> dict:
+    """The quarter sweep, the sweep and the loop for runs of ``agents`` agents."""
+    quarter = spec_from_dict(sweep_document(args, agents, max(1, args.seeds // 4)))
+    time_sweep(quarter)
+    quarter_rss = peak_rss()
+    spec = spec_from_dict(sweep_document(args, agents, args.seeds))
+    total = spec.num_runs
+    sweep = time_sweep(spec)
+    runs = loop_runs(total, len(spec.grid()), len(spec.seeds), args.loop_runs)
+    loop = time_loop(spec, args.map, runs)
+    sweep_costs = sweep["frame"].set_index("run")["cost"]
+    mismatches = [r for r in runs
+                  if not np.array_equal(np.float32(sweep_costs.loc[r]), loop["costs"][r])]
+    sweep_wall = sweep["wall"] - sweep["compile"]
+    loop_wall = loop["wall"] * total / len(runs)
+    return dict(total=total, sweep_wall=sweep_wall, loop_wall=loop_wall,
+                compile=sweep["compile"], measured=len(runs), mismatches=mismatches,
+                quarter_rss=quarter_rss, rss=sweep["rss"],
+                iterations=float(sweep["frame"]["iterations"].mean()))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default="mosaic50", help="a paper map")
-    parser.add_argument("--agents", type=int, default=64)
+    parser.add_argument("--agents", default="16,64", help="comma-separated agents per run")
     parser.add_argument("--iterations", type=int, default=100)
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--values", type=int, default=8,
                         help="values per param (the grid is values x values)")
     parser.add_argument("--chunk-size", type=int, default=DEFAULT_CHUNK_SIZE,
                         help="runs per sweep chunk (default: the sweep spec's default)")
-    parser.add_argument("--vmap-size", type=int, default=DEFAULT_VMAP_SIZE,
-                        help="runs vmapped together (default: the sweep spec's default)")
+    parser.add_argument("--vmap-size", type=int, default=None,
+                        help="runs vmapped together (default: the runner's, from the agents)")
+    parser.add_argument("--devices", type=int, default=os.cpu_count(),
+                        help="JAX CPU devices, one XLA thread each (default: one per core)")
     parser.add_argument("--loop-runs", type=int, default=None,
                         help="time only this many loop runs and extrapolate (default: all)")
     args = parser.parse_args(argv)
-    spec = spec_from_dict(sweep_document(args))
-    total = spec.num_runs
-    combinations = len(spec.grid())
+    configure(devices=args.devices, threads=args.devices)  # before JAX's first computation
 
     print(f"machine: {machine()}")
     print(f"rfd_graded on {args.map}: p_base x alpha = {args.values} x {args.values} values x "
-          f"{args.seeds} seeds = {total} runs, {args.iterations} iterations, {args.agents} agents, "
-          f"chunks of {args.chunk_size}, vmapped {args.vmap_size} at a time")
-    print("sweep: one timed run_sweep into a fresh store (single run, not repeated: too long)",
-          flush=True)
-    sweep = time_sweep(spec)
-    sweep_wall = sweep["wall"] - sweep["compile"]
-
-    runs = loop_runs(total, combinations, len(spec.seeds), args.loop_runs)
-    measured = len(runs)
-    extrapolated = measured < total
-    print(f"loop: run() one at a time, {measured} of {total} runs after one warm-up call",
-          flush=True)
-    loop = time_loop(spec, args.map, runs)
-    loop_wall = loop["wall"] * total / measured
-
-    frame = sweep["frame"]
-    sweep_costs = frame.set_index("run")["cost"]
-    mismatches = [r for r in runs
-                  if not np.array_equal(np.float32(sweep_costs.loc[r]), loop["costs"][r])]
-    speedup = loop_wall / sweep_wall
-    memory_ok = sweep["rss"] < GOAL_MEMORY
-
-    print()
-    print(f"{'mode':6} {'runs':>6} {'wall s':>10} {'runs/s':>9} {'compile s':>10}")
-    print(f"{'sweep':6} {total:>6} {sweep_wall:>10.2f} {total / sweep_wall:>9.2f} "
-          f"{sweep['compile']:>10.2f}")
-    print(f"{'loop':6} {total:>6} {loop_wall:>10.2f} {total / loop_wall:>9.2f} "
-          f"{loop['compile']:>10.2f}" + ("  (extrapolated)" if extrapolated else ""))
-    print()
-    print(f"sweep: run_sweep wall {sweep['wall']:.2f} s including {sweep['compile']:.2f} s "
-          f"compile ({sweep['compiles']} compile(s)); chunks' compute alone "
-          f"{sweep['chunk_seconds']:.2f} s ({total / sweep['chunk_seconds']:.2f} runs/s)")
-    used = frame.groupby("chunk")["iterations"]
-    print(f"iterations used: sweep mean {frame['iterations'].mean():.1f}, but a vmapped group "
-          f"runs as long as its slowest run (max per chunk: "
-          f"{', '.join(str(int(v)) for v in used.max())}); loop mean "
-          f"{np.mean(loop['iterations']):.1f} over its {measured} runs")
-    if extrapolated:
-        print(f"loop: measured {measured} of {total} runs, extrapolated "
-              f"({loop['wall']:.2f} s for {measured} runs, {loop['wall'] / measured:.3f} s/run)")
-    else:
-        print(f"loop: measured all {total} runs ({loop['wall'] / measured:.3f} s/run)")
-    print(f"peak RSS after the sweep: {sweep['rss'] / MiB:.0f} MiB "
-          f"({sweep['rss'] / GiB:.2f} GiB)")
-    stats = sweep["device"]
-    if stats:
-        shown = {k: v for k, v in stats.items() if "bytes" in k}
-        print("XLA device memory stats: " + ", ".join(
-            f"{k} {v / MiB:.0f} MiB" for k, v in sorted(shown.items())))
-    else:
-        print("XLA device memory stats: not available on this backend")
-    print(f"correctness: sweep cost == loop cost on {measured - len(mismatches)} of {measured} "
-          f"runs measured in both; {len(mismatches)} mismatch(es)"
-          + (f" (runs {mismatches[:10]}{' ...' if len(mismatches) > 10 else ''})"
-             if mismatches else ""))
-    print()
-    print(f"speed-up sweep vs loop: {speedup:.2f}x "
-          f"(goal >= {GOAL_SPEEDUP:.0f}x: {'met' if speedup >= GOAL_SPEEDUP else 'NOT met'}"
-          f"{', loop extrapolated' if extrapolated else ''})")
-    print(f"peak memory: {sweep['rss'] / GiB:.2f} GiB "
-          f"(goal < 4 GiB: {'met' if memory_ok else 'NOT met'})")
+          f"{args.seeds} seeds, {args.iterations} iterations, chunks of {args.chunk_size}, "
+          f"groups of {args.vmap_size or 'the runner default'}")
+    print(f"{'agents':>6} {'runs':>6} {'sweep s':>8} {'loop s':>8} {'speed-up':>9} {'goal':>5} "
+          f"{'compile s':>9} {'RSS 1/4 GiB':>11} {'RSS GiB':>8} {'same cost':>11} "
+          f"{'iterations':>10}", flush=True)
+    for agents in (int(part) for part in args.agents.split(",")):
+        r = measure(args, agents)
+        speedup = r["loop_wall"] / r["sweep_wall"]
+        goal = GOAL_SPEEDUP.get(agents)
+        met = "" if goal is None else ("met" if speedup >= goal else "NOT met")
+        print(f"{agents:>6} {r['total']:>6} {r['sweep_wall']:>8.2f} {r['loop_wall']:>8.2f}"
+              f"{'*' if r['measured'] < r['total'] else ' '} {speedup:>8.2f}x "
+              f"{met:>5} {r['compile']:>9.1f} {r['quarter_rss'] / GiB:>11.2f} "
+              f"{r['rss'] / GiB:>8.2f} {r['measured'] - len(r['mismatches']):>5}/"
+              f"{r['measured']:<5} {r['iterations']:>10.1f}", flush=True)
+    print("* loop extrapolated from --loop-runs runs" if args.loop_runs else "")
+    print(f"goals: speed-up {', '.join(f'{v}x at {k} agents' for k, v in GOAL_SPEEDUP.items())}; "
+          f"peak memory below {GOAL_MEMORY / GiB:.0f} GiB and flat in the number of runs")
     return 0
 
 

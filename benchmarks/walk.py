@@ -8,6 +8,9 @@ river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 an
 queue over the walker's lanes), jitted, after one warm-up call (compile excluded). Printed, the
 median over ``--repeats`` runs:
 
+(ACO* finds no path on maze100 in 30 iterations, so its pheromone stays uniform up to a
+factor and both memories give the same walks.)
+
 * ``moves``: moves agents made (one agent changing node is one move), and ``busy``: the share
   of the loop's lane-steps that were moves (the rest idled: an agent that stopped waits for its
   lane's next refill, and the last agents' lanes wait for the slowest),

@@ -24,6 +24,7 @@ from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
 from jaxswarm.sweep.plots import heatmap_figure, line_figure, plot_sweep, summary
+from jaxswarm.sweep.runner import group_size
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -183,7 +184,8 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     metadata = json.loads((out / "metadata.json").read_text())
     assert metadata["spec"]["params"]["p_base"] == [5.0, 20.0]
     assert metadata["jax"] == jax.__version__ and metadata["seeds"] == [0, 1, 2]
-    assert metadata["vmap_size"] == spec.vmap_size == 8
+    assert spec.vmap_size is None and metadata["vmap_size"] == min(
+        group_size(spec.config["num_agents"]), spec.chunk_size)  # the walker's lanes filled
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
 
 

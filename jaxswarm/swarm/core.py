@@ -169,11 +169,12 @@ def _run(swarm, key, graph, task, params, iterations, patience):
         state, trace, stale, _ = carry
         before = swarm.best(state).cost
         # Under vmap every run of the batch goes through this body until the last one stops,
-        # and a stopped run's result is dropped. Giving it the task "from the start to the start"
-        # makes its walk empty, so the walker's lanes go to the runs still going.
+        # and a stopped run's result is dropped. Starting its walk at the goal makes the walk
+        # empty, so the walker's lanes go to the runs still going (the goal stays as it is:
+        # work that depends on it alone is hoisted out of the loop).
         going = keep_going(carry)
         state, info = swarm.step(state, graph, task._replace(
-            goal=jnp.where(going, task.goal, task.start)), params)
+            start=jnp.where(going, task.start, task.goal)), params)
         after = swarm.best(state).cost
         t = trace.iterations
         trace = Trace(best_cost=trace.best_cost.at[t].set(after),

@@ -4,9 +4,11 @@ Per map, the runs are ordered combination-major (run ``r`` = combination ``r // 
 ``seeds[r % S]``) and cut into chunks of ``chunk_size``. A chunk is one call of a compiled
 program: its runs are shared out over ``jax.devices()`` (``shard_map``; the chunk is padded to
 a multiple of the device count, and padding rows are dropped), and each device goes through its
-share ``vmap_size`` runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` over keys and
-stacked params inside ``lax.map``. Small groups keep each run's buffers in the CPU's caches: on
-2 cores, groups of 8 ran chunks of 64 in 0.6-0.9x the time of one ``vmap`` over all 64.
+share a group of runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` over keys and
+stacked params inside ``lax.map``. Under that ``vmap`` the walks of a group's runs share one queue
+of agents over the walker's lanes (:func:`jaxswarm.swarm.walking.walk`), and a run that stopped
+walks no more, so small swarms fill the lanes from many runs: the group is ``vmap_size`` runs, by
+default enough to fill the lanes (:func:`group_size`).
 Maps of the same shape share the compiled program; each compile is logged. A run with seed
 ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
 whatever the chunk size, the group size and the number of devices.
@@ -35,6 +37,7 @@ from tqdm.auto import tqdm
 
 from jaxswarm.exact import optimal_length
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap, check_query, resolve_map
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
@@ -78,17 +81,19 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     maps = _resolve_maps(spec, base_dir)  # every entry checked before anything is written
     writer = jax.process_index() == 0
     swarm = make(spec.algorithm, **spec.config)
-    store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, swarm), writer=writer)
+    devices = jax.devices()
+    padded = -(-spec.chunk_size // len(devices)) * len(devices)
+    group = min(spec.vmap_size or group_size(swarm.config.num_agents), padded // len(devices))
+    store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, swarm, group),
+                         writer=writer)
     grid = spec.grid()
     seeds = np.asarray(spec.seeds)
     num_runs = spec.num_runs
     params = _stacked_params(swarm.default_params, grid, len(seeds))
-    devices = jax.devices()
     mesh = Mesh(np.asarray(devices), (RUNS_AXIS,))
     batch_sharding = NamedSharding(mesh, P(RUNS_AXIS))
     replicated = NamedSharding(mesh, P())
-    padded = -(-spec.chunk_size // len(devices)) * len(devices)
-    batch = _chunk_program(swarm, spec, mesh)
+    batch = _chunk_program(swarm, spec, mesh, group)
     compiled = {}
 
     per_map = math.ceil(num_runs / spec.chunk_size)
@@ -112,7 +117,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
                 compiled[program] = batch.lower(*example, graph, task).compile()
                 log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
-                    f"per chunk on {len(devices)} device(s), {spec.vmap_size} at a time, in "
+                    f"per chunk on {len(devices)} device(s), {group} at a time, in "
                     f"{time.perf_counter() - began:.1f} s")
             for c in todo:
                 first = c * spec.chunk_size
@@ -154,10 +159,16 @@ def _program_key(graph) -> tuple:
     return treedef, tuple(leaf.shape for leaf in leaves)
 
 
-def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh):
+def group_size(num_agents: int) -> int:
+    """Runs of ``num_agents`` agents vmapped together by default: enough to fill the walker's
+    ``LANES`` lanes (64 runs of 16 agents, 4 of 256), at least one."""
+    return max(1, LANES // num_agents)
+
+
+def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
     """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], graph, task) -> (cost
     f32[C], iterations i32[C])``, C a multiple of the mesh size, the runs sharded over the
-    mesh's ``RUNS_AXIS``; each device maps over its runs ``spec.vmap_size`` at a time."""
+    mesh's ``RUNS_AXIS``; each device maps over its runs ``group`` at a time."""
     def one(run_input, graph, task):
         seed, params = run_input
         state, trace = run(swarm, jax.random.key(seed), graph, task, params,
@@ -166,7 +177,7 @@ def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh):
 
     def share(seeds, params, graph, task):
         return jax.lax.map(lambda run_input: one(run_input, graph, task), (seeds, params),
-                           batch_size=min(spec.vmap_size, seeds.shape[0]))
+                           batch_size=min(group, seeds.shape[0]))
 
     return jax.jit(jax.shard_map(share, mesh=mesh,
                                  in_specs=(P(RUNS_AXIS), P(RUNS_AXIS), P(), P()),
@@ -224,7 +235,7 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, c
     return rows
 
 
-def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm) -> dict:
+def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm, group: int) -> dict:
     import jaxlib
     return dict(
         created=datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -233,7 +244,7 @@ def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm) -> dict:
         devices=[str(d) for d in jax.devices()], git_commit=_git_commit(),
         algorithm=spec.algorithm, config=spec.config, swarm=definition(swarm),
         seeds=list(spec.seeds),
-        vmap_size=spec.vmap_size,
+        vmap_size=group,
         maps=[dict(label=m.label, start=m.start, goal=m.goal,
                    size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])
 

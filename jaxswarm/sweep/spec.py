@@ -13,7 +13,7 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
     iterations = 100
     patience = 30                       # optional: stop a run 30 iterations after its last gain
     chunk_size = 64                     # optional: runs per compiled batch (bounds memory)
-    vmap_size = 8                       # optional: runs vmapped together on a device
+    vmap_size = 16                      # optional: runs vmapped together (default: from the agents)
 
     [config]                            # static: sizes and switches of the swarm factory
     num_agents = 64
@@ -53,7 +53,6 @@ SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size",
               "vmap_size"}
 DEFAULT_CHUNK_SIZE = 64
-DEFAULT_VMAP_SIZE = 8
 
 
 class SpecError(ValueError):
@@ -75,8 +74,9 @@ class SweepSpec:
       chunk_size: runs per compiled batch (a chunk is also the unit the store writes and a
         resumed sweep skips).
       vmap_size: runs vmapped together on one device; a device goes through its share of a
-        chunk that many at a time (on CPU, small groups keep each run's buffers in cache; on
-        GPUs raise it towards the chunk's share per device). It changes speed, never results.
+        chunk that many at a time, the walks of a group sharing one queue of agents. None:
+        enough runs to fill the walker's lanes (:func:`jaxswarm.sweep.runner.group_size`). It
+        changes speed, never results.
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).
       source: the file it came from (or "<dict>").
@@ -94,7 +94,7 @@ class SweepSpec:
     config: dict
     params: dict
     source: str = "<dict>"
-    vmap_size: int = DEFAULT_VMAP_SIZE
+    vmap_size: int | None = None
     log_scale: frozenset = frozenset()
 
     def grid(self) -> list[dict[str, float]]:
@@ -180,7 +180,9 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         patience = _positive_int(patience, "sweep.patience", fail)
     chunk_size = _positive_int(sweep.get("chunk_size", DEFAULT_CHUNK_SIZE), "sweep.chunk_size",
                                fail)
-    vmap_size = _positive_int(sweep.get("vmap_size", DEFAULT_VMAP_SIZE), "sweep.vmap_size", fail)
+    vmap_size = sweep.get("vmap_size")
+    if vmap_size is not None:
+        vmap_size = _positive_int(vmap_size, "sweep.vmap_size", fail)
 
     config = document.get("config", {})
     if not isinstance(config, dict):

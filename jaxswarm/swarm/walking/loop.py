@@ -48,8 +48,10 @@ LANES = 1024
 machine (``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited
 sets leave the caches), fewer leave the loop's fixed cost per step unshared."""
 
-STEPS_PER_REFILL = 8
-"""Moves a lane makes between two refills (an agent that stops within them idles until then)."""
+STEPS_PER_REFILL = 16
+"""Moves a lane makes between two refills (an agent that stops within them idles until then).
+Measured on maze100 (2 cores): 16 against 8 made rfd_graded's runs about 7 % faster (fewer
+loop iterations) and left the walk of 16,384 agents as fast."""
 
 REFILL_SHARE = 4
 """At most ``lanes // REFILL_SHARE`` lanes take a new agent per refill: copying a stopped agent's

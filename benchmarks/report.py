@@ -1,0 +1,101 @@
+"""Write ``docs/performance.md`` from the benchmarks: each script of ``BENCHMARKS`` runs in its own
+process (so each configures JAX's devices and threads its own way), and its printed table goes
+into the document verbatim under a paragraph saying what it measures, with the commit, versions
+and machine of the run at the top. The document is written only once every benchmark finished.
+
+Run from the repository root (about 15 minutes on 2 cores; ``make performance`` does the same)::
+
+    python benchmarks/report.py
+    python benchmarks/report.py --quick --out /tmp/performance.md   # small sizes, for a smoke run
+"""
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from jaxswarm.atomic import write_atomically
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _provenance():
+    path = ROOT / "sweeps" / "provenance.py"
+    spec = importlib.util.spec_from_file_location("provenance", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+BENCHMARKS = [
+    ("Walks: moves per second against a scalar C loop", "walk.py", [], ["--repeats", "2",
+                                                                       "--layouts", "64x4"],
+     "Moves per second of one jitted call of the walker on maze100 (all seeds' walks share one "
+     "queue over the lanes), from the swarm's first memory and from its memory after 30 "
+     "iterations, beside `benchmarks/scalar/walk.c` on one core and on all cores. `busy` is the "
+     "share of lane-steps that moved an agent; `same` counts the agents whose paths equal the C "
+     "loop's (it draws the walker's own uniforms)."),
+    ("rfd_graded on the paper maps", "rfd.py", [], ["--maps", "maze20,maze100", "--seeds", "3"],
+     "Median wall time of one `rfd_graded` run (100 iterations at most, patience 30, 256 drops, "
+     "one XLA thread) per paper map over 20 seeds, beside the RFD paper's C# time of RFD*, and "
+     "how many seeds reached the optimum."),
+    ("Sweeps against the same runs one at a time", "sweep.py", [],
+     ["--values", "2", "--seeds", "8", "--iterations", "10", "--loop-runs", "4"],
+     "1,280 `rfd_graded` runs on mosaic50 (8 x 8 values of p_base x alpha, 20 seeds, 100 "
+     "iterations) by the sweep runner and by `run` in a Python loop, in one process, for runs "
+     "of 16 and of 64 drops; the CPU is split into one JAX device per core."),
+    ("Settling and the distance field", "relax.py", [], ["--maps", "maze20", "--repeats", "3"],
+     "The batched relaxation behind `rfd_graded`'s settling and the exact distance field, on "
+     "maze100."),
+    ("Exact planners", "exact.py", [], ["--scenarios", "5", "--repeats", "1"],
+     "The exact planners against networkx on Moving AI maps: time per query and nodes "
+     "expanded."),
+]
+"""(title, script, arguments, quick arguments, what it measures) of each section."""
+
+
+def run_benchmark(script: str, arguments: list[str]) -> tuple[str, float]:
+    """The benchmark's printed output and its wall time; exits naming the script if it fails."""
+    command = [sys.executable, str(ROOT / "benchmarks" / script), *arguments]
+    began = time.perf_counter()
+    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True)
+    if done.returncode:
+        sys.exit(f"benchmarks/{script} failed ({done.returncode}):\n{done.stderr[-3000:]}")
+    return done.stdout.rstrip(), time.perf_counter() - began
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default=str(ROOT / "docs" / "performance.md"))
+    parser.add_argument("--quick", action="store_true", help="small sizes (a smoke run)")
+    parser.add_argument("--only", default=None,
+                        help="comma-separated scripts to run (default: all)")
+    args = parser.parse_args(argv)
+    provenance = _provenance()
+    record = provenance.begin(__file__, argv)
+    chosen = [entry for entry in BENCHMARKS
+              if args.only is None or entry[1] in args.only.split(",")]
+    sections = []
+    for title, script, arguments, quick, about in chosen:
+        used = quick if args.quick else arguments
+        print(f"running benchmarks/{script} {' '.join(used)}", flush=True)
+        output, seconds = run_benchmark(script, used)
+        shown = " ".join(["python", f"benchmarks/{script}", *used])
+        sections.append(f"## {title}\n\n{about}\n\n`{shown}` ({seconds:.0f} s):\n\n"
+                        f"```text\n{output}\n```\n")
+    record.finish(title="Performance on CPU",
+                  about="Every table below is the output of a script of `benchmarks/`, run once "
+                  "by `benchmarks/report.py` on the machine named here (compile time excluded; "
+                  "medians after a warm-up). Shared machines are noisy: compare figures of one "
+                  "run, and rerun a script rather than trusting a number here. Each script's "
+                  "docstring says exactly what it measures.")
+    write_atomically(Path(args.out), record.document("\n".join(sections)))
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
