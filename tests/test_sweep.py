@@ -239,6 +239,16 @@ def test_a_store_records_the_swarms_definition_and_refuses_another(finished, tmp
         run_sweep(spec, copy, progress=False)
 
 
+def test_a_store_of_0_2_0_is_not_resumed(finished, tmp_path):
+    spec, out, _ = finished
+    old = tmp_path / "old"
+    shutil.copytree(out, old)
+    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.2.0"))  # same definition, older walks
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.2\.0, whose walks drew "
+                                                 r"other random numbers"):
+        run_sweep(spec, old, progress=False)
+
+
 def test_a_store_of_0_1_0s_rfd_star_is_not_resumed(finished, tmp_path):
     spec, out, _ = finished
     old = tmp_path / "old"

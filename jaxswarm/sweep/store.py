@@ -92,12 +92,27 @@ def _differences(before: dict, after: dict) -> list[str]:
     return sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
 
 
+SAME_RESULTS_SINCE = (0, 3)
+"""The jaxswarm release since which a run's results are the same: 0.3.0's walker draws other
+random numbers than 0.2.0's, so a store of an older release is not resumed."""
+
+
+def _older_release(version: str | None) -> bool:
+    """Whether a version string (``0.2.0``, ``0.3.0.dev1``) is a release before
+    ``SAME_RESULTS_SINCE``; False when unknown (a source checkout that was not installed)."""
+    try:
+        return tuple(int(part) for part in (version or "").split(".")[:2]) < SAME_RESULTS_SINCE
+    except ValueError:
+        return False
+
+
 def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
     """Refuse to resume a store whose swarm was defined otherwise than ``swarm`` today.
 
     Raises:
       StoreMismatchError: naming the difference (the config fields and default params that
-        changed, or the jaxswarm version that wrote a store without a recorded definition).
+        changed, or the jaxswarm version that wrote a store without a recorded definition or
+        before ``SAME_RESULTS_SINCE``).
     """
     stored = existing.get("swarm")
     if stored == swarm:
@@ -111,6 +126,11 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
             f"which did not record the definition of {swarm['name']!r}; since 0.2.0 a "
             f"registered name is the paper's algorithm{renamed}, see CHANGELOG.md; choose "
             "another --out or delete it")
+    if _older_release(existing.get("jaxswarm")):
+        raise StoreMismatchError(
+            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose walks drew other "
+            f"random numbers (every result changed in 0.3.0, see CHANGELOG.md); choose another "
+            "--out or delete it")
     changed = [f"config.{k}" for k in _differences(stored.get("config", {}), swarm["config"])]
     changed += [f"default_params.{k}" for k in _differences(stored.get("default_params", {}),
                                                             swarm["default_params"])]

@@ -7,6 +7,9 @@ import jax.numpy as jnp
 from jaxswarm.graph import Graph
 from jaxswarm.swarm.walking import Walk
 
+STEPS_PER_CHECK = 8
+"""Steps back along the trails per test of whether any drop is still filling."""
+
 
 def blind_alleys(graph: Graph, log_weights, drops: Walk):
     """bool[N]: the blind alleys the stuck drops of a walk (``drops``, A agents) ran into, given
@@ -37,6 +40,11 @@ def blind_alleys(graph: Graph, log_weights, drops: Walk):
         dead = filling & (last - back >= 1) & ~jnp.any(way_out, axis=1)
         return back + 1, dead, filled.at[jnp.where(dead, node, n)].set(True, mode="drop")
 
-    _, _, filled = jax.lax.while_loop(any_filling, one_back,
+    def steps_back(carry):
+        # Several steps per test of the loop's condition: under vmap (a sweep) the loop runs
+        # until the longest alley of the batch is filled, and a drop done filling idles.
+        return jax.lax.fori_loop(0, STEPS_PER_CHECK, lambda _, c: one_back(c), carry)
+
+    _, _, filled = jax.lax.while_loop(any_filling, steps_back,
                                       (jnp.int32(1), drops.stuck, filled))
     return filled

@@ -49,7 +49,8 @@ from jaxswarm.relax import lowest_neighbour, relax
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import check_greedy_drops, gradients, river_swarm
-from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, visited_nodes
+from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
+                                    neighbour_values, visited_nodes)
 
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
@@ -117,7 +118,7 @@ def graded_transition(graph: Graph, task: Task, altitude, params: GradedParams):
     whenever adjacent."""
     heads, gradient = gradients(graph, altitude)
     carved = altitude < params.initial_height
-    from_bed, into_bed = carved[:, None], carved[heads]
+    from_bed, into_bed = carved[:, None], neighbour_values(graph, carved)
     too_steep = (gradient < -params.climb) & ~from_bed
     gradient = jnp.where(from_bed, jnp.maximum(gradient, -params.climb), gradient)
     gradient = jnp.where(~from_bed & into_bed, jnp.minimum(gradient, params.erosion), gradient)

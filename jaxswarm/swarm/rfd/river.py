@@ -16,7 +16,7 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
-from jaxswarm.swarm.walking import Walk, heads, step_budget, walk
+from jaxswarm.swarm.walking import Walk, heads, neighbour_values, step_budget, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -97,8 +97,8 @@ def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
     """``(heads i32[N, K], gradient f32[N, K])``: each slot's neighbour (0 where there is none)
     and the RFD paper's eq. 2, ``(altitude(i) - altitude(j)) / distance(i, j)``."""
     neighbour = heads(graph)
-    return neighbour, (altitude[:, None] - altitude[neighbour]) / jnp.where(graph.nbr >= 0,
-                                                                             graph.cost, 1.0)
+    drop = altitude[:, None] - neighbour_values(graph, altitude)
+    return neighbour, drop / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
 
 
 def deposit_where_stuck(altitude: jax.Array, drops: Walk, sediment) -> jax.Array:

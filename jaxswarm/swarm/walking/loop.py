@@ -237,7 +237,7 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, *, num_agents: int,
     """The walks of R runs on one map through one queue (leading axis R on every input)."""
     runs = start.shape[0]
     results, lane_steps = _walk_agents(
-        runs * num_agents, seed, graph, log_weights.reshape(-1, graph.max_degree), start, goal,
+        runs * num_agents, seed, graph, log_weights, start, goal,
         num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
@@ -305,7 +305,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
     def one_step(lanes: Lanes):
         here = lanes.position
         neighbours = neighbours_of(here)
-        row = log_weights[lanes.run * n + here]
+        row = log_weights[lanes.run, here]
         seen = bits.is_marked(lanes.visited, neighbours)
         admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
         within_run = lanes.agent % num_agents

@@ -6,13 +6,31 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
-from jaxswarm.lattice import straight_line
+from jaxswarm.lattice import slot_offsets, straight_line
 
 
 def heads(graph: Graph) -> jax.Array:
     """i32[N, K]: each slot's neighbour, 0 where there is none (a safe gather index; mask the
     slot by ``graph.nbr >= 0`` or by an edge table's ``-inf``)."""
     return jnp.where(graph.nbr >= 0, graph.nbr, 0)
+
+
+def neighbour_values(graph: Graph, values: jax.Array) -> jax.Array:
+    """[N, K]: ``values[nbr[i, k]]`` of an array ``values`` [N] (any dtype), some value of the
+    array where slot k has no neighbour (mask it as :func:`heads` says).
+
+    On grids and path maps the slots are fixed offsets, so this is K shifted slices of the
+    padded array, not a gather: under ``vmap`` over many runs' altitudes (a sweep) the gather
+    was most of the cost of a transition table.
+    """
+    if not graph.is_grid:
+        return values[heads(graph)]
+    offsets = [int(offset) for offset in slot_offsets(graph)]
+    margin = max(abs(offset) for offset in offsets)
+    padded = jnp.pad(values, (margin, margin), mode="edge")
+    n = graph.num_nodes
+    return jnp.stack([padded[margin + offset:margin + offset + n] for offset in offsets],
+                     axis=-1)
 
 
 def goal_log_distance(graph: Graph, goal) -> jax.Array:
