@@ -115,6 +115,11 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
         before ``SAME_RESULTS_SINCE``).
     """
     stored = existing.get("swarm")
+    if stored is not None and _older_release(existing.get("jaxswarm")):
+        raise StoreMismatchError(
+            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose walks drew other "
+            f"random numbers (every result changed in 0.3.0, see CHANGELOG.md); choose another "
+            "--out or delete it")
     if stored == swarm:
         return
     if stored is None:
@@ -126,11 +131,6 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
             f"which did not record the definition of {swarm['name']!r}; since 0.2.0 a "
             f"registered name is the paper's algorithm{renamed}, see CHANGELOG.md; choose "
             "another --out or delete it")
-    if _older_release(existing.get("jaxswarm")):
-        raise StoreMismatchError(
-            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose walks drew other "
-            f"random numbers (every result changed in 0.3.0, see CHANGELOG.md); choose another "
-            "--out or delete it")
     changed = [f"config.{k}" for k in _differences(stored.get("config", {}), swarm["config"])]
     changed += [f"default_params.{k}" for k in _differences(stored.get("default_params", {}),
                                                             swarm["default_params"])]
