@@ -17,8 +17,8 @@ factor and both memories give the same walks.)
 * ``M moves/s``: moves / wall time,
 * ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
   (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -fopenmp``, agents
-  shared out over threads; it writes each path's nodes into a buffer filled with -1 before the
-  clock starts), and ``share``: ours as a share of the reference on all cores. The
+  shared out over threads; it fills a path buffer with -1 and writes each path's nodes into it,
+  as the walker does), and ``share``: ours as a share of the reference on all cores. The
   reference draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents
   whose paths are identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may
   send an agent elsewhere at a tie of cumulative weights).
@@ -126,8 +126,8 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
 
     def run_scalar(threads: int) -> float:
         scalar.set_threads(threads)
-        paths.fill(-1)
         began = time.perf_counter()
+        paths.fill(-1)  # padded paths, as the walker returns them
         for s in range(seeds):
             scalar.walk_all(
                 flat_table.ctypes.data, graph.num_nodes, graph.max_degree, offsets.ctypes.data,

@@ -170,10 +170,14 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int):
                          for b in in_batched)
             out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal)
             return out, jax.tree_util.tree_map(lambda _: True, out)
+        weights_b = rest_b[0]
+        # One table for the whole batch stays one table (the walk reads it for every run).
+        shared = not weights_b and log_weights.shape[0] == 1
         runs = (seed, log_weights, start, goal)
-        runs = [x if b else jnp.broadcast_to(x, (axis_size,) + x.shape)
+        runs = [x if b or (x is log_weights and shared)
+                else jnp.broadcast_to(x, (axis_size,) + x.shape)
                 for x, b in zip(runs, [seed_b, *rest_b])]
-        folded = [x.reshape((-1,) + x.shape[2:]) for x in runs]
+        folded = [x if x is runs[1] and shared else x.reshape((-1,) + x.shape[2:]) for x in runs]
         seed, log_weights, start, goal = folded
         out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
                                      walk_runs(seed, graph, log_weights, start, goal))
@@ -234,7 +238,8 @@ class Loop(NamedTuple):
 
 def _walk_runs(seed, graph: Graph, log_weights, start, goal, *, num_agents: int, max_steps: int,
                greedy_agents: int) -> Walk:
-    """The walks of R runs on one map through one queue (leading axis R on every input)."""
+    """The walks of R runs on one map through one queue (leading axis R on every input; the
+    table's may be 1, one table for every run)."""
     runs = start.shape[0]
     results, lane_steps = _walk_agents(
         runs * num_agents, seed, graph, log_weights, start, goal,
@@ -277,7 +282,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
 
     here = start[run_of_row]
     results = Results(
-        path=jnp.full((count, max_steps + 1), NO_NODE, jnp.int32).at[:, 0].set(here),
+        path=jnp.full((count, max_steps + 1), NO_NODE, jnp.int32),  # the start goes in last
         slots=jnp.full((count, max_steps), -1, slot_dtype),
         position=here, visited=start_visited(here),
         moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
@@ -305,7 +310,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
     def one_step(lanes: Lanes):
         here = lanes.position
         neighbours = neighbours_of(here)
-        row = log_weights[lanes.run, here]
+        row = log_weights[lanes.run if log_weights.shape[0] > 1 else 0, here]
         seen = bits.is_marked(lanes.visited, neighbours)
         admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
         within_run = lanes.agent % num_agents
@@ -412,4 +417,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
                                agent=jnp.where(which < num_lanes, lanes.agent, count))
         loop = flush(jax.lax.while_loop(lambda loop: walking_count(loop) > 0, block,
                                         loop._replace(lanes=lanes)))
-    return loop.results, loop.lane_steps
+    # Written into the loop's output in place; set in the initial buffer, the start column made
+    # XLA fill the whole buffer element by element (a third of a large walk's time).
+    results = loop.results._replace(path=loop.results.path.at[:, 0].set(here))
+    return results, loop.lane_steps
