@@ -22,12 +22,13 @@ order in which agents get one, nor batching walks together changes any walk.
 Batching: :func:`walk` has its own ``vmap`` rule (``jax.custom_batching``). A ``vmap`` of walks
 (a batch of runs in a sweep, a batch of seeds) becomes one queue holding every run's agents over
 one set of lanes, instead of one lockstep loop per run that runs until the slowest run's slowest
-agent stops. A run whose task has ``start == goal`` adds no agent to the queue: the run loop
-gives a finished run of a batch that task, so its lanes go to the runs still going.
+agent stops. A run whose walk starts at its goal adds no agent to the queue: the run loop
+starts a finished run of a batch there, so its lanes go to the runs still going.
 
-Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs are each
-agent's visited set (same layout), slots ``i8`` and nodes ``i16`` (i32 above 32,767 nodes)
-, and the paths ``i32[A, max_steps + 1]``, written in place as agents move.
+Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs, written
+in place as agents move and stop, are each agent's visited set (same layout), its slots
+``i8[A, max_steps]`` and its path ``i32[A, max_steps + 1]``. Filling the padded outputs is most
+of a large walk's memory traffic (about 40 ms of 120 for 16,384 agents on maze100).
 """
 from __future__ import annotations
 
@@ -68,8 +69,8 @@ class Walk(NamedTuple):
     Attributes:
       path: i32[A, L] nodes visited, starting with the start node, -1 padded
         (``L = max_steps + 1``).
-      slots: i16[A, L - 1] neighbour slot of each move (``path[a, t + 1] = nbr[path[a, t], slot]``),
-        -1 after the agent stopped.
+      slots: i8[A, L - 1] (i16 on graphs of more than 127 slots) neighbour slot of each move
+        (``path[a, t + 1] = nbr[path[a, t], slot]``), -1 after the agent stopped.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
         counted by kind (:func:`jaxswarm.lattice.lattice_length`), so the same moves in any order
         give the same float; on general graphs the edge costs are summed.
