@@ -4,7 +4,9 @@ Each map is solved by ``rfd_graded`` once per seed (``--seeds``, default 20): at
 iterations, and a run stops after ``--patience`` iterations without improvement (default 30) or when every drop
 follows the same path. Runs are jitted once per map (compile excluded) and timed one by one; the
 script prints the median wall time per run next to the paper's RFD* time (C#, Intel i7-3770, one
-drop at a time), the speed-up, and how many seeds reached the optimum (relative gap < 1e-4).
+drop at a time), the speed-up, how many seeds reached the optimum (relative gap < 1e-4), the
+drops' moves per second of wall time (all iterations, settling and carving included) and the
+share of the walker's lane-steps that were moves (``busy``).
 
 Shared machines are noisy: with ``--repeats R`` the seeds of each map are timed R times over and
 the script prints the median of the R medians and their range. The runs themselves are
@@ -71,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
           f"({jax.default_backend()}, {args.threads} XLA thread(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
-          f"{'mean iterations':>16} {'range ms':>12}")
+          f"{'mean iterations':>16} {'range ms':>12} {'M moves/s':>9} {'busy':>5}")
     for name in maps:
         medians, first = [], None
         for _ in range(args.repeats):
@@ -87,7 +89,10 @@ def main(argv: list[str] | None = None) -> int:
               f"{paper_ms[name] / ours:>8.1f}x "
               f"{sum(r['success'] for r in rows):>5}/{len(rows):<2} "
               f"{statistics.mean(r['iterations'] for r in rows):>16.1f} "
-              f"{min(medians):>5.0f}-{max(medians):<6.0f}", flush=True)
+              f"{min(medians):>5.0f}-{max(medians):<6.0f} "
+              f"{sum(r['moves'] for r in rows) / sum(r['seconds'] for r in rows) / 1e6:>9.1f} "
+              f"{sum(r['moves'] for r in rows) / sum(r['lane_steps'] for r in rows):>5.2f}",
+              flush=True)
     return 0
 
 

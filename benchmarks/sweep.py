@@ -19,8 +19,9 @@ a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The 
   the first device. With ``--loop-runs N`` below the total only N runs, spread over the grid and
   the seeds, are timed and the loop's wall time is extrapolated to all runs; the output says so.
 * the speed-up (loop wall / sweep wall, compile excluded on both sides) against the goal (5x for
-  16 agents, 1.5x for 64), the peak memory against 4 GiB, and a correctness check: the sweep's
-  cost equals the loop's cost (bit for bit, float32) for every run measured in both.
+  16 agents, 1.5x for 64), the peak memory against 4 GiB, the moves per second of each (the
+  agents' moves of all runs, counted by the runs' traces), and a correctness check: the sweep's
+  cost (bit for bit, float32) and moves equal the loop's for every run measured in both.
 
 Run from the repository root::
 
@@ -122,7 +123,8 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
     def one(r: int):
         state, trace = run(swarm, jax.random.key(seeds[r % len(seeds)]), graph, task,
                            params_of(r), iterations=spec.iterations)
-        return jax.block_until_ready((swarm.best(state).cost, trace.iterations))
+        return jax.block_until_ready((swarm.best(state).cost, trace.iterations,
+                                      jnp.sum(trace.moves)))
 
     began = time.perf_counter()
     one(runs[0])  # warm-up: the loop's only compile
@@ -132,9 +134,9 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
     for r in runs:
         results[r] = one(r)
     wall = time.perf_counter() - began
-    costs = {r: np.float32(cost) for r, (cost, _) in results.items()}
-    iterations = [int(used) for _, used in results.values()]
-    return dict(costs=costs, wall=wall, compile=compile_seconds, iterations=iterations)
+    costs = {r: np.float32(cost) for r, (cost, _, _) in results.items()}
+    moves = {r: int(made) for r, (_, _, made) in results.items()}
+    return dict(costs=costs, moves=moves, wall=wall, compile=compile_seconds)
 
 
 def measure(args, agents: int) -> dict:
@@ -147,15 +149,17 @@ def measure(args, agents: int) -> dict:
     sweep = time_sweep(spec)
     runs = loop_runs(total, len(spec.grid()), len(spec.seeds), args.loop_runs)
     loop = time_loop(spec, args.map, runs)
-    sweep_costs = sweep["frame"].set_index("run")["cost"]
+    by_run = sweep["frame"].set_index("run")
     mismatches = [r for r in runs
-                  if not np.array_equal(np.float32(sweep_costs.loc[r]), loop["costs"][r])]
+                  if not np.array_equal(np.float32(by_run["cost"].loc[r]), loop["costs"][r])
+                  or by_run["moves"].loc[r] != loop["moves"][r]]
     sweep_wall = sweep["wall"] - sweep["compile"]
     loop_wall = loop["wall"] * total / len(runs)
     return dict(total=total, sweep_wall=sweep_wall, loop_wall=loop_wall,
                 compile=sweep["compile"], measured=len(runs), mismatches=mismatches,
                 quarter_rss=quarter_rss, rss=sweep["rss"],
-                iterations=float(sweep["frame"]["iterations"].mean()))
+                iterations=float(sweep["frame"]["iterations"].mean()),
+                moves=int(sweep["frame"]["moves"].sum()))
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -182,8 +186,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{args.seeds} seeds, {args.iterations} iterations, chunks of {args.chunk_size}, "
           f"groups of {args.vmap_size or 'the runner default'}")
     print(f"{'agents':>6} {'runs':>6} {'sweep s':>8} {'loop s':>8} {'speed-up':>9} {'goal':>5} "
-          f"{'compile s':>9} {'RSS 1/4 GiB':>11} {'RSS GiB':>8} {'same cost':>11} "
-          f"{'iterations':>10}", flush=True)
+          f"{'compile s':>9} {'RSS 1/4 GiB':>11} {'RSS GiB':>8} {'same result':>11} "
+          f"{'iterations':>10} {'M moves/s sweep / loop':>22}", flush=True)
     for agents in (int(part) for part in args.agents.split(",")):
         r = measure(args, agents)
         speedup = r["loop_wall"] / r["sweep_wall"]
@@ -193,7 +197,9 @@ def main(argv: list[str] | None = None) -> int:
               f"{'*' if r['measured'] < r['total'] else ' '} {speedup:>8.2f}x "
               f"{met:>5} {r['compile']:>9.1f} {r['quarter_rss'] / GiB:>11.2f} "
               f"{r['rss'] / GiB:>8.2f} {r['measured'] - len(r['mismatches']):>5}/"
-              f"{r['measured']:<5} {r['iterations']:>10.1f}", flush=True)
+              f"{r['measured']:<5} {r['iterations']:>10.1f} "
+              f"{r['moves'] / r['sweep_wall'] / 1e6:>12.2f} / {r['moves'] / r['loop_wall'] / 1e6:<7.2f}",
+              flush=True)
     print("* loop extrapolated from --loop-runs runs" if args.loop_runs else "")
     print(f"goals: speed-up {', '.join(f'{v}x at {k} agents' for k, v in GOAL_SPEEDUP.items())}; "
           f"peak memory below {GOAL_MEMORY / GiB:.0f} GiB and flat in the number of runs")

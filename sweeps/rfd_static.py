@@ -45,8 +45,9 @@ ALGORITHMS = tuple(SOURCES)
 SUCCESS_GAP = 1e-4
 """A run succeeds when its relative gap to the optimum is below this."""
 COLUMNS = ("map", "algorithm", "seed", "optimum", "cost", "gap", "success", "iterations",
-           "first_optimal_iteration", "seconds")
-"""Columns of runs.csv."""
+           "first_optimal_iteration", "seconds", "moves", "lane_steps")
+"""Columns of runs.csv (``moves``: the drops' moves in all iterations; ``lane_steps``: the
+walker's lane-steps, so ``moves / lane_steps`` is the share of its work that moved a drop)."""
 TITLE = "RFD, RFD* and RFD graded on the RFD paper's nine maps (static environment)"
 """Title of table.md."""
 ABOUT = (
@@ -84,6 +85,7 @@ def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patienc
                 if (best - optimum) / optimum < SUCCESS_GAP]
         rows.append(dict(map=name, algorithm=algorithm, seed=seed, optimum=optimum, cost=cost,
                          gap=gap, success=gap < SUCCESS_GAP, iterations=int(trace.iterations),
+                         moves=int(trace.moves.sum()), lane_steps=int(trace.lane_steps.sum()),
                          first_optimal_iteration=hits[0] if hits else "",
                          seconds=seconds))
     return rows

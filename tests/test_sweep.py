@@ -28,7 +28,8 @@ from jaxswarm.sweep.runner import group_size
 
 REPO = Path(__file__).resolve().parents[1]
 
-OUTCOME_COLUMNS = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations"]
+OUTCOME_COLUMNS = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations",
+                   "moves"]
 """What a run decides, without its timing: equal wherever and however the runs are batched."""
 
 

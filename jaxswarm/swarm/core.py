@@ -56,11 +56,16 @@ class StepInfo(NamedTuple):
       iteration_cost: f32[] cost of this iteration's best arrived agent (inf if none arrived).
       arrived: f32[] share of agents that reached the goal.
       converged: bool[] every agent arrived along one and the same path.
+      moves: i32[] moves the agents made (the useful work of the walk).
+      lane_steps: i32[] lane-steps the walk's loop executed (a batch of runs shares one loop,
+        so under ``vmap`` each run gets the batch's total).
     """
 
     iteration_cost: jax.Array
     arrived: jax.Array
     converged: jax.Array
+    moves: jax.Array
+    lane_steps: jax.Array
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -99,23 +104,29 @@ class Swarm:
 
 @dataclasses.dataclass(frozen=True)
 class Trace:
-    """Per-iteration record of a run (a pytree); entries after the stop are NaN.
+    """Per-iteration record of a run (a pytree); entries after the stop are NaN (0 for the
+    counts).
 
     Attributes:
       best_cost: f32[T] best cost found so far, after each iteration.
       iteration_cost: f32[T] cost of each iteration's best agent (inf if none arrived).
       arrived: f32[T] share of agents that reached the goal in each iteration.
       iterations: i32[] iterations actually run (<= T).
+      moves: i32[T] moves the agents made in each iteration.
+      lane_steps: i32[T] lane-steps of each iteration's walk (see :class:`StepInfo`).
     """
 
     best_cost: jax.Array
     iteration_cost: jax.Array
     arrived: jax.Array
     iterations: jax.Array
+    moves: jax.Array
+    lane_steps: jax.Array
 
 
 jax.tree_util.register_dataclass(
-    Trace, data_fields=["best_cost", "iteration_cost", "arrived", "iterations"], meta_fields=[])
+    Trace, data_fields=["best_cost", "iteration_cost", "arrived", "iterations", "moves",
+                        "lane_steps"], meta_fields=[])
 
 
 def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
@@ -158,7 +169,9 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
 def _run(swarm, key, graph, task, params, iterations, patience):
     state = swarm.init(key, graph, task, params)
     nan = jnp.full((iterations,), jnp.nan, jnp.float32)
-    trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0))
+    counts = jnp.zeros((iterations,), jnp.int32)
+    trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0),
+                  moves=counts, lane_steps=counts)
     limit = iterations if patience is None else patience
 
     def keep_going(carry):
@@ -180,7 +193,8 @@ def _run(swarm, key, graph, task, params, iterations, patience):
         trace = Trace(best_cost=trace.best_cost.at[t].set(after),
                       iteration_cost=trace.iteration_cost.at[t].set(info.iteration_cost),
                       arrived=trace.arrived.at[t].set(info.arrived),
-                      iterations=t + 1)
+                      iterations=t + 1, moves=trace.moves.at[t].set(info.moves),
+                      lane_steps=trace.lane_steps.at[t].set(info.lane_steps))
         stale = jnp.where((after < before) | ~jnp.isfinite(after), 0, stale + 1)
         return state, trace, stale, info.converged
 
@@ -248,7 +262,8 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False):
                              lambda path: jnp.array(False), walk.path)
     info = StepInfo(iteration_cost=cost,
                     arrived=jnp.mean(walk.arrived.astype(jnp.float32)),
-                    converged=all_arrived & same_path)
+                    converged=all_arrived & same_path, moves=jnp.sum(walk.moves),
+                    lane_steps=walk.lane_steps)
     return (jnp.where(better, walk.path[winner], best_path), jnp.where(better, cost, best_cost),
             info)
 
