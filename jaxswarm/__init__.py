@@ -7,7 +7,7 @@ Where things are:
   :mod:`jaxswarm.paths` (padded paths and their lengths);
 * :mod:`jaxswarm.maps` (the RFD paper's maps, seeded random maps, Moving AI files);
 * :mod:`jaxswarm.exact` (Dijkstra, A*, bidirectional A* and the batched distance field);
-* :mod:`jaxswarm.swarm` (the swarm protocol, the lockstep walker and the algorithms, by name);
+* :mod:`jaxswarm.swarm` (the swarm protocol, the walker and the algorithms, by name);
 * :mod:`jaxswarm.sweep` (parameter studies: specs, the sharded runner, the results store);
 * :mod:`jaxswarm.plot` (figures), :mod:`jaxswarm.cpu` (XLA:CPU devices and threads, set before
   JAX starts), :mod:`jaxswarm.cli` (the ``jaxswarm`` command).

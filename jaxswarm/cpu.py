@@ -2,8 +2,8 @@
 
 XLA:CPU runs a compiled program as a graph of small kernels ("thunks") on a pool of
 ``XLAEigen`` threads, one per core by default, and starts any kernel whose inputs are ready on
-whichever thread is free. A swarm iteration is thousands of tiny kernels in a row (one lockstep
-step of 256 agents is about 15 of them, each a microsecond or two), so with two threads each step
+whichever thread is free. A swarm iteration is thousands of tiny kernels in a row (one walk
+step of 256 lanes is about 15 of them, each a microsecond or two), so with two threads each step
 hands its data back and forth between the cores: in a ``perf`` profile of the maze100 walk each
 core spent about a third of its time looking for the next kernel and a quarter more in the
 runtime, allocations and thread wake-ups, against 40 % in the kernels themselves. With one

@@ -1,4 +1,4 @@
-"""Swarm planners on the graph tensors: the protocol and run loop (``core``), the lockstep walker
+"""Swarm planners on the graph tensors: the protocol and run loop (``core``), the walker
 (``walking``), the algorithms (``rfd``, ``aco``), the registry of names (``registry``:
 ``make(name, **config)``) and the conformance suite every swarm passes (``testing``)."""
 from jaxswarm.swarm.core import Swarm, Task, Trace, make_task, run

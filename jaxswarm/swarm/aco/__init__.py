@@ -1,4 +1,4 @@
-"""Ant colonies on the lockstep walker: the RFD paper's Ant System and ACO* (:mod:`.ant_system`),
+"""Ant colonies on the shared walker: the RFD paper's Ant System and ACO* (:mod:`.ant_system`),
 the Max-Min ACO paper's Max-Min ACO (:mod:`.max_min`) and Improved Max-Min ACO (:mod:`.improved`,
 with its first ant in :mod:`.bug2`), over the shared pheromone memory (:mod:`.colony`)."""
 from jaxswarm.swarm.aco.ant_system import (DEFAULT_ACO_STAR, DEFAULT_ANT_SYSTEM, ACOStarParams,
