@@ -1,6 +1,6 @@
 /* A scalar reference of jaxswarm's walk on grids: one agent at a time, the same transition
  * rule (inverse CDF over exp(log-weight - max) of the admissible slots), visited sets as bits,
- * the same counter-based uniforms (jaxswarm.swarm.walking.uniforms), so it walks the same paths.
+ * the same counter-based uniforms (jaxswarm.swarm.walking.streams.uniforms), so it walks the same paths.
  * Built and timed by benchmarks/walk.py; agents are shared out over threads with OpenMP. */
 #include <math.h>
 #include <stdint.h>

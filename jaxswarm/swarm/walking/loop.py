@@ -16,7 +16,7 @@ Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk
 batch of that many lanes.
 
 Random streams belong to agents, not lanes: agent ``a``'s ``m``-th move draws a uniform hashed
-from the walk's key, ``a`` and ``m`` (:func:`uniforms`). So neither the number of lanes, nor the
+from the walk's key, ``a`` and ``m`` (:func:`.streams.uniforms`). So neither the number of lanes, nor the
 order in which agents get one, nor batching walks together changes any walk.
 
 Batching: :func:`walk` has its own ``vmap`` rule (``jax.custom_batching``). A ``vmap`` of walks
@@ -43,6 +43,7 @@ from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.sampler import sample_masked
+from jaxswarm.swarm.walking.streams import uniforms
 
 LANES = 1024
 """Lanes of one walk loop (fewer when the walk has fewer agents). Measured on maze100 on a 2-core
@@ -62,6 +63,7 @@ any more stopped lanes wait for the next refill."""
 COMPACT_SHARE = 8
 """When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
 goes on with only them, in a batch of that many lanes."""
+
 
 class Walk(NamedTuple):
     """What a walk produced (a pytree).
@@ -103,34 +105,12 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
     return bits.union(walk.visited, num_nodes, which)
 
 
-def uniforms(seed: jax.Array, agent: jax.Array, move: jax.Array) -> jax.Array:
-    """f32[...] in [0, 1): the uniform of agent ``agent``'s move ``move`` (i32[...] each) in a
-    walk keyed by ``seed`` (u32[..., 2]).
-
-    A counter-based hash (MurmurHash3's 32-bit finaliser, twice, keyed by the two seed words),
-    so a draw depends on the agent and the move only, never on the lane that makes it; about a
-    tenth of the arithmetic of a Threefry draw.
-    """
-    counter = (agent.astype(jnp.uint32) * jnp.uint32(0x9E3779B1)) ^ move.astype(jnp.uint32)
-    mixed = _finalise(_finalise(counter ^ seed[..., 0]) ^ seed[..., 1])
-    return (mixed >> 8).astype(jnp.float32) * jnp.float32(2.0 ** -24)
-
-
-def _finalise(x: jax.Array) -> jax.Array:
-    """MurmurHash3's fmix32 on u32: every input bit flips each output bit with probability ~1/2."""
-    x = x ^ (x >> 16)
-    x = x * jnp.uint32(0x85EBCA6B)
-    x = x ^ (x >> 13)
-    x = x * jnp.uint32(0xC2B2AE35)
-    return x ^ (x >> 16)
-
-
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
          max_steps: int, greedy_agents: int = 0) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal``.
 
     Args:
-      key: PRNG key; the same key gives the same walk (see :func:`uniforms`).
+      key: PRNG key; the same key gives the same walk (see :func:`.streams.uniforms`).
       graph: the map.
       log_weights: f32[N, K] unnormalised log-probability of each edge (see
         :func:`~jaxswarm.swarm.walking.tables.edge_table`); ``-inf`` where the edge may not be
@@ -141,6 +121,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
       greedy_agents: how many agents (the first ones; static) always take their most likely
         admissible move, ties drawn at random, instead of sampling.
+
     Returns:
       A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
     """
@@ -171,15 +152,18 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int):
                          for b in in_batched)
             out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal)
             return out, jax.tree_util.tree_map(lambda _: True, out)
-        weights_b = rest_b[0]
+        weights_b, start_b, goal_b = rest_b
+
+        def fold(x, batched):
+            """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
+            if not batched:
+                x = jnp.broadcast_to(x, (axis_size,) + x.shape)
+            return x.reshape((-1,) + x.shape[2:])
+
+        seed, start, goal = fold(seed, seed_b), fold(start, start_b), fold(goal, goal_b)
         # One table for the whole batch stays one table (the walk reads it for every run).
-        shared = not weights_b and log_weights.shape[0] == 1
-        runs = (seed, log_weights, start, goal)
-        runs = [x if b or (x is log_weights and shared)
-                else jnp.broadcast_to(x, (axis_size,) + x.shape)
-                for x, b in zip(runs, [seed_b, *rest_b])]
-        folded = [x if x is runs[1] and shared else x.reshape((-1,) + x.shape[2:]) for x in runs]
-        seed, log_weights, start, goal = folded
+        if weights_b or log_weights.shape[0] > 1:
+            log_weights = fold(log_weights, weights_b)
         out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
                                      walk_runs(seed, graph, log_weights, start, goal))
         return out, jax.tree_util.tree_map(lambda _: True, out)
@@ -404,9 +388,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
     few = num_lanes // COMPACT_SHARE
 
     def keep_queueing(loop: Loop):
-        queue_left = loop.next_queued < live
-        return (queue_left | (walking_count(loop) > few)) & (queue_left
-                                                             | (walking_count(loop) > 0))
+        return (loop.next_queued < live) | (walking_count(loop) > few)
 
     loop = flush(jax.lax.while_loop(keep_queueing, lambda loop: refill(block(loop)), loop))
     if few:
