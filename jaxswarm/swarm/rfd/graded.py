@@ -43,6 +43,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.batching import one_at_a_time
 from jaxswarm.graph import Graph
 from jaxswarm.lattice import move_lengths
 from jaxswarm.relax import lowest_neighbour, relax
@@ -50,7 +51,7 @@ from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, defaul
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
-                                    neighbour_values, visited_nodes)
+                                    neighbour_slots, visited_nodes)
 
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
@@ -116,17 +117,17 @@ def graded_transition(graph: Graph, task: Task, altitude, params: GradedParams):
     bed and the uncarved plateau clipped (at least ``-climb`` out of a bed, at most ``erosion``
     into one), climbs steeper than ``climb`` on uncarved ground banned, and the goal forced
     whenever adjacent."""
-    heads, gradient = gradients(graph, altitude)
+    heads, gradient = gradients(graph, altitude)  # slot-major: [K, N]
     carved = altitude < params.initial_height
-    from_bed, into_bed = carved[:, None], neighbour_values(graph, carved)
+    from_bed, into_bed = carved, neighbour_slots(graph, carved)
     too_steep = (gradient < -params.climb) & ~from_bed
     gradient = jnp.where(from_bed, jnp.maximum(gradient, -params.climb), gradient)
     gradient = jnp.where(~from_bed & into_bed, jnp.minimum(gradient, params.erosion), gradient)
     logw = (gradient * jnp.log(params.p_base)
-            - params.alpha * goal_log_distance(graph, task.goal)[heads])
+            - params.alpha * neighbour_slots(graph, goal_log_distance(graph, task.goal)))
     logw = jnp.where(too_steep, -jnp.inf, logw)
     logw = jnp.where(heads == task.goal, FORCED, logw)
-    return edge_table(graph, logw)
+    return edge_table(graph, logw.T)
 
 
 def graded_reshape(graph: Graph, task: Task, altitude, table, drops: Walk, params: GradedParams):
@@ -142,13 +143,18 @@ def graded_reshape(graph: Graph, task: Task, altitude, table, drops: Walk, param
     return erode_banks(graph, altitude, visited_nodes(drops, n), params)
 
 
+@one_at_a_time
 def settle(graph: Graph, altitude, params: GradedParams):
     """Sediment slides into pits: f32[N] altitudes, for altitudes f32[N], after sweeps that raise
     every filled node (above ``initial_height``) to at least its lowest neighbour plus
     ``repose`` times the edge length, until no filled node is a pit (or ``SETTLE_SWEEPS`` sweeps
     have run). Then a drop on filled ground (which does not climb) always has a way down to
     unfilled ground or a bed. The result is the lowest ground at or above the given altitudes on
-    which no filled node is a pit, whatever the order of the sweeps."""
+    which no filled node is a pit, whatever the order of the sweeps.
+
+    Under ``vmap`` (a sweep) the runs settle one at a time
+    (:func:`~jaxswarm.batching.one_at_a_time`): most need one sweep, a few dozens, and settled
+    together each paid for the slowest."""
     rise = jnp.where(graph.valid_edges(), params.repose * graph.cost, jnp.inf)
 
     def raise_pits(here, lowest):  # lowest is inf for a node without edges
@@ -169,6 +175,7 @@ def erode_banks(graph: Graph, altitude, visited, params: GradedParams):
                      jnp.minimum(altitude, lowest_neighbour(graph, bed, run)), altitude)
 
 
+@one_at_a_time
 def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
     """f32[N] altitudes after every drop lowered each node of its path to ``erosion`` times the
     shortest way its walk offers from there to water: the goal, or a later node of the path
@@ -176,6 +183,7 @@ def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
 
     Works backwards over the walked part of the paths, ``CARVE_COLUMNS`` columns at a time,
     carrying per drop the length walked after the block and the best way to water found there.
+    Under ``vmap`` the runs carve one at a time, each over its own walked blocks.
     """
     n = altitude.shape[0]
     num_agents, width = drops.path.shape

@@ -50,7 +50,7 @@ from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, defaul
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, gradients,
                                       river_swarm)
-from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance
+from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, neighbour_slots
 
 EROSION_LAWS = ("linear", "exponential")
 """How ``rfd_star``'s arrived drops erode their paths: eq. 4, or its exponential form."""
@@ -137,7 +137,7 @@ def rfd_transition(graph: Graph, task: Task, altitude, params: RFDParams):
     _, gradient = gradients(graph, altitude)
     weight = jnp.where(gradient > 0, gradient,
                        jnp.where(gradient < 0, params.omega / jnp.abs(gradient), params.delta))
-    return edge_table(graph, jnp.log(weight))
+    return edge_table(graph, jnp.log(weight).T)
 
 
 def rfd_star_transition(config: RFDStarConfig, graph: Graph, task: Task, altitude,
@@ -146,11 +146,11 @@ def rfd_star_transition(config: RFDStarConfig, graph: Graph, task: Task, altitud
     * log d_j``, the goal forced whenever adjacent, and (``max_climb``) steeper climbs banned."""
     heads, gradient = gradients(graph, altitude)
     logw = (gradient * jnp.log(params.p_base)
-            - params.alpha * goal_log_distance(graph, task.goal)[heads])
+            - params.alpha * neighbour_slots(graph, goal_log_distance(graph, task.goal)))
     if config.max_climb is not None:
         logw = jnp.where(gradient < -config.max_climb, -jnp.inf, logw)
     logw = jnp.where(heads == task.goal, FORCED, logw)
-    return edge_table(graph, logw)
+    return edge_table(graph, logw.T)
 
 
 def erode_eq4(graph: Graph, altitude, drops: Walk, erosion, p_base=None):

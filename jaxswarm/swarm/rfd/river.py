@@ -16,7 +16,7 @@ import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
-from jaxswarm.swarm.walking import Walk, heads, neighbour_values, step_budget, walk
+from jaxswarm.swarm.walking import Walk, heads, neighbour_slots, step_budget, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,11 +94,12 @@ def check_greedy_drops(greedy_drops: int, num_agents: int) -> None:
 
 
 def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
-    """``(heads i32[N, K], gradient f32[N, K])``: each slot's neighbour (0 where there is none)
-    and the RFD paper's eq. 2, ``(altitude(i) - altitude(j)) / distance(i, j)``."""
-    neighbour = heads(graph)
-    drop = altitude[:, None] - neighbour_values(graph, altitude)
-    return neighbour, drop / jnp.where(graph.nbr >= 0, graph.cost, 1.0)
+    """``(heads i32[K, N], gradient f32[K, N])``, slot-major (see
+    :func:`~jaxswarm.swarm.walking.tables.neighbour_slots`; transpose the finished table once):
+    each slot's neighbour (0 where there is none) and the RFD paper's eq. 2,
+    ``(altitude(i) - altitude(j)) / distance(i, j)``."""
+    drop = altitude - neighbour_slots(graph, altitude)
+    return heads(graph).T, drop / jnp.where(graph.nbr >= 0, graph.cost, 1.0).T
 
 
 def deposit_where_stuck(altitude: jax.Array, drops: Walk, sediment) -> jax.Array:

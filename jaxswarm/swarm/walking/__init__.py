@@ -7,8 +7,8 @@ from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, STEPS_PER_REFILL,
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
-                                           neighbour_values, step_budget)
+                                           neighbour_slots, step_budget)
 
-__all__ = ["COMPACT_SHARE", "FORCED", "LANES", "STEPS_PER_REFILL", "Walk",
-           "edge_table", "goal_log_distance", "heads", "neighbour_values", "sample_masked",
+__all__ = ["COMPACT_SHARE", "FORCED", "LANES", "STEPS_PER_REFILL", "Walk", "edge_table",
+           "goal_log_distance", "heads", "neighbour_slots", "sample_masked",
            "step_budget", "uniforms", "visited_nodes", "walk"]

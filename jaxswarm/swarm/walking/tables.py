@@ -15,22 +15,22 @@ def heads(graph: Graph) -> jax.Array:
     return jnp.where(graph.nbr >= 0, graph.nbr, 0)
 
 
-def neighbour_values(graph: Graph, values: jax.Array) -> jax.Array:
-    """[N, K]: ``values[nbr[i, k]]`` of an array ``values`` [N] (any dtype), some value of the
-    array where slot k has no neighbour (mask it as :func:`heads` says).
+def neighbour_slots(graph: Graph, values: jax.Array) -> jax.Array:
+    """[K, N]: ``values[nbr[i, k]]`` of an array ``values`` [N] (any dtype), slot-major, some
+    value of the array where slot k has no neighbour (mask it as :func:`heads` says).
 
-    On grids and path maps the slots are fixed offsets, so this is K shifted slices of the
-    padded array, not a gather: under ``vmap`` over many runs' altitudes (a sweep) the gather
-    was most of the cost of a transition table.
+    On grids and path maps the slots are fixed offsets, so each row is a shifted slice of the
+    padded array, not a gather. Elementwise tables built in this layout and transposed once at
+    the end (``table.T``, f32[N, K] as the walker reads it) are several times faster on CPU than
+    built in [N, K], where every slot's slice is interleaved with the others.
     """
     if not graph.is_grid:
-        return values[heads(graph)]
+        return values[heads(graph).T]
     offsets = [int(offset) for offset in slot_offsets(graph)]
     margin = max(abs(offset) for offset in offsets)
     padded = jnp.pad(values, (margin, margin), mode="edge")
     n = graph.num_nodes
-    return jnp.stack([padded[margin + offset:margin + offset + n] for offset in offsets],
-                     axis=-1)
+    return jnp.stack([padded[margin + offset:margin + offset + n] for offset in offsets])
 
 
 def goal_log_distance(graph: Graph, goal) -> jax.Array:
