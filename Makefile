@@ -35,7 +35,8 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # 100 iterations and 256 agents; the path maps 10x10, 20x20 and 40x25 with 10 runs of populations
 # of 50 ants; the A* study on 1000 grids per size 10..100. Measured: 23 min on 2 cores (AMD EPYC,
 # shared with other work, load 1.5-4): Table 1 6.5 min, RFD table 2.8 min, path maps 0.3 min,
-# A* study 13.6 min (29 min in an earlier run under load 3-6).
+# A* study 13.6 min (29 min in an earlier run under load 3-6) with the planners of 0.3.0 in
+# plain Python; compiled (0.4.0) it took about 4 min.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256

@@ -51,8 +51,9 @@ BENCHMARKS = [
      "The batched relaxation behind `rfd_graded`'s settling and the exact distance field, on "
      "maze100."),
     ("Exact planners", "exact.py", [], ["--scenarios", "5", "--repeats", "1"],
-     "The exact planners against networkx on Moving AI maps: time per query and nodes "
-     "expanded."),
+     "The exact planners (compiled) beside pyastar2d (C++ A*) and networkx on three Moving AI "
+     "maps, one query at a time and in a batch, and D* Lite's repair after a single-cell edit "
+     "against A* from scratch."),
 ]
 """(title, script, arguments, quick arguments, what it measures) of each section."""
 

@@ -7,12 +7,13 @@ import pytest
 import scipy.sparse.csgraph as csgraph
 
 import oracle
-from jaxswarm.exact import astar, bidirectional_astar, dijkstra, distance_field, optimum
+from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
+                            distance_field, optimum)
 from jaxswarm.graph import dense_graph, grid_graph, path_map_graph
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.paths import is_valid_path, path_length
 
-PLANNERS = [dijkstra, astar, bidirectional_astar]
+PLANNERS = [dijkstra, astar, bidirectional_astar, balanced_bidirectional_astar]
 
 
 def check_solution(graph, solution, source, target, expected):
@@ -63,7 +64,8 @@ def test_directed_general_graphs_match_oracle_and_scipy(seed, planner):
         check_solution(graph, planner(graph, int(source), int(target)), source, target, expected)
 
 
-@pytest.mark.parametrize("planner", [astar, bidirectional_astar], ids=lambda p: p.__name__)
+@pytest.mark.parametrize("planner", [astar, bidirectional_astar, balanced_bidirectional_astar],
+                         ids=lambda p: p.__name__)
 def test_euclidean_heuristic_on_geometric_graph_is_optimal(planner):
     rng = np.random.default_rng(7)
     n = 60
@@ -101,7 +103,7 @@ def test_unreachable_goal_is_not_found_and_no_exception():
         # A one-sided search proves the goal unreachable by expanding the start's whole
         # component (the 10 cells left of the wall); a two-sided one stops as soon as one side
         # runs out, having expanded at most both components.
-        if planner is bidirectional_astar:
+        if planner in (bidirectional_astar, balanced_bidirectional_astar):
             assert 10 <= solution.stats.expanded <= 20
         else:
             assert solution.stats.expanded == 10

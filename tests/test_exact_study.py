@@ -17,7 +17,7 @@ from repo_scripts import load_script
 
 SIZES = (10, 15)
 GRIDS = 3
-PLANNERS = ("dijkstra", "astar", "bidirectional_astar")
+PLANNERS = ("dijkstra", "astar", "bidirectional_astar", "balanced_bidirectional_astar")
 
 study = load_script("sweeps/exact_study.py")
 

@@ -5,10 +5,18 @@ import numpy as np
 import pytest
 
 from conftest import MOVINGAI
-from jaxswarm.exact import astar, bidirectional_astar, dijkstra
+from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
+                            reference, replanner, shortest_lengths)
 from jaxswarm.maps.movingai import MovingAIFormatError, load_map, load_scenarios, read_map
 
-PLANNERS = [dijkstra, astar, bidirectional_astar]
+
+def dstar_lite(graph, start, goal):
+    return replanner(graph, start, goal).solve()
+
+
+PLANNERS = [dijkstra, astar, bidirectional_astar, balanced_bidirectional_astar, dstar_lite]
+REFERENCE_PLANNERS = [reference.dijkstra, reference.astar, reference.bidirectional_astar,
+                      reference.balanced_bidirectional_astar]
 DEFAULT_SAMPLE = 8  # rows per scenario file in the default run; the slow test takes them all
 
 
@@ -22,12 +30,22 @@ def map_of(scen_path, scenarios):
     return load_map(scen_path.parent / scenarios[0].map_name.split("/")[-1])
 
 
-def check_rows(scen_path, every):
+def check_rows(scen_path, every, planners=PLANNERS):
+    """Every ``every``-th row of a scenario file solved by each planner, and all of them by one
+    batch: the published optimum (or no path); returns the (row, planner) answers checked."""
     scenarios = load_scenarios(scen_path)
     graph = map_of(scen_path, scenarios)
+    rows = scenarios[::every]
+    batch = shortest_lengths(graph, np.array([row.start for row in rows]),
+                             np.array([row.goal for row in rows]))
+    for row, cost, found in zip(rows, batch.cost, batch.found):
+        assert found == row.reachable, (scen_path.name, row.line, "shortest_lengths")
+        if found:
+            error = abs(cost - row.optimal_length) / max(row.optimal_length, 1.0)
+            assert error < 1e-4, (scen_path.name, row.line, "shortest_lengths", cost)
     checked = 0
-    for row in scenarios[::every]:
-        for planner in PLANNERS:
+    for row in rows:
+        for planner in planners:
             solution = planner(graph, row.start, row.goal)
             if not row.reachable:
                 assert not solution.found, (scen_path.name, row.line, planner.__name__)
@@ -41,7 +59,8 @@ def check_rows(scen_path, every):
 def test_sample_of_every_scenario_file_has_published_optimum(movingai_dir):
     for scen in scenario_files(movingai_dir):
         rows = len(load_scenarios(scen))
-        assert check_rows(scen, every=max(1, rows // DEFAULT_SAMPLE)) > 0
+        every = max(1, rows // DEFAULT_SAMPLE)
+        assert check_rows(scen, every=every, planners=PLANNERS + REFERENCE_PLANNERS) > 0
 
 
 # Without the data folder the list would be empty and the slow test silently skipped: one
@@ -55,7 +74,7 @@ SCENARIO_FILES = sorted(p.relative_to(MOVINGAI).as_posix()
 def test_every_scenario_row_has_published_optimum(movingai_dir, name):
     rows = load_scenarios(movingai_dir / name)
     reachable = sum(row.reachable for row in rows)
-    assert check_rows(movingai_dir / name, every=1) == 3 * reachable
+    assert check_rows(movingai_dir / name, every=1) == len(PLANNERS) * reachable
 
 
 def test_load_map_passes_grid_options(movingai_dir):

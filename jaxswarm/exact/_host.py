@@ -1,8 +1,8 @@
-"""Host-side adjacency lists of a Graph, cached per Graph object, for the heapq planners.
+"""Host-side forms of a Graph for the exact planners, cached per Graph object.
 
-The exact planners are plain Python over lists (the fastest way to walk a heap on CPU); this
-module turns the padded tensors into successor and predecessor lists once per map. Graphs are
-immutable and compare by identity, so an edit (which returns a new Graph) is a new cache entry.
+The compiled planners read :class:`EdgeArrays` (CSR arrays of the valid edges); the readable heapq planners of :mod:`jaxswarm.exact.reference` read :class:`HostGraph` (Python lists
+of the valid edges). Graphs are immutable and compare by identity, so an edit (which returns a
+new Graph) is a new cache entry.
 """
 from __future__ import annotations
 
@@ -37,20 +37,70 @@ class HostGraph:
     is_grid: bool
 
 
-_CACHE: "weakref.WeakKeyDictionary[Graph, HostGraph]" = weakref.WeakKeyDictionary()
+@dataclasses.dataclass(frozen=True, eq=False)
+class EdgeArrays:
+    """The valid edges of a Graph as CSR arrays, for the compiled planners.
+
+    Attributes:
+      indptr: i64[N + 1]; the edges out of ``u`` are ``indptr[u]:indptr[u + 1]``, in slot order.
+      heads: i32[E] each edge's head.
+      lengths: f64[E] each edge's length.
+      rev_indptr: i64[N + 1]; the edges into ``v`` are ``rev_indptr[v]:rev_indptr[v + 1]``.
+      rev_tails: i32[E] their tails.
+      rev_edge: i64[E] their index into ``heads`` and ``lengths``.
+      rev_lengths: f64[E] their lengths (``lengths[rev_edge]``).
+      x, y: f64[N] node coordinates.
+      free: bool[N] passable nodes.
+    """
+
+    indptr: np.ndarray
+    heads: np.ndarray
+    lengths: np.ndarray
+    rev_indptr: np.ndarray
+    rev_tails: np.ndarray
+    rev_edge: np.ndarray
+    rev_lengths: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    free: np.ndarray
+
+    @property
+    def num_nodes(self) -> int:
+        return self.indptr.shape[0] - 1
+
+
+_HOST: "weakref.WeakKeyDictionary[Graph, HostGraph]" = weakref.WeakKeyDictionary()
+_ARRAYS: "weakref.WeakKeyDictionary[Graph, EdgeArrays]" = weakref.WeakKeyDictionary()
 
 
 def host_graph(graph: Graph) -> HostGraph:
     """The cached HostGraph of ``graph`` (built on first use, O(N K))."""
-    cached = _CACHE.get(graph)
+    cached = _HOST.get(graph)
     if cached is None:
-        cached = _CACHE[graph] = _build(graph)
+        arrays = edge_arrays(graph)
+        rows = np.repeat(np.arange(arrays.num_nodes), np.diff(arrays.indptr))
+        heads, lengths = arrays.heads, arrays.lengths
+        n = graph.num_nodes
+        order = np.argsort(heads, kind="stable")
+        cached = _HOST[graph] = HostGraph(
+            succ=_group(rows, heads, lengths, n),
+            pred=_group(heads[order], rows[order], lengths[order], n),
+            x=arrays.x.tolist(), y=arrays.y.tolist(), free=arrays.free,
+            is_grid=graph.is_grid)
     return cached
 
 
-def _build(graph: Graph) -> HostGraph:
-    valid = np.asarray(graph.valid_edges())
+def edge_arrays(graph: Graph) -> EdgeArrays:
+    """The cached EdgeArrays of ``graph`` (built on first use, O(N K))."""
+    cached = _ARRAYS.get(graph)
+    if cached is None:
+        cached = _ARRAYS[graph] = _build_arrays(graph)
+    return cached
+
+
+def _build_arrays(graph: Graph) -> EdgeArrays:
     nbr = np.asarray(graph.nbr)
+    valid = np.asarray(graph.valid_edges())
     xy = np.asarray(graph.xy, dtype=np.float64)
     rows, slots = np.nonzero(valid)
     heads = nbr[rows, slots]
@@ -61,11 +111,17 @@ def _build(graph: Graph) -> HostGraph:
     else:
         lengths = np.asarray(graph.cost, dtype=np.float64)[rows, slots]
     n = graph.num_nodes
-    succ = _group(rows, heads, lengths, n)
     order = np.argsort(heads, kind="stable")
-    pred = _group(heads[order], rows[order], lengths[order], n)
-    return HostGraph(succ=succ, pred=pred, x=xy[:, 0].tolist(), y=xy[:, 1].tolist(),
-                     free=np.asarray(graph.free), is_grid=graph.is_grid)
+    return EdgeArrays(indptr=_indptr(rows, n), heads=heads.astype(np.int32), lengths=lengths,
+                      rev_indptr=_indptr(heads[order], n),
+                      rev_tails=rows[order].astype(np.int32), rev_edge=order.astype(np.int64),
+                      rev_lengths=lengths[order],
+                      x=np.ascontiguousarray(xy[:, 0]), y=np.ascontiguousarray(xy[:, 1]),
+                      free=np.asarray(graph.free))
+
+
+def _indptr(sorted_keys: np.ndarray, n: int) -> np.ndarray:
+    return np.searchsorted(sorted_keys, np.arange(n + 1)).astype(np.int64)
 
 
 def _group(keys: np.ndarray, values: np.ndarray, lengths: np.ndarray, n: int) -> list:
@@ -73,6 +129,13 @@ def _group(keys: np.ndarray, values: np.ndarray, lengths: np.ndarray, n: int) ->
     pairs = list(zip(values.tolist(), lengths.tolist()))
     bounds = np.searchsorted(keys, np.arange(n + 1)).tolist()
     return [pairs[bounds[i]:bounds[i + 1]] for i in range(n)]
+
+
+def default_heuristic(graph: Graph, kind: str | None) -> str:
+    """The heuristic a planner uses: ``kind``, or octile on grids and euclidean otherwise."""
+    if kind is None:
+        return "octile" if graph.is_grid else "euclidean"
+    return kind
 
 
 def heuristic(kind: str, host: HostGraph, target: int):
@@ -88,7 +151,10 @@ def heuristic(kind: str, host: HostGraph, target: int):
     if kind == "zero":
         return lambda v: 0.0
     if kind == "euclidean":
-        return lambda v: math.hypot(xs[v] - tx, ys[v] - ty)
+        def euclidean(v):  # the compiled planners' very floats (not math.hypot's)
+            dx, dy = xs[v] - tx, ys[v] - ty
+            return math.sqrt(dx * dx + dy * dy)
+        return euclidean
     if kind == "octile":
         diagonal_extra = SQRT2 - 1.0
 
@@ -96,4 +162,19 @@ def heuristic(kind: str, host: HostGraph, target: int):
             dx, dy = abs(xs[v] - tx), abs(ys[v] - ty)
             return dx + diagonal_extra * dy if dx > dy else dy + diagonal_extra * dx
         return octile
-    raise ValueError(f"unknown heuristic {kind!r}: choose 'octile', 'euclidean' or 'zero'")
+    raise _unknown(kind)
+
+
+HEURISTIC_CODES = {"zero": 0, "euclidean": 1, "octile": 2}
+"""The compiled planners' heuristic codes (:mod:`jaxswarm.exact.kernels`)."""
+
+
+def heuristic_code(kind: str) -> int:
+    """The kernels' code of a heuristic name (see :func:`heuristic`)."""
+    if kind not in HEURISTIC_CODES:
+        raise _unknown(kind)
+    return HEURISTIC_CODES[kind]
+
+
+def _unknown(kind) -> ValueError:
+    return ValueError(f"unknown heuristic {kind!r}: choose 'octile', 'euclidean' or 'zero'")

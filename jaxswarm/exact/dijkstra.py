@@ -1,7 +1,7 @@
 """Dijkstra's algorithm (best-first search by path cost, stopping when the goal is settled)."""
 from __future__ import annotations
 
-from jaxswarm.exact.best_first import search
+from jaxswarm.exact.search import best_first_search
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, path_length
 
@@ -22,7 +22,7 @@ def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Soluti
     Raises:
       ValueError: start or goal off the map or blocked.
     """
-    return search(graph, start, goal, heuristic_kind="zero", max_len=max_len)
+    return best_first_search(graph, start, goal, heuristic="zero", max_len=max_len)
 
 
 def optimal_length(graph: Graph, start, goal) -> float:

@@ -14,21 +14,25 @@ class SearchStats:
     """What one exact search did.
 
     Attributes:
-      iterations: main-loop iterations (priority-queue pops, stale entries included).
+      iterations: main-loop iterations (priority-queue pops; the compiled planners re-key a
+        queued node in place, so they pop no stale entries, the heapq reference planners do).
       expanded: nodes expanded (successors generated); counts both directions for bidirectional A*.
       generated: nodes pushed onto a priority queue (successful relaxations plus the roots).
       wall_time: seconds spent in the search (adjacency caching excluded).
+      touched: D* Lite only (else None): nodes whose labels the call set or changed; after an
+        edit, how far the repair reached.
     """
 
     iterations: int
     expanded: int
     generated: int
     wall_time: float
+    touched: int | None = None
 
 
 jax.tree_util.register_dataclass(
-    SearchStats, data_fields=["iterations", "expanded", "generated", "wall_time"], meta_fields=[]
-)
+    SearchStats, data_fields=["iterations", "expanded", "generated", "wall_time", "touched"],
+    meta_fields=[])
 
 
 def make_solution(nodes: list[int] | None, cost: float, stats: SearchStats,
