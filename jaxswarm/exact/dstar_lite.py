@@ -183,7 +183,8 @@ class DStarLite:
 class _Structure:
     """Every lattice edge of a map (valid or not) as CSR arrays in slot order, cached per Graph:
     ``edge[i, k]`` is slot k's edge index (-1 without neighbour), ``lengths`` f64[E] each edge's
-    length, ``valid`` bool[N, K] the graph's valid edges."""
+    length, ``valid`` bool[N, K] the graph's valid edges and ``cost`` f64[E] the lengths of the
+    valid ones, ``inf`` elsewhere (a planner's starting costs)."""
 
     indptr: np.ndarray
     heads: np.ndarray
@@ -196,6 +197,7 @@ class _Structure:
     y: np.ndarray
     nbr: np.ndarray
     valid: np.ndarray
+    cost: np.ndarray
 
 
 _STRUCTURES: "weakref.WeakKeyDictionary[Graph, _Structure]" = weakref.WeakKeyDictionary()
@@ -217,13 +219,14 @@ def _structure(graph: Graph) -> _Structure:
     edge = np.full(nbr.shape, -1, np.int64)
     edge[rows, slots] = np.arange(rows.shape[0])
     order = np.argsort(heads, kind="stable")
+    valid = np.asarray(graph.valid_edges())
     cached = _STRUCTURES[graph] = _Structure(
         indptr=np.searchsorted(rows, np.arange(n + 1)).astype(np.int64),
         heads=heads.astype(np.int32),
         rev_indptr=np.searchsorted(heads[order], np.arange(n + 1)).astype(np.int64),
         rev_tails=rows[order].astype(np.int32), rev_edge=order.astype(np.int64), edge=edge,
         lengths=lengths, x=np.ascontiguousarray(xy[:, 0]), y=np.ascontiguousarray(xy[:, 1]),
-        nbr=nbr, valid=np.asarray(graph.valid_edges()))
+        nbr=nbr, valid=valid, cost=np.where(valid[rows, slots], lengths, np.inf))
     return cached
 
 
@@ -237,7 +240,7 @@ class _Lattice:
         self.structure = structure
         self.x, self.y = structure.x, structure.y
         self.valid = structure.valid
-        self.cost = np.where(structure.valid[structure.edge >= 0], structure.lengths, np.inf)
+        self.cost = structure.cost.copy()
 
     def check_same_map(self, graph: Graph) -> None:
         if graph.nbr is self.source.nbr:  # an edit (jaxswarm.edits) keeps the lattice's array
