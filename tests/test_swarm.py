@@ -356,7 +356,8 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
 
     return Swarm(name="late", config=None, init=init, step=step, best=best,
                  default_params=None, check_params=lambda params: None,
-                 memory=lambda state: jnp.zeros(1), memory_label="")
+                 memory=lambda state: jnp.zeros(1), memory_label="",
+                 adapt=lambda state, *_: state)
 
 
 @pytest.mark.parametrize("name", ["rfd_star", "ant_system"])

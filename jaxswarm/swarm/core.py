@@ -89,6 +89,9 @@ class Swarm:
       memory: ``(state) -> f32[N]``: the swarm's memory per node (altitude, pheromone), for
         figures and for inspecting what persists between iterations.
       memory_label: what ``memory`` shows, for colorbars.
+      adapt: ``(state, before, after, old_task, new_task, params) -> State``: the memory rule of
+        a change of the map (``before`` to ``after``) or the task (see
+        :func:`jaxswarm.dynamic.change`); each family documents its own.
     """
 
     name: str
@@ -100,6 +103,7 @@ class Swarm:
     check_params: Callable
     memory: Callable
     memory_label: str
+    adapt: Callable
 
 
 @dataclasses.dataclass(frozen=True)
@@ -130,8 +134,8 @@ jax.tree_util.register_dataclass(
 
 
 def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
-        iterations: int = 100, patience: int | None = None):
-    """Iterate a swarm until a stop condition holds.
+        iterations: int = 100, patience: int | None = None, state=None):
+    """Iterate a swarm until a stop condition holds, from fresh memory or from ``state``.
 
     Stops after ``iterations`` iterations, or when the best cost has not improved for ``patience``
     iterations (if given) since a first path was found, or when every agent of an iteration
@@ -149,6 +153,10 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
       iterations: the iteration budget T (static).
       patience: stop after this many iterations without improvement of a path found
         (static; None = never).
+      state: a State to continue from (the memory of an earlier run, after
+        :func:`jaxswarm.dynamic.change` when the map or the task changed); its key is replaced
+        by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
+        iteration count and the patience count start again either way.
 
     Returns:
       ``(state, trace)``: the final State and a :class:`Trace`.
@@ -162,12 +170,15 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
         raise ValueError(f"patience must be at least 1, got {patience}")
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
-    return _run(swarm, key, graph, task, params, iterations, patience)
+    return _run(swarm, key, graph, task, params, iterations, patience, state)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 5, 6))
-def _run(swarm, key, graph, task, params, iterations, patience):
-    state = swarm.init(key, graph, task, params)
+def _run(swarm, key, graph, task, params, iterations, patience, state):
+    if state is None:
+        state = swarm.init(key, graph, task, params)
+    else:
+        state = dataclasses.replace(state, key=key)
     nan = jnp.full((iterations,), jnp.nan, jnp.float32)
     counts = jnp.zeros((iterations,), jnp.int32)
     trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0),

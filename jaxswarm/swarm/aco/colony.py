@@ -51,6 +51,16 @@ jax.tree_util.register_dataclass(
     ACOState, data_fields=["key", "pheromone", "best_path", "best_cost"], meta_fields=[])
 
 
+def pheromone_rule(state: ACOState, before: Graph, after: Graph, old: Task, new: Task,
+                   params) -> ACOState:
+    """The ant colonies' memory rule for a change of the map or the goal: pheromone kept on every
+    edge; an edge valid now that was not before (a cell or passage opened) starts at ``tau0``, as
+    every edge did at the start."""
+    new_edges = after.valid_edges() & ~before.valid_edges()
+    return dataclasses.replace(state, pheromone=jnp.where(new_edges, params.tau0,
+                                                          state.pheromone))
+
+
 def transition_rule(graph: Graph, task: Task, pheromone, params, *, direction: bool = False,
                     goal_distance: bool = False, beta=None):
     """f32[N, K] log-weight table ``alpha log tau + beta log eta (- alpha_goal log d_j)``.
@@ -142,7 +152,7 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=default_params, check_params=check_params,
                  memory=lambda state: state.pheromone.sum(axis=-1),
-                 memory_label="pheromone on a node's edges")
+                 memory_label="pheromone on a node's edges", adapt=pheromone_rule)
 
 
 _RULES = {"rho": "positive", "q": "positive", "alpha": "non-negative", "beta": "non-negative",

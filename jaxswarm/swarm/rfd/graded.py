@@ -44,12 +44,13 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.batching import one_at_a_time
+from jaxswarm.exact.field import distance_field
 from jaxswarm.graph import Graph
 from jaxswarm.lattice import move_lengths
 from jaxswarm.relax import lowest_neighbour, relax
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import check_greedy_drops, gradients, river_swarm
+from jaxswarm.swarm.rfd.river import RFDState, check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
                                     neighbour_slots, visited_nodes)
 
@@ -218,6 +219,31 @@ def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
     return carved
 
 
+def regrade(state: RFDState, before: Graph, after: Graph, old: Task, new: Task,
+            params: GradedParams) -> RFDState:
+    """``rfd_graded``'s memory rule for a change of the map or the goal: every bed keeps only the
+    depth it can still justify, ``erosion`` times its shortest way to the (new) goal over carved
+    ground that is still passable; a bed cut off from the goal returns to the plateau
+    (``initial_height``), as does a newly opened node; filled ground keeps its altitude, and the
+    new goal is 0.
+
+    Why not the paper's rule: a carved altitude is a promise (``E`` times a walked way to the
+    goal), and drops trust it (a drop on the plateau sees any bed as a way down). After a block
+    or a goal move a bed may promise a way that no longer exists: kept as it is, it draws the
+    drops into the cut river, and nothing in the law raises carved ground again. Re-measured on
+    the new map (:func:`~jaxswarm.exact.field.distance_field` over carved ground), the beds that
+    still lead to the goal keep guiding the drops, and no bed lies.
+    """
+    altitude = state.altitude
+    carved = (altitude < params.initial_height) | (jnp.arange(altitude.shape[0]) == new.goal)
+    beds = dataclasses.replace(after, free=after.free & carved)
+    way = distance_field(beds, new.goal)
+    altitude = jnp.where(carved, jnp.where(jnp.isfinite(way), params.erosion * way,
+                                           params.initial_height), altitude)
+    altitude = jnp.where(after.free & ~before.free, params.initial_height, altitude)
+    return dataclasses.replace(state, altitude=altitude.at[new.goal].set(0.0))
+
+
 def _check_graded(params: GradedParams) -> None:
     check_positive("p_base", params.p_base)
     check_positive("alpha", params.alpha, allow_zero=True)
@@ -232,4 +258,4 @@ def build_rfd_graded(config: GradedConfig) -> Swarm:
     """This project's river formation law (see the module docstring), with :class:`GradedParams`."""
     return river_swarm("rfd_graded", config, transition=graded_transition,
                        reshape=graded_reshape, greedy_drops=config.greedy_drops,
-                       default_params=DEFAULT_GRADED, check_params=_check_graded)
+                       default_params=DEFAULT_GRADED, check_params=_check_graded, adapt=regrade)

@@ -48,7 +48,7 @@ after one iteration's erosion and sediment."""
 
 
 def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
-                greedy_drops: int, default_params, check_params) -> Swarm:
+                greedy_drops: int, default_params, check_params, adapt=None) -> Swarm:
     """A river formation Swarm from its transition rule and its altitude update.
 
     Args:
@@ -59,6 +59,8 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
       greedy_drops: how many drops (the first ones) take their most likely move.
       default_params: the variant's default Params.
       check_params: host-side Params check.
+      adapt: the memory rule of a change (``Swarm.adapt``); default
+        :func:`paper_altitude_rule`.
     """
     def init(key, graph: Graph, task: Task, params) -> RFDState:
         altitude = jnp.full((graph.num_nodes,), params.initial_height,
@@ -83,7 +85,23 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
 
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=default_params, check_params=check_params,
-                 memory=lambda state: state.altitude, memory_label="altitude")
+                 memory=lambda state: state.altitude, memory_label="altitude",
+                 adapt=paper_altitude_rule if adapt is None else adapt)
+
+
+def paper_altitude_rule(state: RFDState, before: Graph, after: Graph, old: Task, new: Task,
+                        params) -> RFDState:
+    """The RFD paper's memory rule for a change of the map or the goal (RFD and RFD*): the old
+    goal takes the mean altitude of its neighbours (those it has a valid edge to on the new map),
+    the new goal 0, a newly opened node ``initial_height``; every other altitude is kept."""
+    altitude = state.altitude
+    valid = after.valid_edges()[old.goal]
+    around = jnp.where(valid, altitude[jnp.maximum(after.nbr[old.goal], 0)], 0.0)
+    mean = jnp.sum(around) / jnp.maximum(jnp.sum(valid), 1)
+    altitude = altitude.at[old.goal].set(jnp.where(new.goal != old.goal, mean,
+                                                   altitude[old.goal]))
+    altitude = jnp.where(after.free & ~before.free, params.initial_height, altitude)
+    return dataclasses.replace(state, altitude=altitude.at[new.goal].set(0.0))
 
 
 def check_greedy_drops(greedy_drops: int, num_agents: int) -> None:

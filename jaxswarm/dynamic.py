@@ -1,0 +1,142 @@
+"""Changes of the map or the task during a run, and what a swarm's memory does about them.
+
+An :class:`Event` is data (node indices, -1 for "none"), so the same compiled program applies any
+event of the same size, and a batch of events vmaps::
+
+    event = make_event(graph, goal=(19, 17), block=[(5, 5), (5, 6)])
+    state, graph, task = change(swarm, state, event, graph, task, params)  # memory kept
+    state, trace = run(swarm, key, graph, task, params, state=state)     # continue from it
+
+:func:`change` applies the event to the map and the task (:func:`apply_event`), then the swarm's
+memory rule (``Swarm.adapt``, documented per swarm family: the RFD paper's
+:func:`jaxswarm.swarm.rfd.river.paper_altitude_rule`, ``rfd_graded``'s
+:func:`jaxswarm.swarm.rfd.graded.regrade` and the ant colonies'
+:func:`jaxswarm.swarm.aco.colony.pheromone_rule`), then forgets a best path the event made
+invalid (:func:`forget_invalid_best`). Continuing with ``run(..., state=...)``
+restarts the patience count.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.edits import block_cells, unblock_cells
+from jaxswarm.graph import Graph
+from jaxswarm.paths import as_node, is_valid_path
+from jaxswarm.swarm.core import Swarm, Task
+
+NO_NODE = -1
+
+
+class Event(NamedTuple):
+    """One change (a pytree; stack events of equal sizes for a batch).
+
+    Attributes:
+      start: i32[] the new start (the robot moved), -1: unchanged.
+      goal: i32[] the new goal, -1: unchanged.
+      block: i32[M] nodes that become obstacles, -1 padded.
+      unblock: i32[M'] nodes that become free, -1 padded.
+      num_nodes: i32[] the node count of the map the event was made for.
+    """
+
+    start: jax.Array
+    goal: jax.Array
+    block: jax.Array
+    unblock: jax.Array
+    num_nodes: jax.Array
+
+
+def make_event(graph: Graph, *, start=None, goal=None, block=(), unblock=(),
+               size: int | None = None) -> Event:
+    """Host-side: an Event for ``graph``, points as (x, y) cells or node indices.
+
+    Args:
+      graph: the map the event is for.
+      start, goal: the new start or goal (None: unchanged).
+      block, unblock: cells that become obstacles, or free.
+      size: pad ``block`` and ``unblock`` to this length (events of one batch must agree).
+
+    Raises:
+      ValueError: a point off the map; more cells than ``size``.
+    """
+    def nodes(points, name):
+        indices = [as_node(graph, p, name=name, require_free=False) for p in points]
+        length = len(indices) if size is None else size
+        if len(indices) > length:
+            raise ValueError(f"{name}: {len(indices)} cells do not fit size={size}")
+        return jnp.asarray(indices + [NO_NODE] * (length - len(indices)), jnp.int32)
+
+    def node(point, name):
+        return NO_NODE if point is None else as_node(graph, point, name=name,
+                                                     require_free=False)
+
+    return Event(start=jnp.int32(node(start, "start")), goal=jnp.int32(node(goal, "goal")),
+                 block=nodes(block, "block"), unblock=nodes(unblock, "unblock"),
+                 num_nodes=jnp.int32(graph.num_nodes))
+
+
+def check_events(graph: Graph, task: Task, events: Event) -> None:
+    """Host-side: raise ValueError naming the first bad event (of a single Event or a stacked
+    batch) before anything is applied: made for a map of another size, a node off the map, a
+    start or goal moved onto an obstacle, or a start or goal blocked by the event."""
+    leaves = jax.tree_util.tree_map(np.asarray, events)
+    batched = leaves.start.ndim == 1
+    count = leaves.start.shape[0] if batched else 1
+    n = graph.num_nodes
+    free = np.asarray(graph.free)
+    for i in range(count):
+        e = jax.tree_util.tree_map(lambda x, i=i: x[i], leaves) if batched else leaves
+        name = f"event {i}" if batched else "event"
+        if int(e.num_nodes) != n:
+            raise ValueError(f"{name} was made for a map of {int(e.num_nodes)} nodes; this map "
+                             f"has {n}")
+        for field in ("start", "goal", "block", "unblock"):
+            values = np.atleast_1d(getattr(e, field))
+            off = (values != NO_NODE) & ((values < 0) | (values >= n))
+            if off.any():
+                raise ValueError(f"{name}: {field} node {int(values[off][0])} is off the map "
+                                 f"(nodes 0..{n - 1})")
+        after = free.copy()
+        after[e.block[e.block >= 0]] = False
+        after[e.unblock[e.unblock >= 0]] = True
+        for field, old in (("start", int(task.start)), ("goal", int(task.goal))):
+            moved = int(getattr(e, field))
+            node = old if moved == NO_NODE else moved
+            if not after[node]:
+                what = "moves onto an obstacle" if moved != NO_NODE else "is blocked"
+                raise ValueError(f"{name}: the {field} (node {node}) {what}")
+
+
+def apply_event(event: Event, graph: Graph, task: Task) -> tuple[Graph, Task]:
+    """The map and the task after ``event`` (jittable; shapes unchanged). Cells are blocked
+    first, then unblocked."""
+    n = graph.num_nodes
+    graph = block_cells(graph, jnp.where(event.block >= 0, event.block, n))
+    graph = unblock_cells(graph, jnp.where(event.unblock >= 0, event.unblock, n))
+    task = Task(start=jnp.where(event.start >= 0, event.start, task.start),
+                goal=jnp.where(event.goal >= 0, event.goal, task.goal))
+    return graph, task
+
+
+def change(swarm: Swarm, state, event: Event, graph: Graph, task: Task, params):
+    """Apply ``event``: ``(state, graph, task)`` after it, the swarm's memory adapted by its rule
+    and a best path the event made invalid forgotten (jittable, vmappable over events).
+
+    Check events on the host first (:func:`check_events`); :func:`run` does not."""
+    after, new_task = apply_event(event, graph, task)
+    state = swarm.adapt(state, graph, after, task, new_task, params)
+    return forget_invalid_best(state, after, new_task), after, new_task
+
+
+def forget_invalid_best(state, graph: Graph, task: Task):
+    """``state`` without its best path if that path is no longer a path from the start to the
+    goal on ``graph`` (it crosses a blocked cell or edge, or ends at an old goal): its cost is
+    forgotten too (inf), so the swarm's next arrived agent becomes the best."""
+    valid = is_valid_path(graph, state.best_path, task.start, task.goal)
+    return dataclasses.replace(
+        state, best_path=jnp.where(valid, state.best_path, NO_NODE),
+        best_cost=jnp.where(valid, state.best_cost, jnp.inf))
