@@ -1,7 +1,12 @@
-"""Random test maps shared by the exact-planner tests."""
+"""Maps and swarm states shared by several test modules."""
+from typing import NamedTuple
+
+import jax
 import numpy as np
 
 from jaxswarm.graph import dense_graph
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.swarm import make, make_task, run
 
 
 def geometric_graph(rng, n: int, *, radius: float, density: float, stretch: tuple[float, float]):
@@ -13,3 +18,27 @@ def geometric_graph(rng, n: int, *, radius: float, density: float, stretch: tupl
     weights = np.where((span < radius) & (rng.random((n, n)) < density),
                        span * rng.uniform(*stretch, (n, n)), 0.0)
     return dense_graph(weights, xy=xy)
+
+
+class Solved(NamedTuple):
+    """A paper map, its graph and task, a swarm, its default params and a state after a run."""
+
+    chosen: object
+    graph: object
+    task: object
+    swarm: object
+    params: object
+    state: object
+
+
+def solved_paper_map(name: str, swarm_name: str, *, agents: int, iterations: int,
+                     seed: int = 0) -> Solved:
+    """``swarm_name`` with ``agents`` agents run for ``iterations`` on paper map ``name`` from
+    ``jax.random.key(seed)``."""
+    chosen = paper_map(name)
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    swarm = make(swarm_name, num_agents=agents)
+    state, _ = run(swarm, jax.random.key(seed), graph, task, swarm.default_params,
+                   iterations=iterations)
+    return Solved(chosen, graph, task, swarm, swarm.default_params, state)

@@ -7,9 +7,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from graphs import solved_paper_map
 from jaxswarm.dynamic import apply_event, change, check_events, make_event
 from jaxswarm.graph import grid_graph
-from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import _run
 
@@ -111,12 +111,8 @@ def test_invalid_best_path_is_forgotten_and_a_valid_one_kept():
 
 
 def test_vmap_over_events_equals_a_loop():
-    chosen = paper_map("mosaic20")
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("rfd_graded", num_agents=16)
-    params = swarm.default_params
-    state, _ = run(swarm, jax.random.key(1), graph, task, params, iterations=10)
+    _, graph, task, swarm, params, state = solved_paper_map("mosaic20", "rfd_graded",
+                                                             agents=16, iterations=10, seed=1)
     free = np.nonzero(np.asarray(graph.free))[0]
     events = [make_event(graph, goal=int(free[i]), block=[int(free[i + 50])], size=1)
               for i in (40, 120, 200)]
@@ -133,12 +129,8 @@ def test_vmap_over_events_equals_a_loop():
 
 
 def test_continuing_uses_the_given_key_and_events_do_not_recompile():
-    chosen = paper_map("maze20")
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("rfd_star", num_agents=16)
-    params = swarm.default_params
-    state, _ = run(swarm, jax.random.key(0), graph, task, params, iterations=5)
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_star", agents=16,
+                                                             iterations=5)
     other = dataclasses.replace(state, key=jax.random.key(99))  # the state's own key is ignored
     a, trace_a = run(swarm, jax.random.key(3), graph, task, params, iterations=5, state=state)
     b, trace_b = run(swarm, jax.random.key(3), graph, task, params, iterations=5, state=other)

@@ -134,7 +134,7 @@ jax.tree_util.register_dataclass(
 
 
 def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
-        iterations: int = 100, patience: int | None = None, state=None):
+        iterations: int = 100, patience: int | None = None, state=None, budget=None):
     """Iterate a swarm until a stop condition holds, from fresh memory or from ``state``.
 
     Stops after ``iterations`` iterations, or when the best cost has not improved for ``patience``
@@ -157,6 +157,9 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
         :func:`jaxswarm.dynamic.change` when the map or the task changed); its key is replaced
         by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
         iteration count and the patience count start again either way.
+      budget: i32[] stop after at most this many iterations (traced, so runs of different
+        budgets share one compiled program: replaying a run up to the iteration where something
+        happened); None: ``iterations``.
 
     Returns:
       ``(state, trace)``: the final State and a :class:`Trace`.
@@ -170,11 +173,12 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
         raise ValueError(f"patience must be at least 1, got {patience}")
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
-    return _run(swarm, key, graph, task, params, iterations, patience, state)
+    budget = jnp.int32(iterations if budget is None else budget)
+    return _run(swarm, key, graph, task, params, iterations, patience, state, budget)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 5, 6))
-def _run(swarm, key, graph, task, params, iterations, patience, state):
+def _run(swarm, key, graph, task, params, iterations, patience, state, budget):
     if state is None:
         state = swarm.init(key, graph, task, params)
     else:
@@ -187,7 +191,8 @@ def _run(swarm, key, graph, task, params, iterations, patience, state):
 
     def keep_going(carry):
         _, trace, stale, converged = carry
-        return (trace.iterations < iterations) & (stale < limit) & ~converged
+        return ((trace.iterations < jnp.minimum(iterations, budget)) & (stale < limit)
+                & ~converged)
 
     def one_iteration(carry):
         state, trace, stale, _ = carry

@@ -1,0 +1,231 @@
+"""The RFD paper's dynamic scenarios (Tables 2-5) on our rebuilds of its nine maps.
+
+The paper moves the goal (Table 2), adds obstacles that cut the static path (Table 3), removes
+obstacles to open a shorter one (Table 4), and makes a major change (Table 5: the mosaic goals
+move far, the alleys and mazes lose a large share of their obstacles). Its goal cells are given;
+its edited cells are only drawn (Figures 4-6), not listed. Here:
+
+* **goal moves** (Table 2, and Table 5 on the mosaics) go to the paper's cell, or, where that cell
+  is an obstacle on our map, to the nearest free cell reachable from the start (both are kept);
+* **added obstacles** (Table 3): a single cell, or a 3 x 3 plug, on the static optimal path, the
+  one whose new optimum comes closest to the paper's (scaled, below);
+* **removed obstacles** (Table 4): a single obstacle cell, or a small block of them (a 4-connected
+  group of at most ``MAX_BLOCK`` cells), chosen the same way;
+* **a major removal** (Table 5, alleys and mazes): every obstacle within a disc around the start,
+  its radius the one whose new optimum comes closest to the paper's.
+
+Our maps are not the paper's, so a target is the paper's new optimum scaled by our static optimum
+over the paper's (Table 1): ``ours_static * paper_after / paper_static``. The candidates are
+evaluated exactly, by one D* Lite planner repaired after each trial edit, and ties go to the
+candidate found first (cells in node order): every scenario is deterministic.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+
+import numpy as np
+
+from jaxswarm.dynamic import Event, make_event
+from jaxswarm.edits import block_cells, unblock_cells
+from jaxswarm.exact import dijkstra, replanner
+from jaxswarm.graph import Graph
+from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, _by_map, paper_map
+
+TABLES = (2, 3, 4, 5)
+"""The paper's dynamic tables."""
+
+PAPER_DIJKSTRA_AFTER: dict[int, dict[str, float]] = {
+    table: _by_map({"Dijkstra": values})["Dijkstra"] for table, values in {
+        2: (20.07, 34.31, 77.79, 50.79, 83.21, 227.28, 117.76, 171.66, 509.32),
+        3: (19.48, 34.31, 82.62, 51.45, 83.62, 232.52, 118.59, 172.91, 514.56),
+        4: (17.82, 32.07, 76.62, 48.97, 79.14, 224.52, 115.28, 167.59, 504.56),
+        5: (21.31, 13, 58.97, 55.11, 29, 167.7, 117.5, 52, 359.11),
+    }.items()}
+"""The paper's Dijkstra path length after each change (Tables 2-5), per map."""
+
+TABLE2_GOALS: dict[str, tuple[int, int]] = {
+    "maze20": (19, 17), "mosaic20": (19, 8), "alley20": (14, 9), "maze50": (49, 46),
+    "mosaic50": (47, 22), "alley50": (35, 24), "maze100": (99, 96), "mosaic100": (99, 54),
+    "alley100": (72, 49)}
+"""The paper's new goals of Table 2, (x, y)."""
+
+TABLE5_GOALS: dict[str, tuple[int, int]] = {
+    "mosaic20": (19, 17), "mosaic50": (47, 45), "mosaic100": (99, 85)}
+"""The paper's new goals of Table 5 (the mosaics; the other maps lose obstacles)."""
+
+MAX_BLOCK = 16
+"""Largest group of obstacle cells removed at once for Table 4."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Scenario:
+    """One change of one paper map.
+
+    Attributes:
+      map: the paper map's name.
+      table: the paper's table (2-5).
+      kind: "goal", "added", "removed" or "major removal".
+      paper_goal: the paper's new goal cell (x, y), or None.
+      goal: our new goal (x, y) (the paper's, or the nearest free cell), or None.
+      block: cells (x, y) that become obstacles.
+      unblock: cells (x, y) that become free.
+      target: the new optimum aimed at (the paper's, scaled to our map).
+      static_optimum: our optimum before the change.
+      optimum: our optimum after it (Dijkstra).
+    """
+
+    map: str
+    table: int
+    kind: str
+    paper_goal: tuple[int, int] | None
+    goal: tuple[int, int] | None
+    block: tuple[tuple[int, int], ...]
+    unblock: tuple[tuple[int, int], ...]
+    target: float
+    static_optimum: float
+    optimum: float
+
+    def event(self, graph: Graph, size: int | None = None) -> Event:
+        """The change as an :class:`~jaxswarm.dynamic.Event` on ``graph`` (the map's graph)."""
+        return make_event(graph, goal=self.goal, block=self.block, unblock=self.unblock,
+                          size=size)
+
+    def obstacles(self) -> np.ndarray:
+        """bool[H, W] the map's obstacles after the change."""
+        obstacles = paper_map(self.map).obstacles.copy()
+        for x, y in self.block:
+            obstacles[y, x] = True
+        for x, y in self.unblock:
+            obstacles[y, x] = False
+        return obstacles
+
+
+@functools.lru_cache(maxsize=None)
+def paper_scenario(name: str, table: int) -> Scenario:
+    """The scenario of the paper's ``table`` (2-5) on paper map ``name`` (see the module
+    docstring; computed once per process).
+
+    Raises:
+      ValueError: an unknown map or table.
+    """
+    if name not in PAPER_MAPS:
+        raise ValueError(f"unknown paper map {name!r}; choose one of {', '.join(PAPER_MAPS)}")
+    if table not in TABLES:
+        raise ValueError(f"the paper's dynamic tables are 2-5, got {table}")
+    chosen = paper_map(name)
+    graph = chosen.graph()
+    static = float(dijkstra(graph, chosen.start, chosen.goal).cost)
+    target = static * PAPER_DIJKSTRA_AFTER[table][name] / PAPER_OPTIMA[name]
+    common = dict(map=name, table=table, target=target, static_optimum=static)
+    if table == 2 or (table == 5 and name in TABLE5_GOALS):
+        paper_goal = (TABLE2_GOALS if table == 2 else TABLE5_GOALS)[name]
+        goal = nearest_free(graph, chosen.start, paper_goal)
+        return Scenario(kind="goal", paper_goal=paper_goal, goal=goal, block=(), unblock=(),
+                        optimum=float(dijkstra(graph, chosen.start, goal).cost), **common)
+    if table == 3:
+        block, optimum = _closest(graph, chosen, _plugs(graph, chosen), target, block_cells)
+        return Scenario(kind="added", paper_goal=None, goal=None, block=block, unblock=(),
+                        optimum=optimum, **common)
+    if table == 4:
+        unblock, optimum = _closest(graph, chosen, _obstacle_groups(chosen.obstacles), target,
+                                    unblock_cells)
+    else:  # a disc that grows clears ever more: the optimum only shrinks
+        unblock, optimum = _closest(graph, chosen, _discs(chosen), target, unblock_cells,
+                                    shrinking=True)
+    return Scenario(kind="removed" if table == 4 else "major removal", paper_goal=None,
+                    goal=None, block=(), unblock=unblock, optimum=optimum, **common)
+
+
+def nearest_free(graph: Graph, start: tuple[int, int], cell: tuple[int, int]) -> tuple[int, int]:
+    """``cell`` if it is free and reachable from ``start``, else the nearest such cell
+    (Euclidean distance; ties to the smaller node index)."""
+    height, width = graph.shape
+    free = np.asarray(graph.free).reshape(height, width)
+    ys, xs = np.nonzero(free)
+    order = np.lexsort((ys * width + xs, np.hypot(xs - cell[0], ys - cell[1])))
+    for i in order:
+        candidate = (int(xs[i]), int(ys[i]))
+        if dijkstra(graph, start, candidate).found:
+            return candidate
+    raise ValueError(f"no cell reachable from {start} on this map")
+
+
+def _closest(graph, chosen, candidates, target, edit, *, shrinking=False):
+    """The candidate cell group whose edit (``block_cells`` or ``unblock_cells``) gives the new
+    optimum closest to ``target`` (a changed, finite one): ``(cells, optimum)``. One D* Lite
+    planner evaluates them all, each trial edit replacing the last. ``shrinking``: the
+    candidates' optima only decrease, so the search stops at the first one below the target."""
+    width = graph.shape[1]
+    planner = replanner(graph, chosen.start, chosen.goal)
+    static = float(planner.solve().cost)
+    best, best_cells, best_cost = np.inf, None, None
+    for cells in candidates:
+        if not cells:
+            continue
+        nodes = np.asarray([y * width + x for x, y in cells], np.int32)
+        cost = float(planner.update(edit(graph, nodes)).cost)
+        if np.isfinite(cost) and abs(cost - static) > 1e-9 and abs(cost - target) < best:
+            best, best_cells, best_cost = abs(cost - target), tuple(cells), cost
+        if shrinking and cost < target:
+            break
+    if best_cells is None:
+        raise ValueError(f"{chosen.name}: no candidate edit changes the optimum")
+    return best_cells, best_cost
+
+
+def _plugs(graph, chosen):
+    """Cells of the static optimal path (not its ends), each alone and as a 3 x 3 plug of the
+    free cells around it (the start, the goal and their neighbours never)."""
+    height, width = graph.shape
+    nodes = dijkstra(graph, chosen.start, chosen.goal).nodes()
+    ends = {chosen.start, chosen.goal}
+    keep_free = {(x + dx, y + dy) for x, y in ends for dx in (-1, 0, 1) for dy in (-1, 0, 1)}
+    free = ~chosen.obstacles
+    for node in nodes[1:-1]:
+        x, y = int(node % width), int(node // width)
+        if (x, y) in keep_free:
+            continue
+        yield [(x, y)]
+        yield [(x + dx, y + dy) for dy in (-1, 0, 1) for dx in (-1, 0, 1)
+               if 0 <= x + dx < width and 0 <= y + dy < height and free[y + dy, x + dx]
+               and (x + dx, y + dy) not in keep_free]
+
+
+def _obstacle_groups(obstacles):
+    """Each obstacle cell next to a free one, alone; then each 4-connected group of obstacle
+    cells of at most ``MAX_BLOCK`` cells, whole."""
+    height, width = obstacles.shape
+    padded = np.pad(~obstacles, 1)
+    touches = np.zeros_like(obstacles)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            touches |= padded[1 + dy:1 + dy + height, 1 + dx:1 + dx + width]
+    for y, x in zip(*np.nonzero(obstacles & touches)):
+        yield [(int(x), int(y))]
+    seen = np.zeros_like(obstacles)
+    for y0, x0 in zip(*np.nonzero(obstacles)):
+        if seen[y0, x0]:
+            continue
+        group, stack = [], [(int(y0), int(x0))]
+        seen[y0, x0] = True
+        while stack:
+            y, x = stack.pop()
+            group.append((x, y))
+            for ny, nx in ((y + 1, x), (y - 1, x), (y, x + 1), (y, x - 1)):
+                if 0 <= ny < height and 0 <= nx < width and obstacles[ny, nx] and not seen[ny, nx]:
+                    seen[ny, nx] = True
+                    stack.append((ny, nx))
+        if 1 < len(group) <= MAX_BLOCK:
+            yield sorted(group, key=lambda cell: (cell[1], cell[0]))
+
+
+def _discs(chosen):
+    """Every obstacle within distance r of the start, for r = 1, 2, ... up to the map's
+    diagonal."""
+    height, width = chosen.obstacles.shape
+    ys, xs = np.nonzero(chosen.obstacles)
+    distance = np.hypot(xs - chosen.start[0], ys - chosen.start[1])
+    for radius in range(1, int(np.hypot(height, width)) + 1):
+        inside = distance <= radius
+        yield [(int(x), int(y)) for x, y in zip(xs[inside], ys[inside])]
