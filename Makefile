@@ -36,23 +36,27 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # of 50 ants; the A* study on 1000 grids per size 10..100. Measured: 23 min on 2 cores (AMD EPYC,
 # shared with other work, load 1.5-4): Table 1 6.5 min, RFD table 2.8 min, path maps 0.3 min,
 # A* study 13.6 min (29 min in an earlier run under load 3-6) with the planners of 0.3.0 in
-# plain Python; compiled (0.4.0) it took about 4 min.
+# plain Python; compiled (0.4.0) it took about 4 min. The dynamic tables (rfd_paper_dynamic, 0.4.0)
+# have not been run at full size yet: about eight times Table 1's runs.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
 RFD_FULL := --maps all --seeds 20 --iterations 100 --agents 256
 PATHMAPS_FULL := --sizes 10x10,20x20,40x25 --runs 10 --ants 50 --max-ants 5000 --patience 20
 EXACT_FULL := --sizes 10:100:5 --grids 1000
+DYNAMIC_FULL := --maps all --seeds 20 --iterations 100 --patience 30 --agents 256
 TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
 RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
 EXACT_QUICK := --sizes 10:20:5 --grids 5
+DYNAMIC_QUICK := --maps mosaic20 --tables 2,3 --seeds 2 --iterations 5 --patience 5 --agents 32
 
-reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 min on 2 cores)
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 min on 2 cores, plus the dynamic tables)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
+	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_FULL) --out $(RESULTS)/rfd_paper_dynamic
 	$(BIN)/python sweeps/provenance.py $(RESULTS)
 
 reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
@@ -60,6 +64,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/rfd_static.py $(RFD_QUICK) --out $(QUICK_OUT)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_QUICK) --out $(QUICK_OUT)/aco_pathmaps
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
+	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_QUICK) --out $(QUICK_OUT)/rfd_paper_dynamic
 	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 
 clean:

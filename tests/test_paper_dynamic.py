@@ -8,7 +8,7 @@ from jaxswarm.dynamic import apply_event, change, check_events
 from jaxswarm.exact import dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import PAPER_OPTIMA, paper_map
-from jaxswarm.maps.paper_dynamic import (PAPER_DIJKSTRA_AFTER, TABLE2_GOALS, nearest_free,
+from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
                                          paper_scenario)
 from jaxswarm.swarm import make_task, run
 
@@ -30,7 +30,8 @@ def test_scenarios_change_the_optimum_as_described(name, table):
     assert after.found and after.cost == pytest.approx(scenario.optimum)
     assert scenario.optimum != pytest.approx(scenario.static_optimum)
     assert scenario.target == pytest.approx(
-        scenario.static_optimum * PAPER_DIJKSTRA_AFTER[table][name] / PAPER_OPTIMA[name])
+        scenario.static_optimum * PAPER_DYNAMIC_LENGTH[table]["Dijkstra"][name]
+        / PAPER_OPTIMA[name])
     kinds = {2: "goal", 3: "added", 4: "removed"}
     assert scenario.kind == kinds.get(table, "goal" if name == "mosaic20" else "major removal")
     if scenario.kind == "added":  # a cut of the static optimal path

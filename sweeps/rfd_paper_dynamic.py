@@ -1,0 +1,303 @@
+"""The RFD paper's Tables 2-5 (dynamic environment), reproduced on our nine paper maps.
+
+The rows of Table 1 (:mod:`rfd_paper_static`, the same labels, swarms and params) plus "D* Lite
+(repair)", a row the paper lacks. Per map, each swarm first solves the static map once per seed
+(keys split from key 0, ``--iterations`` iterations, like Table 1): its Table 1 state. Then for
+each of the paper's changes (:func:`jaxswarm.maps.paper_dynamic.paper_scenario`: Table 2 the goal
+moves, 3 obstacles added, 4 removed, 5 a major change) the swarm continues from that state:
+:func:`jaxswarm.dynamic.change` applies the change and the swarm's memory rule, then ``run``
+continues (``--iterations`` at most, patience ``--patience``; key ``fold_in(seed key, table)``).
+
+Timed per run, compile excluded (each program runs once first):
+
+* **time to stop**: from the change to the run's own stop;
+* **time to target**: from the change to the first iteration whose best path is the new
+  optimum (replayed with ``budget``; the run never sees the optimum); none if never reached.
+  For the exact planners both are their one search.
+
+Dijkstra and A* solve the changed map from scratch (their own ``stats.wall_time``; the map's
+host arrays are built outside it); D* Lite repairs its search of the static map (the ``update``
+call timed; a goal move restarts it).
+
+Written to ``--out`` (default ``out/rfd_paper_dynamic``; ``make reproduce`` uses
+``results/rfd_paper_dynamic``), each file atomically: ``runs.csv`` (one row per map, table, row
+and seed), ``table.md`` (the provenance, then per table: path length, runs at the new optimum,
+time to stop and time to target, ours beside the paper's values), ``provenance.json`` and
+``table<T>.png`` (each map after the change, the changed cells marked, each row's best path).
+
+Run from the repository root::
+
+    python sweeps/rfd_paper_dynamic.py
+    python sweeps/rfd_paper_dynamic.py --maps mosaic20,alley20,maze20 --seeds 3
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import jax
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+from matplotlib import pyplot as plt
+
+from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.dynamic import apply_event, change, check_events
+from jaxswarm.exact import replanner
+from jaxswarm.graph import grid_graph
+from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
+                                         paper_scenario)
+from jaxswarm.plot import draw_map, draw_paths, save_png
+from jaxswarm.swarm import make_task, run
+
+HERE = str(Path(__file__).resolve().parent)
+if HERE not in sys.path:  # loaded by path (the tests): find the modules beside this script
+    sys.path.insert(0, HERE)
+import provenance  # noqa: E402
+import rfd_paper_static as static  # noqa: E402
+
+DSTAR = "D* Lite (repair)"
+LABELS = static.ALGORITHMS[:2] + (DSTAR,) + static.ALGORITHMS[2:]
+"""Row labels in table order: Table 1's, with D* Lite after the exact planners."""
+COLUMNS = ("map", "table", "algorithm", "planner", "seed", "optimum", "cost", "gap", "found",
+           "iterations", "seconds", "target_iterations", "target_seconds")
+"""Columns of runs.csv (``seconds``: time to stop; ``target_*``: to the new optimum)."""
+TITLE = "RFD paper, Tables 2-5 (dynamic environment): ours beside the paper's"
+ABOUT = static.ABOUT + (
+    " \"D* Lite (repair)\" is not in the paper: D* Lite (`jaxswarm.exact.replanner`) repairing "
+    "its search of the static map. Each swarm continues from its own Table 1 state, its memory "
+    "adapted by its rule (`jaxswarm.dynamic`).")
+PAPER_ROW = {**{row.label: row.paper for row in static.ROWS}, DSTAR: None}
+
+
+def exact_runs(name, chosen, graph, scenario, table, seeds):
+    """Dijkstra and A* on the changed map, D* Lite repairing the static search: rows, best."""
+    fresh = grid_graph(scenario.obstacles())
+    goal = scenario.goal or chosen.goal
+    rows, best = [], {}
+    for label in static.ALGORITHMS[:2]:
+        planner = static.PLANNERS[label]
+        planner(fresh, chosen.start, goal)  # host arrays
+        for seed in range(seeds):
+            solution = planner(fresh, chosen.start, goal)
+            seconds = solution.stats.wall_time
+            rows.append(record(name, table, label, planner.__name__, seed, scenario, solution,
+                               "", seconds, (None, seconds)))
+        best[label] = solution
+    edited = apply_event(scenario.event(graph), graph, make_task(graph, chosen.start,
+                                                                 chosen.goal))[0]
+    for seed in range(seeds):
+        planner = replanner(graph, chosen.start, chosen.goal)
+        planner.solve()
+        began = time.perf_counter()
+        solution = planner.update(edited, goal=scenario.goal)
+        seconds = time.perf_counter() - began
+        rows.append(record(name, table, DSTAR, "replanner", seed, scenario, solution, "",
+                           seconds, (None, seconds)))
+    best[DSTAR] = solution
+    return rows, best
+
+
+def record(name, table, label, planner, seed, scenario, solution, iterations, seconds,
+           target=(None, None)):
+    """One runs.csv row; ``target`` is (iterations, seconds) to the new optimum, or Nones."""
+    cost = float(solution.cost)
+    return dict(map=name, table=table, algorithm=label, planner=planner, seed=seed,
+                optimum=scenario.optimum, cost=cost,
+                gap=(cost - scenario.optimum) / scenario.optimum, found=bool(solution.found),
+                iterations=iterations, seconds=seconds, target_iterations=target[0] or "",
+                target_seconds="" if target[1] is None else target[1])
+
+
+def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience, agents):
+    """One swarm row on one map: its Table 1 states, then each table's change continued."""
+    task = make_task(graph, chosen.start, chosen.goal)
+    swarm, params = static.row_swarm(row, agents)
+    keys = jax.random.split(jax.random.key(0), seeds)
+    states = [run(swarm, key, graph, task, params, iterations=iterations)[0] for key in keys]
+    rows, best = [], {}
+    for table in tables:
+        scenario = paper_scenario(name, table)
+        event = scenario.event(graph)
+        check_events(graph, task, event)
+
+        @jax.jit
+        def replay(state, key, budget, event=event):
+            changed, edited, new_task = change(swarm, state, event, graph, task, params)
+            state, trace = run(swarm, key, edited, new_task, params, iterations=iterations,
+                               patience=patience, state=changed, budget=budget)
+            return swarm.best(state), trace
+
+        for seed, (key, state) in enumerate(zip(keys, states)):
+            key = jax.random.fold_in(key, table)
+            if seed == 0:
+                jax.block_until_ready(replay(state, key, iterations))  # compile
+            solution, trace, seconds = _timed(replay, state, key, iterations)
+            used = int(trace.iterations)
+            best_costs = np.asarray(trace.best_cost)[:used]
+            hits = np.nonzero((best_costs - scenario.optimum) / scenario.optimum
+                              < static.OPTIMAL_GAP)[0]
+            target = (None, None)
+            if hits.size:
+                first = int(hits[0]) + 1
+                target = (first, _timed(replay, state, key, first)[2])
+            rows.append(record(name, table, row.label, row.planner(), seed, scenario, solution,
+                               used, seconds, target))
+            if table not in best or float(solution.cost) < float(best[table].cost):
+                best[table] = solution
+    return rows, best
+
+
+def _timed(replay, state, key, budget):
+    began = time.perf_counter()
+    solution, trace = jax.block_until_ready(replay(state, key, budget))
+    return solution, trace, time.perf_counter() - began
+
+
+def solve_map(name, tables, **options):
+    """Every row on paper map ``name``: (rows, table -> row label -> best Solution)."""
+    chosen = paper_map(name)
+    graph = chosen.graph()
+    rows, best = [], {table: {} for table in tables}
+    for table in tables:
+        mine, solutions = exact_runs(name, chosen, graph, paper_scenario(name, table), table,
+                                     options["seeds"])
+        rows += mine
+        best[table].update(solutions)
+    for row in static.ROWS[2:]:
+        began = time.perf_counter()
+        mine, solutions = swarm_runs(name, chosen, graph, row, tables, **options)
+        rows += mine
+        for table, solution in solutions.items():
+            best[table][row.label] = solution
+        print(f"{name:10} {row.label:22} {time.perf_counter() - began:.0f} s", flush=True)
+    return rows, best
+
+
+def cells(rows, maps, label, table, ours):
+    return [ours([r for r in rows if r["map"] == m and r["table"] == table
+                  and r["algorithm"] == label]) for m in maps]
+
+
+def target_cell(runs):
+    """Median time to the new optimum [ms] over the runs that reached it (count)."""
+    hit = [r["target_seconds"] for r in runs if r["target_seconds"] != ""]
+    median = f"{1e3 * statistics.median(hit):.2f}" if hit else "-"
+    return f"{median} ({len(hit)}/{len(runs)})"
+
+
+def half(rows, maps, table, ours, paper=None):
+    """Markdown lines: a row of ours per algorithm, and the paper's where ``paper`` is given."""
+    lines = ["| algorithm | source | " + " | ".join(maps) + " |",
+             "| --- | --- |" + " ---: |" * len(maps)]
+    for label in LABELS:
+        lines.append(f"| {label} | ours | " + " | ".join(cells(rows, maps, label, table, ours))
+                     + " |")
+        if paper is not None and PAPER_ROW[label] is not None:
+            values = paper[table].get(PAPER_ROW[label])
+            shown = ["" if values is None else "n/a" if values[m] is None else f"{values[m]:g}"
+                     for m in maps]
+            lines.append(f"| {label} | paper ({PAPER_ROW[label]}) | " + " | ".join(shown)
+                         + " |")
+    return lines
+
+
+def markdown(rows, maps, tables, args):
+    parts = [f"{args.seeds} seeds; each swarm continues from its Table 1 state ({args.agents} "
+             f"agents, {args.iterations} iterations at most, patience {args.patience}). Times "
+             "in ms (compile excluded); the paper's are C# on its own maps. An empty paper cell: "
+             "the paper's text has no such row."]
+    for table in tables:
+        changes = ", ".join(f"{m}: {_describe(paper_scenario(m, table))}" for m in maps)
+        parts += ["", f"## Table {table}", "", f"Changes: {changes}.", "",
+                  "### Path length: mean over the seeds that found a path", "",
+                  *half(rows, maps, table, static.length_cell, PAPER_DYNAMIC_LENGTH), "",
+                  "### Runs at the new optimum", "", *half(rows, maps, table, static.optimal_cell),
+                  "", "### Time to stop [ms]: median", "",
+                  *half(rows, maps, table, static.time_cell, PAPER_DYNAMIC_MS), "",
+                  "### Time to target [ms]: median over the runs that reached the new optimum", "",
+                  *half(rows, maps, table, target_cell)]
+    return "\n".join(parts) + "\n"
+
+
+def _describe(scenario):
+    if scenario.kind == "goal":
+        return (f"goal to {scenario.goal} (paper {scenario.paper_goal}), optimum "
+                f"{scenario.optimum:.2f}")
+    cells_ = len(scenario.block) + len(scenario.unblock)
+    return f"{cells_} cells {scenario.kind}, optimum {scenario.optimum:.2f}"
+
+
+def figure(best, table):
+    """Each map after the change of ``table``, changed cells marked, each row's best path."""
+    names = list(best)
+    rows, columns = math.ceil(len(names) / 3), min(len(names), 3)
+    fig, axes = plt.subplots(rows, columns, figsize=(5 * columns, 5.9 * rows), squeeze=False,
+                             layout="constrained")
+    for ax in axes.flat[len(names):]:
+        ax.set_visible(False)
+    for name, ax in zip(names, axes.flat):
+        scenario, chosen = paper_scenario(name, table), paper_map(name)
+        graph = grid_graph(scenario.obstacles())
+        draw_map(ax, graph, start=chosen.start, goal=scenario.goal or chosen.goal, title=name)
+        for cells_, marker in ((scenario.block, "s"), (scenario.unblock, "D")):
+            if cells_:
+                xs, ys = zip(*cells_)
+                ax.scatter(xs, ys, marker=marker, s=12, color="tab:pink", zorder=3)
+        for thinner, (label, solution) in enumerate(best[name][table].items()):
+            cost = f"{float(solution.cost):.2f}" if bool(solution.found) else "no path"
+            colour = static.COLORS.get(label, "black")
+            draw_paths(ax, graph, [solution], [f"{label} ({cost})"], colors=[colour],
+                       linewidth=5 - 0.5 * thinner)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.03), ncols=2, frameon=False,
+                  fontsize="small")
+    fig.suptitle(f"RFD paper, Table {table}: the map after the change (pink: cells blocked "
+                 "(squares) or opened (diamonds)) and each algorithm's best path")
+    return fig
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--maps", type=paper_maps_argument, default="all")
+    parser.add_argument("--tables", default="2,3,4,5")
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--iterations", type=int, default=100)
+    parser.add_argument("--patience", type=int, default=30)
+    parser.add_argument("--agents", type=int, default=256)
+    parser.add_argument("--out", type=Path, default=Path("out/rfd_paper_dynamic"))
+    args = parser.parse_args(argv)
+    tables = [int(t) for t in args.tables.split(",")]
+    if any(t not in TABLES for t in tables):
+        parser.error(f"--tables: the paper's dynamic tables are {', '.join(map(str, TABLES))}")
+    for option in ("seeds", "iterations", "patience", "agents"):
+        if getattr(args, option) < 1:
+            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    record_ = provenance.begin(__file__, argv)
+    rows, best = [], {}
+    for name in args.maps:
+        mine, best[name] = solve_map(name, tables, seeds=args.seeds, iterations=args.iterations,
+                                     patience=args.patience, agents=args.agents)
+        rows += mine
+    record_.finish(title=TITLE, about=ABOUT, arguments=vars(args),
+                   rows=static.row_definitions(args.agents))
+    write_csv(args.out / "runs.csv", rows, COLUMNS)
+    text = record_.document(markdown(rows, args.maps, tables, args))
+    write_atomically(args.out / "table.md", text)
+    record_.write(args.out)
+    for table in tables:
+        fig = figure(best, table)
+        save_png(fig, args.out / f"table{table}.png")
+        plt.close(fig)
+    print("\n" + text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
