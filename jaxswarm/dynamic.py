@@ -132,6 +132,20 @@ def change(swarm: Swarm, state, event: Event, graph: Graph, task: Task, params):
     return forget_invalid_best(state, after, new_task), after, new_task
 
 
+def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterations: int):
+    """Step a swarm ``iterations`` times from ``state`` (static count, no stop rule) and keep its
+    memory after each step: ``(state, f32[iterations + 1, N])``, the first row the memory
+    given (for a figure or a GIF of it re-forming after a change, see
+    :func:`jaxswarm.plot.animate_field`)."""
+    def one(state, _):
+        state, _ = swarm.step(state, graph, task, params)
+        return state, swarm.memory(state)
+
+    first = swarm.memory(state)
+    state, frames = jax.lax.scan(one, state, None, length=iterations)
+    return state, jnp.concatenate([first[None], frames])
+
+
 def forget_invalid_best(state, graph: Graph, task: Task):
     """``state`` without its best path if that path is no longer a path from the start to the
     goal on ``graph`` (it crosses a blocked cell or edge, or ends at an old goal): its cost is

@@ -20,11 +20,14 @@ Nothing here selects a backend or shows a window; callers own the figures they g
 """
 from __future__ import annotations
 
+import tempfile
 from collections.abc import Mapping
+from pathlib import Path
 
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.colors import LogNorm
@@ -32,7 +35,7 @@ from matplotlib.figure import Figure
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 
-from jaxswarm.atomic import atomic_path
+from jaxswarm.atomic import atomic_path, write_atomically
 from jaxswarm.graph import Graph
 from jaxswarm.lattice import OPPOSITE
 from jaxswarm.paths import Solution, as_node, trim
@@ -253,6 +256,53 @@ def plot_swarm_run(graph: Graph, field, solution: Solution, trace, *, start, goa
     if path is not None:
         save_png(fig, path)
     return fig
+
+
+def animate_field(graph: Graph, frames, path, *, start=None, goal=None, label=None,
+                  title=None, interval_ms: int = 200, log: bool = False) -> None:
+    """Write a GIF of a per-node field changing over time (one frame per row of ``frames``),
+    e.g. a swarm's altitude or pheromone re-forming after the map changed, atomically.
+
+    Args:
+      graph: a grid map (N nodes).
+      frames: f[T, N] the field at T moments.
+      path: the GIF to write (parent directories are created).
+      start, goal: markers, as :func:`draw_map`'s.
+      label: colorbar label; title: axes title, formatted with ``frame`` (e.g. "iteration
+        {frame}").
+      interval_ms: time between frames.
+      log: logarithmic colour scale.
+
+    Raises:
+      ValueError: as :func:`draw_field`, or ``frames`` not [T, N].
+    """
+    frames = np.asarray(frames, dtype=np.float64)
+    if frames.ndim != 2 or frames.shape[1] != graph.num_nodes:
+        raise ValueError(f"frames must be [T, {graph.num_nodes}], got {frames.shape}")
+    fig, ax = plt.subplots(figsize=(6, 6), layout="constrained")
+    image = draw_field(ax, graph, frames[0], label=label, log=log)
+    _draw_endpoints(ax, graph, start, goal)
+    finite = frames[np.isfinite(frames)]
+    if finite.size and not log:
+        image.set_clim(finite.min(), finite.max())
+    hidden = np.ma.getmaskarray(image.get_array())
+
+    def show(t):
+        image.set_data(np.ma.masked_array(frames[t].reshape(graph.shape),
+                                          mask=hidden | ~np.isfinite(frames[t]).reshape(
+                                              graph.shape)))
+        if title is not None:
+            ax.set_title(title.format(frame=t))
+        return (image,)
+
+    animation = FuncAnimation(fig, show, frames=frames.shape[0], interval=interval_ms, blit=False)
+    # Pillow picks the format from the file name, so the GIF is made under its own name in a
+    # scratch folder, then moved into place whole.
+    with tempfile.TemporaryDirectory() as scratch:
+        made = Path(scratch) / "animation.gif"
+        animation.save(made, writer=PillowWriter(fps=max(1, round(1000 / interval_ms))))
+        write_atomically(path, made.read_bytes())
+    plt.close(fig)
 
 
 def save_png(fig: Figure, path) -> None:

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from graphs import solved_paper_map
-from jaxswarm.dynamic import apply_event, change, check_events, make_event
+from jaxswarm.dynamic import apply_event, change, check_events, make_event, memory_frames
 from jaxswarm.graph import grid_graph
+from jaxswarm.plot import animate_field
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import _run
 
@@ -164,3 +165,18 @@ def test_bad_events_are_named_before_anything_is_applied():
                                    make_event(graph, block=[8], size=1))
     with pytest.raises(ValueError, match="event 1: the goal"):
         check_events(graph, task, batch)
+
+
+def test_memory_frames_and_their_gif(tmp_path):
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded", agents=8,
+                                                             iterations=3)
+    after, frames = jax.jit(memory_frames, static_argnums=(0, 5))(swarm, state, graph, task,
+                                                                   params, 4)
+    assert frames.shape == (5, graph.num_nodes)
+    np.testing.assert_array_equal(frames[0], swarm.memory(state))
+    np.testing.assert_array_equal(frames[-1], swarm.memory(after))
+    gif = tmp_path / "sub" / "altitude.gif"
+    animate_field(graph, np.minimum(np.asarray(frames), 100.0), gif, title="{frame}")
+    assert gif.read_bytes()[:6] == b"GIF89a" and list(gif.parent.iterdir()) == [gif]
+    with pytest.raises(ValueError, match=r"frames must be \[T, 400\]"):
+        animate_field(graph, np.zeros((3, 5)), tmp_path / "bad.gif")

@@ -9,6 +9,8 @@ The notebooks also check their own results with ``assert``. After a run, the tes
 * quickstart: the JSON line printed by the cell tagged ``checks``. The three exact planners report
   one finite optimum, no swarm beats it, and a repeated key reproduces its run. Its figures were
   shown inline.
+* dynamic: the JSON line of its ``checks`` cell (three swarms continued after the goal moved, none
+  beating the new optimum) and the GIF it wrote under ``tmp_path``.
 * sweep_analysis: the Parquet store under ``tmp_path``. Read back with pandas, it holds
   maps x combinations x seeds rows, one per run, taken from the spec in ``metadata.json``. No gap
   is below -1e-6. The PNGs of ``plot_sweep`` exist. The figures were shown inline, which
@@ -25,7 +27,7 @@ variable only lives for the test (monkeypatch). Nothing is installed, and no use
 change. Before a notebook's own cells, the test runs one extra cell, added to the in-memory copy
 only. It prints the kernel's ``sys.prefix``, and the test checks that this equals pytest's.
 
-Run time on 2 CPU cores: about 1 minute for both notebooks, mostly JAX compiling. Each cell may
+Run time on 2 CPU cores: about 2 minutes for the three notebooks, mostly JAX compiling. Each cell may
 take up to ``CELL_TIMEOUT`` seconds.
 """
 from __future__ import annotations
@@ -155,3 +157,15 @@ def test_sweep_analysis(notebook_env):
         assert path.is_file(), f"missing {path}"
         assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert count_images(nb) >= 6  # heat maps, lines, the PNG shown, and one replay per map
+
+
+def test_dynamic(notebook_env):
+    nb = execute("dynamic.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+    assert set(result["swarms"]) == {"rfd_star", "rfd_graded", "aco_star"}
+    gif = Path(result["gif"])
+    assert gif.parent == notebook_env and gif.stat().st_size > 0
+    assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a") and result["frames"] == 16
+    assert count_images(nb) >= 2
