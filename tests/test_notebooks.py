@@ -27,8 +27,8 @@ variable only lives for the test (monkeypatch). Nothing is installed, and no use
 change. Before a notebook's own cells, the test runs one extra cell, added to the in-memory copy
 only. It prints the kernel's ``sys.prefix``, and the test checks that this equals pytest's.
 
-Run time on 2 CPU cores: about 2 minutes for the three notebooks, mostly JAX compiling. Each cell may
-take up to ``CELL_TIMEOUT`` seconds.
+Run time on 2 CPU cores: about 2 minutes for the three notebooks, mostly JAX compiling. Each cell
+may take up to ``CELL_TIMEOUT`` seconds.
 """
 from __future__ import annotations
 

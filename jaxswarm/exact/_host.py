@@ -1,8 +1,9 @@
 """Host-side forms of a Graph for the exact planners, cached per Graph object.
 
-The compiled planners read :class:`EdgeArrays` (CSR arrays of the valid edges); the readable heapq planners of :mod:`jaxswarm.exact.reference` read :class:`HostGraph` (Python lists
-of the valid edges). Graphs are immutable and compare by identity, so an edit (which returns a
-new Graph) is a new cache entry.
+The compiled planners read :class:`EdgeArrays` (CSR arrays of the valid edges); the readable
+heapq planners of :mod:`jaxswarm.exact.reference` read :class:`HostGraph` (Python lists of the
+valid edges). Graphs are immutable and compare by identity, so an edit (which returns a new
+Graph) is a new cache entry.
 """
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import weakref
 
 import numpy as np
 
+from jaxswarm.exact import kernels
 from jaxswarm.graph import Graph
 
 SQRT2 = math.sqrt(2.0)
@@ -165,7 +167,7 @@ def heuristic(kind: str, host: HostGraph, target: int):
     raise _unknown(kind)
 
 
-HEURISTIC_CODES = {"zero": 0, "euclidean": 1, "octile": 2}
+HEURISTIC_CODES = {"zero": kernels.ZERO, "euclidean": kernels.EUCLIDEAN, "octile": kernels.OCTILE}
 """The compiled planners' heuristic codes (:mod:`jaxswarm.exact.kernels`)."""
 
 

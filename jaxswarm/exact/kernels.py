@@ -3,12 +3,14 @@
 numba because a priority-queue search is a scalar loop with data-dependent branches: XLA has no
 fast form of it, and a pure-Python heap spends most of its time in the interpreter (7-9 ms per A*
 query on a 128 x 128 maze where a C++ A* takes 0.3 ms). The loops are written over plain arrays
-(:class:`~jaxswarm.exact._host.EdgeArrays`, a :class:`Workspace`), so a batch of queries reuses
-its buffers and pays no Python per node.
+(:class:`~jaxswarm.exact._host.EdgeArrays`, a :class:`~jaxswarm.exact.search.Workspace`), so a
+batch of queries reuses its buffers and pays no Python per node.
 
-The binary heap orders entries by ``(f, -g, node)`` exactly as the readable heapq planners of
-:mod:`jaxswarm.exact.reference` do (ties on f towards the larger g, then the smaller node). Keys
-are distinct, so both pop the same sequence: the same paths and the same statistics.
+The indexed binary heap orders entries by ``(f, -g, node)`` exactly as the readable heapq planners
+of :mod:`jaxswarm.exact.reference` do (ties on f towards the larger g, then the smaller node), and
+moves a queued node whose cost improves instead of leaving a stale entry behind. Keys are
+distinct, so both expand the same nodes in the same order: the same paths, expansions and
+relaxations (the heapq planners also pop the stale entries they leave).
 """
 from __future__ import annotations
 
@@ -17,8 +19,8 @@ import math
 import numba
 import numpy as np
 
-ZERO, EUCLIDEAN, OCTILE = 0, 1, 2  # as _host.HEURISTIC_CODES
-"""Heuristic codes of the kernels (see :func:`jaxswarm.exact._host.heuristic_code`)."""
+ZERO, EUCLIDEAN, OCTILE = 0, 1, 2
+"""Heuristic codes of the kernels (by name: :func:`jaxswarm.exact._host.heuristic_code`)."""
 
 DIAGONAL_EXTRA = math.sqrt(2.0) - 1.0
 
