@@ -75,6 +75,7 @@ class DStarLite:
         self._graph = graph
         self._lattice = _Lattice(graph)
         self._start = as_node(graph, start, name="start")
+        self._call = 0  # counts the calls: a node's mark is the last call that touched it
         self._restart(as_node(graph, goal, name="goal"))
         self._solution: Solution | None = None
 
@@ -87,6 +88,7 @@ class DStarLite:
         """The shortest path from the current start to the goal (searching only as far as the
         last change requires; nothing when nothing changed since the last call)."""
         if self._solution is None:
+            self._call += 1
             self._solution = self._search(time.perf_counter(), 0)
         return self._solution
 
@@ -111,6 +113,7 @@ class DStarLite:
         new_goal = self._goal if goal is None else as_node(graph, goal, name="goal")
         as_node(graph, new_start, name="start")  # still free after the edit?
         as_node(graph, new_goal, name="goal")
+        self._call += 1
         touched = 0
         if new_goal != self._goal:
             self._graph, self._start = graph, new_start
@@ -137,7 +140,6 @@ class DStarLite:
         self._heap = np.empty((n + 1, 3))
         self._position = np.full(n, -1, np.int32)
         self._mark = np.zeros(n, np.int32)  # the call that last touched each node
-        self._call = 0
         self._rhs[goal] = 0.0
         lattice = self._lattice
         self._size = kernels.heap_set(
@@ -152,7 +154,6 @@ class DStarLite:
         """New edge costs from ``graph``: every changed edge's tail re-evaluated; returns the
         number of nodes touched."""
         changed, old = self._lattice.set_costs(graph)
-        self._call += 1
         lattice = self._lattice
         self._size, touched = repair(lattice.edges(), lattice.x, lattice.y, self._kind,
                                      self._state(), self._call, self._size, self._start,
@@ -161,7 +162,6 @@ class DStarLite:
 
     def _search(self, began: float, touched: int) -> Solution:
         lattice = self._lattice
-        self._call += 1
         self._size, *counts = compute_shortest_path(
             lattice.edges(), lattice.x, lattice.y, self._kind, self._state(), self._call,
             self._size, self._start, self._goal, self._km)
