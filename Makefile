@@ -55,16 +55,16 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
-	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_FULL) --out $(RESULTS)/rfd_paper_dynamic
+	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/provenance.py $(RESULTS)
 
 reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_QUICK) --out $(QUICK_OUT)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_QUICK) --out $(QUICK_OUT)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_QUICK) --out $(QUICK_OUT)/aco_pathmaps
-	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_QUICK) --out $(QUICK_OUT)/rfd_paper_dynamic
+	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 
 clean:

@@ -118,8 +118,10 @@ def begin(script: str, argv: Sequence[str] | None) -> Provenance:
     argv = sys.argv[1:] if argv is None else list(argv)
     commit, dirty_files = git_state()
     return Provenance(command=command(script, argv), commit=commit, dirty_files=dirty_files,
+                      # Milliseconds: the index orders tables by their start, and a quick
+                      # script may start within the second the one before it started.
                       started=datetime.datetime.now(datetime.timezone.utc).isoformat(
-                          timespec="seconds"),
+                          timespec="milliseconds"),
                       versions=versions(), machine=machine())
 
 

@@ -34,10 +34,10 @@ TINY = {
                    ["--maps", "alley20", "--seeds", "1", "--iterations", "2", "--agents", "8"]),
     "aco_pathmaps": ("sweeps/aco_pathmaps.py",
                      ["--sizes", "10x10", "--runs", "2", "--max-ants", "200"]),
-    "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
     "rfd_paper_dynamic": ("sweeps/rfd_paper_dynamic.py",
                           ["--maps", "alley20", "--tables", "2", "--seeds", "1",
                            "--iterations", "2", "--patience", "1", "--agents", "8"]),
+    "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 
 
