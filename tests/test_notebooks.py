@@ -159,6 +159,7 @@ def test_sweep_analysis(notebook_env):
     assert count_images(nb) >= 6  # heat maps, lines, the PNG shown, and one replay per map
 
 
+@pytest.mark.slow  # about a minute; the default suite keeps under ten
 def test_dynamic(notebook_env):
     nb = execute("dynamic.ipynb")
     checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
