@@ -54,6 +54,12 @@ BENCHMARKS = [
      "The exact planners (compiled) beside pyastar2d (C++ A*) and networkx on three Moving AI "
      "maps, one query at a time and in a batch, and D* Lite's repair after a single-cell edit "
      "against A* from scratch."),
+    ("Re-planning after the RFD paper's changes", "dynamic.py", ["--seeds", "5"],
+     ["--maps", "maze20", "--tables", "2", "--seeds", "1", "--swarms", "rfd_graded"],
+     "`rfd_star`, `rfd_graded` and ACO* continuing from their memory after each change of the "
+     "RFD paper's Tables 2-5 on the 100 x 100 paper maps (5 seeds here; the issue's check runs "
+     "20): time from the change to the first iteration with the new optimum and to the run's "
+     "own stop, beside A* from scratch on the changed map and D* Lite's repair."),
 ]
 """(title, script, arguments, quick arguments, what it measures) of each section."""
 
