@@ -40,19 +40,18 @@ import statistics
 import time
 
 import jax
-import numpy as np
 
 from jaxswarm.cpu import configure
-from jaxswarm.dynamic import apply_event, change, check_events
+from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
 from jaxswarm.exact import astar, dijkstra, replanner
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map, paper_map_names
 from jaxswarm.maps.paper_dynamic import TABLES, paper_scenario
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.sweep.runner import SUCCESS_GAP
 
 ITERATIONS = 100
 PATIENCE = 30
-SUCCESS_GAP = 1e-4
 GOAL_SEEDS, GOAL_MS = 19, 20.0
 
 
@@ -67,14 +66,12 @@ def replan_rows(swarm, graph, task, scenario, seeds: int):
     """Per seed: (reached, ms to target, iterations to target, ms to stop, iterations)."""
     event = scenario.event(graph)
     check_events(graph, task, event)
-    optimum = scenario.optimum
     params = swarm.default_params
 
     @jax.jit
     def replay(state, key, budget):
-        changed, edited, new_task = change(swarm, state, event, graph, task, params)
-        return run(swarm, key, edited, new_task, params, iterations=ITERATIONS,
-                   patience=PATIENCE, state=changed, budget=budget)
+        return replan(swarm, key, state, event, graph, task, params, iterations=ITERATIONS,
+                      patience=PATIENCE, budget=budget)
 
     rows = []
     for seed in range(seeds):
@@ -85,10 +82,8 @@ def replan_rows(swarm, graph, task, scenario, seeds: int):
             jax.block_until_ready(replay(state, key, ITERATIONS))  # compile
         (_, trace), to_stop = timed(lambda: replay(state, key, ITERATIONS))
         used = int(trace.iterations)
-        best = np.asarray(trace.best_cost)[:used]
-        hits = np.nonzero((best - optimum) / optimum < SUCCESS_GAP)[0]
-        if hits.size:
-            first = int(hits[0]) + 1
+        first = first_iteration_at(trace, scenario.optimum, gap=SUCCESS_GAP)
+        if first is not None:
             _, to_target = timed(lambda: replay(state, key, first))
             rows.append((True, 1e3 * to_target, first, 1e3 * to_stop, used))
         else:

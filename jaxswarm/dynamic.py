@@ -7,6 +7,9 @@ event of the same size, and a batch of events vmaps::
     state, graph, task = change(swarm, state, event, graph, task, params)  # memory kept
     state, trace = run(swarm, key, graph, task, params, state=state)     # continue from it
 
+:func:`replan` does both in one jittable call, and :func:`first_iteration_at` reads from its trace
+when the new optimum was first reached.
+
 :func:`change` applies the event to the map and the task (:func:`apply_event`), then the swarm's
 memory rule (``Swarm.adapt``, documented per swarm family: the RFD paper's
 :func:`jaxswarm.swarm.rfd.river.paper_altitude_rule`, ``rfd_graded``'s
@@ -27,7 +30,7 @@ import numpy as np
 from jaxswarm.edits import block_cells, unblock_cells
 from jaxswarm.graph import Graph
 from jaxswarm.paths import as_node, is_valid_path
-from jaxswarm.swarm.core import Swarm, Task
+from jaxswarm.swarm.core import Swarm, Task, run
 
 NO_NODE = -1
 
@@ -130,6 +133,24 @@ def change(swarm: Swarm, state, event: Event, graph: Graph, task: Task, params):
     after, new_task = apply_event(event, graph, task)
     state = swarm.adapt(state, graph, after, task, new_task, params)
     return forget_invalid_best(state, after, new_task), after, new_task
+
+
+def replan(swarm: Swarm, key, state, event: Event, graph: Graph, task: Task, params, *,
+           iterations: int, patience: int | None = None, budget=None):
+    """Apply ``event`` (:func:`change`) and continue the run from the adapted memory: ``(state,
+    trace)`` of the continuation (:func:`jaxswarm.swarm.run` with ``state``; jittable, so the
+    change and the continuation are timed together)."""
+    changed, edited, new_task = change(swarm, state, event, graph, task, params)
+    return run(swarm, key, edited, new_task, params, iterations=iterations, patience=patience,
+               state=changed, budget=budget)
+
+
+def first_iteration_at(trace, cost: float, *, gap: float) -> int | None:
+    """Host-side: the 1-based iteration at which a run's best cost first came within relative
+    ``gap`` of ``cost`` (say the new optimum; the run itself never saw it), None if never."""
+    best = np.asarray(trace.best_cost)[:int(trace.iterations)]
+    hits = np.nonzero((best - cost) / cost < gap)[0]
+    return int(hits[0]) + 1 if hits.size else None
 
 
 def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterations: int):

@@ -41,13 +41,12 @@ from pathlib import Path
 
 import jax
 import matplotlib
-import numpy as np
 
 matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 
 from jaxswarm.atomic import write_atomically, write_csv
-from jaxswarm.dynamic import apply_event, change, check_events
+from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
 from jaxswarm.exact import replanner
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
@@ -129,9 +128,8 @@ def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience,
 
         @jax.jit
         def replay(state, key, budget, event=event):
-            changed, edited, new_task = change(swarm, state, event, graph, task, params)
-            state, trace = run(swarm, key, edited, new_task, params, iterations=iterations,
-                               patience=patience, state=changed, budget=budget)
+            state, trace = replan(swarm, key, state, event, graph, task, params,
+                                  iterations=iterations, patience=patience, budget=budget)
             return swarm.best(state), trace
 
         for seed, (key, state) in enumerate(zip(keys, states)):
@@ -139,16 +137,11 @@ def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience,
             if seed == 0:
                 jax.block_until_ready(replay(state, key, iterations))  # compile
             solution, trace, seconds = _timed(replay, state, key, iterations)
-            used = int(trace.iterations)
-            best_costs = np.asarray(trace.best_cost)[:used]
-            hits = np.nonzero((best_costs - scenario.optimum) / scenario.optimum
-                              < static.OPTIMAL_GAP)[0]
-            target = (None, None)
-            if hits.size:
-                first = int(hits[0]) + 1
-                target = (first, _timed(replay, state, key, first)[2])
+            first = first_iteration_at(trace, scenario.optimum, gap=static.OPTIMAL_GAP)
+            target = (None, None) if first is None else (
+                first, _timed(replay, state, key, first)[2])
             rows.append(record(name, table, row.label, row.planner(), seed, scenario, solution,
-                               used, seconds, target))
+                               int(trace.iterations), seconds, target))
             if table not in best or float(solution.cost) < float(best[table].cost):
                 best[table] = solution
     return rows, best

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from graphs import solved_paper_map
-from jaxswarm.dynamic import apply_event, change, check_events, make_event, memory_frames
+from jaxswarm.dynamic import (apply_event, change, check_events, first_iteration_at, make_event,
+                              memory_frames, replan)
 from jaxswarm.graph import grid_graph
 from jaxswarm.plot import animate_field
 from jaxswarm.swarm import make, make_task, run
@@ -180,3 +181,19 @@ def test_memory_frames_and_their_gif(tmp_path):
     assert gif.read_bytes()[:6] == b"GIF89a" and list(gif.parent.iterdir()) == [gif]
     with pytest.raises(ValueError, match=r"frames must be \[T, 400\]"):
         animate_field(graph, np.zeros((3, 5)), tmp_path / "bad.gif")
+
+
+def test_replan_is_change_then_run_and_first_iteration_at_reads_the_trace():
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded", agents=16,
+                                                             iterations=5)
+    event = make_event(graph, block=[int(np.nonzero(np.asarray(graph.free))[0][60])])
+    key = jax.random.key(5)
+    _, together = replan(swarm, key, state, event, graph, task, params, iterations=8)
+    changed, edited, new_task = change(swarm, state, event, graph, task, params)
+    _, apart = run(swarm, key, edited, new_task, params, iterations=8, state=changed)
+    np.testing.assert_array_equal(together.best_cost, apart.best_cost)
+    trace = dataclasses.replace(together, best_cost=jnp.array([np.inf, 12.0, 10.0005, 10.0]),
+                                iterations=jnp.int32(4))
+    assert first_iteration_at(trace, 10.0, gap=1e-4) == 3  # 5e-5 relative: within the gap
+    assert first_iteration_at(trace, 10.0, gap=1e-6) == 4
+    assert first_iteration_at(trace, 9.0, gap=1e-4) is None
