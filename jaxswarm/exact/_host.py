@@ -41,7 +41,8 @@ class HostGraph:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class EdgeArrays:
-    """The valid edges of a Graph as CSR arrays, for the compiled planners.
+    """Edges of a Graph as CSR arrays, for the compiled planners: the valid ones
+    (:func:`edge_arrays`), or every lattice edge (:func:`lattice_arrays`, D* Lite's).
 
     Attributes:
       indptr: i64[N + 1]; the edges out of ``u`` are ``indptr[u]:indptr[u + 1]``, in slot order.
@@ -96,15 +97,21 @@ def edge_arrays(graph: Graph) -> EdgeArrays:
     """The cached EdgeArrays of ``graph`` (built on first use, O(N K))."""
     cached = _ARRAYS.get(graph)
     if cached is None:
-        cached = _ARRAYS[graph] = _build_arrays(graph)
+        cached = _ARRAYS[graph] = _csr(graph, np.asarray(graph.valid_edges()))
     return cached
 
 
-def _build_arrays(graph: Graph) -> EdgeArrays:
+def lattice_arrays(graph: Graph) -> EdgeArrays:
+    """EdgeArrays of every lattice edge of ``graph`` (valid now or not), with their lengths: the
+    structure a planner that follows edits keeps (D* Lite). Not cached."""
+    return _csr(graph, np.asarray(graph.nbr) >= 0)
+
+
+def _csr(graph: Graph, selected: np.ndarray) -> EdgeArrays:
+    """EdgeArrays of the edge slots ``selected`` (bool[N, K]), in row-major (node, slot) order."""
     nbr = np.asarray(graph.nbr)
-    valid = np.asarray(graph.valid_edges())
     xy = np.asarray(graph.xy, dtype=np.float64)
-    rows, slots = np.nonzero(valid)
+    rows, slots = np.nonzero(selected)
     heads = nbr[rows, slots]
     if graph.is_grid:
         # Grid edge lengths are exactly the distance between cell centres (1 or sqrt 2); taking

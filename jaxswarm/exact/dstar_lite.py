@@ -27,7 +27,7 @@ import weakref
 import numpy as np
 
 from jaxswarm.exact import kernels
-from jaxswarm.exact._host import default_heuristic, heuristic_code
+from jaxswarm.exact._host import EdgeArrays, default_heuristic, heuristic_code, lattice_arrays
 from jaxswarm.exact.stats import SearchStats, make_solution
 from jaxswarm.graph import Graph
 from jaxswarm.paths import Solution, as_node
@@ -181,20 +181,14 @@ class DStarLite:
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class _Structure:
-    """Every lattice edge of a map (valid or not) as CSR arrays in slot order, cached per Graph:
-    ``edge[i, k]`` is slot k's edge index (-1 without neighbour), ``lengths`` f64[E] each edge's
-    length, ``valid`` bool[N, K] the graph's valid edges and ``cost`` f64[E] the lengths of the
-    valid ones, ``inf`` elsewhere (a planner's starting costs)."""
+    """A map's lattice, cached per Graph: ``arrays`` every lattice edge (valid or not,
+    :func:`~jaxswarm.exact._host.lattice_arrays`), ``edge[i, k]`` slot k's edge index (-1
+    without neighbour), ``nbr`` the lattice it was built from, ``valid`` bool[N, K] the graph's
+    valid edges and ``cost`` f64[E] the lengths of the valid ones, ``inf`` elsewhere (a planner's
+    starting costs)."""
 
-    indptr: np.ndarray
-    heads: np.ndarray
-    rev_indptr: np.ndarray
-    rev_tails: np.ndarray
-    rev_edge: np.ndarray
+    arrays: EdgeArrays
     edge: np.ndarray
-    lengths: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
     nbr: np.ndarray
     valid: np.ndarray
     cost: np.ndarray
@@ -207,26 +201,15 @@ def _structure(graph: Graph) -> _Structure:
     cached = _STRUCTURES.get(graph)
     if cached is not None:
         return cached
+    arrays = lattice_arrays(graph)
     nbr = np.asarray(graph.nbr)
-    xy = np.asarray(graph.xy, dtype=np.float64)
-    rows, slots = np.nonzero(nbr >= 0)
-    heads = nbr[rows, slots]
-    n = graph.num_nodes
-    if graph.is_grid:  # exact 1 and sqrt 2, as the other exact planners
-        lengths = np.hypot(*(xy[heads] - xy[rows]).T)
-    else:
-        lengths = np.asarray(graph.cost, dtype=np.float64)[rows, slots]
+    rows, slots = np.nonzero(nbr >= 0)  # the order of the arrays' edges
     edge = np.full(nbr.shape, -1, np.int64)
     edge[rows, slots] = np.arange(rows.shape[0])
-    order = np.argsort(heads, kind="stable")
     valid = np.asarray(graph.valid_edges())
     cached = _STRUCTURES[graph] = _Structure(
-        indptr=np.searchsorted(rows, np.arange(n + 1)).astype(np.int64),
-        heads=heads.astype(np.int32),
-        rev_indptr=np.searchsorted(heads[order], np.arange(n + 1)).astype(np.int64),
-        rev_tails=rows[order].astype(np.int32), rev_edge=order.astype(np.int64), edge=edge,
-        lengths=lengths, x=np.ascontiguousarray(xy[:, 0]), y=np.ascontiguousarray(xy[:, 1]),
-        nbr=nbr, valid=valid, cost=np.where(valid[rows, slots], lengths, np.inf))
+        arrays=arrays, edge=edge, nbr=nbr, valid=valid,
+        cost=np.where(valid[rows, slots], arrays.lengths, np.inf))
     return cached
 
 
@@ -238,7 +221,7 @@ class _Lattice:
         structure = _structure(graph)
         self.source = graph
         self.structure = structure
-        self.x, self.y = structure.x, structure.y
+        self.x, self.y = structure.arrays.x, structure.arrays.y
         self.valid = structure.valid
         self.cost = structure.cost.copy()
 
@@ -258,13 +241,13 @@ class _Lattice:
         self.valid = valid
         changed = self.structure.edge.reshape(-1)[flips]
         old = self.cost[changed]
-        self.cost[changed] = np.where(valid.reshape(-1)[flips], self.structure.lengths[changed],
-                                      np.inf)
+        self.cost[changed] = np.where(valid.reshape(-1)[flips],
+                                      self.structure.arrays.lengths[changed], np.inf)
         return changed, old
 
     def edges(self):
-        s = self.structure
-        return (s.indptr, s.heads, self.cost, s.rev_indptr, s.rev_tails, s.rev_edge)
+        a = self.structure.arrays
+        return (a.indptr, a.heads, self.cost, a.rev_indptr, a.rev_tails, a.rev_edge)
 
 
 @inline
