@@ -13,7 +13,10 @@ from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nea
 from jaxswarm.swarm import make_task, run
 
 
-@pytest.mark.parametrize("name", ["mosaic20", "alley20", "maze20"])
+@pytest.mark.parametrize("name", [
+    "mosaic20",
+    pytest.param("alley20", marks=pytest.mark.slow),  # the default suite keeps under ten minutes
+    pytest.param("maze20", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("table", [2, 3, 4, 5])
 def test_scenarios_change_the_optimum_as_described(name, table):
     scenario = paper_scenario(name, table)
