@@ -23,7 +23,8 @@ Written to ``--out`` (default ``out/rfd_paper_dynamic``; ``make reproduce`` uses
 ``results/rfd_paper_dynamic``), each file atomically: ``runs.csv`` (one row per map, table, row
 and seed), ``table.md`` (the provenance, then per table: path length, runs at the new optimum,
 time to stop and time to target, ours beside the paper's values), ``provenance.json`` and
-``table<T>.png`` (each map after the change, the changed cells marked, each row's best path).
+``table<T>.png`` (each map after the change, the changed cells marked, the optimal path before
+the change dashed, each row's best path after it).
 
 Run from the repository root::
 
@@ -47,7 +48,7 @@ from matplotlib import pyplot as plt
 
 from jaxswarm.atomic import write_atomically, write_csv
 from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
-from jaxswarm.exact import replanner
+from jaxswarm.exact import astar, replanner
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
 from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
@@ -243,6 +244,13 @@ def figure(best, table):
             if cells_:
                 xs, ys = zip(*cells_)
                 ax.scatter(xs, ys, marker=marker, s=12, color="tab:pink", zorder=3)
+        before = astar(chosen.graph(), chosen.start, chosen.goal)
+        label = f"before: optimal ({scenario.static_optimum:.2f})"
+        (line,) = draw_paths(ax, graph, [before], [label], colors=["dimgrey"], linewidth=1.5)
+        line.set(linestyle=(0, (2, 2)), zorder=6)
+        if scenario.goal is not None:
+            ax.plot(*chosen.goal, marker="x", color="dimgrey", markersize=8, zorder=6,
+                    linestyle="none", label="before: goal")
         for thinner, (label, solution) in enumerate(best[name][table].items()):
             cost = f"{float(solution.cost):.2f}" if bool(solution.found) else "no path"
             colour = static.COLORS.get(label, "black")
@@ -251,7 +259,8 @@ def figure(best, table):
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.03), ncols=2, frameon=False,
                   fontsize="small")
     fig.suptitle(f"RFD paper, Table {table}: the map after the change (pink: cells blocked "
-                 "(squares) or opened (diamonds)) and each algorithm's best path")
+                 "(squares) or opened (diamonds)),\nthe optimal path before it (dashed) and each "
+                 "algorithm's best path after it")
     return fig
 
 
