@@ -4,6 +4,9 @@
 exact planners and the swarm planners, prints a comparison table (length, optimality gap, work,
 time) and writes figures of the paths and of the swarms' memory and convergence.
 
+``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.robot`): a swarm
+and D* Lite re-plan whenever it finds one; it prints what each did and writes a GIF of the walk.
+
 ``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
 map.
@@ -11,6 +14,7 @@ map.
 from __future__ import annotations
 
 import argparse
+import re
 import statistics
 import sys
 import time
@@ -20,9 +24,12 @@ import jax
 
 from jaxswarm.cpu import configure
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
+from jaxswarm.graph import path_map_graph
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
+from jaxswarm.maps.random import random_path_map
 from jaxswarm.paths import as_node, path_length
+from jaxswarm.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
 from jaxswarm.swarm import make, make_task, registry, run
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
@@ -42,7 +49,8 @@ def main(argv: list[str] | None = None) -> int:
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
     demo.add_argument("--map", default="mosaic50",
-                      help=f"a paper map ({', '.join(PAPER_MAPS)}) or a Moving AI .map file")
+                      help=f"a paper map ({', '.join(PAPER_MAPS)}), a random path map "
+                           "pathmapWxH (e.g. pathmap20x20) or a Moving AI .map file")
     demo.add_argument("--start", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
     demo.add_argument("--repeats", type=int, default=5, help="runs per planner (median time)")
@@ -56,6 +64,24 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--out", type=Path,
                       help="figure path (default out/demo_MAP.png); each swarm's figure is "
                            "written beside it with the swarm's name appended")
+    robot = commands.add_parser("robot", help="a robot that finds hidden blocks and re-plans")
+    robot.add_argument("--map", default="maze20",
+                       help=f"a paper map ({', '.join(PAPER_MAPS)}), a random path map "
+                            "pathmapWxH (e.g. pathmap20x20, seeded by --seed) or a Moving AI "
+                            ".map file")
+    robot.add_argument("--start", type=_point, help="x,y (required with a .map file)")
+    robot.add_argument("--goal", type=_point, help="x,y (required with a .map file)")
+    robot.add_argument("--swarm", type=_swarm_names, default=("improved_max_min_aco",),
+                       help="the registered swarm that plans (default improved_max_min_aco)")
+    robot.add_argument("--memory", choices=MEMORY, default="keep",
+                       help="the swarm's memory at a re-plan: kept (adapted) or wiped")
+    robot.add_argument("--blocks", type=int, default=2, help="hidden blocks on the robot's way")
+    robot.add_argument("--seed", type=int, default=0, help="seed of the blocks and the swarm")
+    robot.add_argument("--iterations", type=int, default=100, help="iterations per plan")
+    robot.add_argument("--max-plans", type=int, default=16, help="plans at most")
+    robot.add_argument("--out", type=Path,
+                       help="GIF of the swarm's walk (default out/robot_MAP.gif); a PNG of the "
+                            "whole walk is written beside it")
     sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
     sweep.add_argument("file", type=Path, help="the sweep spec (TOML)")
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
@@ -68,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
         except (ValueError, RuntimeError) as error:
             parser.error(f"--threads: {error}")
     try:
-        return run_demo(args) if args.command == "demo" else run_sweep_command(args)
+        command = {"demo": run_demo, "robot": run_robot, "sweep": run_sweep_command}
+        return command[args.command](args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
     except KeyboardInterrupt:
@@ -154,6 +181,53 @@ def run_demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def run_robot(args: argparse.Namespace) -> int:
+    """Walk the robot with the swarm and with D* Lite, print the table and write the GIF."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib import pyplot as plt
+
+    from jaxswarm.plot_robot import animate_robot, plot_robot
+
+    name, graph, start, goal = _load(args)
+    for option in ("blocks", "iterations", "max_plans"):
+        if getattr(args, option) < 1:
+            raise ValueError(f"--{option.replace('_', '-')} must be at least 1, "
+                             f"got {getattr(args, option)}")
+    hidden = hidden_blocks(graph, start, goal, count=args.blocks, seed=args.seed)
+    optimum = check_world(graph, start, goal, hidden, name=name)
+    swarm = make(args.swarm[0])
+    print(f"map {name}: start {start} -> goal {goal}, {args.blocks} hidden blocks; optimum "
+          f"with full knowledge {optimum:.2f}")
+
+    def walk_swarm():
+        return jax.block_until_ready(swarm_robot(
+            swarm, jax.random.key(args.seed), graph, make_task(graph, start, goal), hidden,
+            swarm.default_params, iterations=args.iterations, max_plans=args.max_plans,
+            memory=args.memory))
+
+    walk_swarm()  # compile
+    began = time.perf_counter()
+    walk = walk_swarm()
+    seconds = time.perf_counter() - began
+    dstar_robot(graph, start, goal, hidden, max_plans=args.max_plans)  # compile the kernels
+    exact, exact_seconds = dstar_robot(graph, start, goal, hidden, max_plans=args.max_plans)
+    rows = [(f"{swarm_label(swarm.name)}, memory {args.memory}", walk, seconds),
+            ("D* Lite (repair)", exact, exact_seconds)]
+    print(_table(("planner", "reached", "travelled", "vs optimum", "plans", "time [ms]"),
+                 [(label, bool(w.reached), _fmt(w.travelled), _gap(float(w.travelled), optimum),
+                   int(w.plans), f"{1e3 * t:.2f}") for label, w, t in rows]))
+    figure = args.out if args.out is not None else Path("out") / f"robot_{name}.gif"
+    title = f"{name}, {swarm.name}: plan {{plan}}, move {{move}}"
+    animate_robot(graph, hidden, walk, figure, start=start, goal=goal, title=title)
+    still = figure.with_suffix(".png")
+    plt.close(plot_robot(graph, hidden, walk, start=start, goal=goal, path=still,
+                         title=f"{name}, {swarm.name}: {float(walk.travelled):.2f}"))
+    print(f"figures written to {figure} and {still}")
+    return 0
+
+
 def _run_swarm(swarm, graph, start, goal, args):
     """Run one swarm planner: compile once, then ``(state, trace, median ms)`` of
     ``args.repeats`` timed runs."""
@@ -177,14 +251,19 @@ def _load(args):
     if args.map in PAPER_MAPS:
         chosen = paper_map(args.map)
         return args.map, chosen.graph(), args.start or chosen.start, args.goal or chosen.goal
+    sized = re.fullmatch(r"pathmap(\d+)x(\d+)", args.map)
+    if sized:
+        width, height = (int(v) for v in sized.groups())
+        graph = path_map_graph(random_path_map(width, height, getattr(args, "seed", 0)))
+        return args.map, graph, args.start or (0, 0), args.goal or (width - 1, height - 1)
     if args.map.endswith(".map"):
         if args.start is None or args.goal is None:
             raise ValueError("--start and --goal are required with a .map file")
         if not Path(args.map).is_file():
             raise ValueError(f"--map {args.map}: no such file")
         return Path(args.map).stem, load_map(args.map), args.start, args.goal
-    raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)} or a .map file, "
-                     f"got {args.map!r}")
+    raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)}, pathmapWxH or a .map "
+                     f"file, got {args.map!r}")
 
 
 def _swarm_names(text: str) -> tuple[str, ...]:

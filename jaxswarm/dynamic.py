@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.edits import block_cells, unblock_cells
+from jaxswarm.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.graph import Graph
 from jaxswarm.paths import as_node, is_valid_path
 from jaxswarm.swarm.core import Swarm, Task, run
@@ -43,6 +43,9 @@ class Event(NamedTuple):
       goal: i32[] the new goal, -1: unchanged.
       block: i32[M] nodes that become obstacles, -1 padded.
       unblock: i32[M'] nodes that become free, -1 padded.
+      close: i32[E, 2] passages that get a thin wall, as (node, neighbour slot) pairs (both
+        directions close), -1 padded.
+      open: i32[E', 2] passages whose thin wall goes, likewise.
       num_nodes: i32[] the node count of the map the event was made for.
     """
 
@@ -50,35 +53,51 @@ class Event(NamedTuple):
     goal: jax.Array
     block: jax.Array
     unblock: jax.Array
+    close: jax.Array
+    open: jax.Array
     num_nodes: jax.Array
 
 
-def make_event(graph: Graph, *, start=None, goal=None, block=(), unblock=(),
-               size: int | None = None) -> Event:
+def make_event(graph: Graph, *, start=None, goal=None, block=(), unblock=(), close=(),
+               open=(), size: int | None = None) -> Event:
     """Host-side: an Event for ``graph``, points as (x, y) cells or node indices.
 
     Args:
       graph: the map the event is for.
       start, goal: the new start or goal (None: unchanged).
       block, unblock: cells that become obstacles, or free.
-      size: pad ``block`` and ``unblock`` to this length (events of one batch must agree).
+      close, open: passages that get, or lose, a thin wall: pairs of adjacent cells
+        ``(a, b)``, each an (x, y) cell or a node index.
+      size: pad each of ``block``, ``unblock``, ``close`` and ``open`` to this length (events
+        of one batch must agree).
 
     Raises:
-      ValueError: a point off the map; more cells than ``size``.
+      ValueError: a point off the map; a pair of cells that are not neighbours; more entries
+        than ``size``.
     """
-    def nodes(points, name):
-        indices = [as_node(graph, p, name=name, require_free=False) for p in points]
-        length = len(indices) if size is None else size
-        if len(indices) > length:
-            raise ValueError(f"{name}: {len(indices)} cells do not fit size={size}")
-        return jnp.asarray(indices + [NO_NODE] * (length - len(indices)), jnp.int32)
+    def padded(entries, name, blank):
+        length = len(entries) if size is None else size
+        if len(entries) > length:
+            raise ValueError(f"{name}: {len(entries)} entries do not fit size={size}")
+        rows = list(entries) + [blank] * (length - len(entries))
+        return jnp.asarray(rows, jnp.int32).reshape((length,) + np.shape(blank))
 
     def node(point, name):
         return NO_NODE if point is None else as_node(graph, point, name=name,
                                                      require_free=False)
 
+    def passage(pair, name):
+        a, b = (node(p, name) for p in pair)
+        slots = np.nonzero(np.asarray(graph.nbr[a]) == b)[0]
+        if not slots.size:
+            raise ValueError(f"{name}: cells {pair[0]} and {pair[1]} are not neighbours")
+        return (a, int(slots[0]))
+
     return Event(start=jnp.int32(node(start, "start")), goal=jnp.int32(node(goal, "goal")),
-                 block=nodes(block, "block"), unblock=nodes(unblock, "unblock"),
+                 block=padded([node(p, "block") for p in block], "block", NO_NODE),
+                 unblock=padded([node(p, "unblock") for p in unblock], "unblock", NO_NODE),
+                 close=padded([passage(p, "close") for p in close], "close", (NO_NODE,) * 2),
+                 open=padded([passage(p, "open") for p in open], "open", (NO_NODE,) * 2),
                  num_nodes=jnp.int32(graph.num_nodes))
 
 
@@ -97,12 +116,23 @@ def check_events(graph: Graph, task: Task, events: Event) -> None:
         if int(e.num_nodes) != n:
             raise ValueError(f"{name} was made for a map of {int(e.num_nodes)} nodes; this map "
                              f"has {n}")
-        for field in ("start", "goal", "block", "unblock"):
+        for field in ("start", "goal", "block", "unblock", "close", "open"):
             values = np.atleast_1d(getattr(e, field))
+            values = values[:, 0] if values.ndim == 2 else values
             off = (values != NO_NODE) & ((values < 0) | (values >= n))
             if off.any():
                 raise ValueError(f"{name}: {field} node {int(values[off][0])} is off the map "
                                  f"(nodes 0..{n - 1})")
+        for field in ("close", "open"):
+            pairs = getattr(e, field)
+            pairs = pairs[pairs[:, 0] >= 0]
+            slot_ok = (pairs[:, 1] >= 0) & (pairs[:, 1] < graph.max_degree)
+            lattice = slot_ok & (np.asarray(graph.nbr)[pairs[:, 0],
+                                                       np.where(slot_ok, pairs[:, 1], 0)] >= 0)
+            if not lattice.all():
+                a, k = pairs[~lattice][0]
+                raise ValueError(f"{name}: {field} passage (node {a}, slot {k}) is not an edge "
+                                 "of the map")
         after = free.copy()
         after[e.block[e.block >= 0]] = False
         after[e.unblock[e.unblock >= 0]] = True
@@ -115,11 +145,13 @@ def check_events(graph: Graph, task: Task, events: Event) -> None:
 
 
 def apply_event(event: Event, graph: Graph, task: Task) -> tuple[Graph, Task]:
-    """The map and the task after ``event`` (jittable; shapes unchanged). Cells are blocked
-    first, then unblocked."""
+    """The map and the task after ``event`` (jittable; shapes unchanged). Cells are blocked,
+    then unblocked, then passages closed, then opened."""
     n = graph.num_nodes
     graph = block_cells(graph, jnp.where(event.block >= 0, event.block, n))
     graph = unblock_cells(graph, jnp.where(event.unblock >= 0, event.unblock, n))
+    for edit, pairs in ((close_edges, event.close), (open_edges, event.open)):
+        graph = edit(graph, pairs[:, 0], jnp.maximum(pairs[:, 1], 0))  # -1 rows: ignored
     task = Task(start=jnp.where(event.start >= 0, event.start, task.start),
                 goal=jnp.where(event.goal >= 0, event.goal, task.goal))
     return graph, task

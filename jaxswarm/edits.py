@@ -41,7 +41,8 @@ def close_edges(graph: Graph, nodes, slots) -> Graph:
       slots: int or i32[M] neighbour slots (grid direction indices, see ``graph.DIRECTIONS``).
 
     Returns:
-      The map with both directions of each edge closed. Slots without a neighbour are ignored.
+      The map with both directions of each edge closed. Slots without a neighbour, and nodes
+      outside ``0..N-1`` (padding), are ignored.
     """
     return _set_edges(graph, nodes, slots, False)
 
@@ -57,9 +58,11 @@ def open_edges(graph: Graph, nodes, slots) -> Graph:
 def _set_edges(graph: Graph, nodes, slots, value: bool) -> Graph:
     nodes, slots = jnp.broadcast_arrays(jnp.asarray(nodes), jnp.asarray(slots))
     n = graph.num_nodes
-    target = graph.nbr[nodes, slots]
-    back_slot = graph.rev[nodes, slots]
-    exists = target >= 0
+    on_map = (nodes >= 0) & (nodes < n)
+    rows = jnp.where(on_map, nodes, 0)
+    target = graph.nbr[rows, slots]
+    back_slot = graph.rev[rows, slots]
+    exists = on_map & (target >= 0)
     # Indices of n (out of bounds) are dropped: JAX would wrap -1 to the last node.
     fwd_rows = jnp.where(exists, nodes, n)
     back_rows = jnp.where(exists & (back_slot >= 0), target, n)

@@ -295,14 +295,19 @@ def animate_field(graph: Graph, frames, path, *, start=None, goal=None, label=No
             ax.set_title(title.format(frame=t))
         return (image,)
 
-    animation = FuncAnimation(fig, show, frames=frames.shape[0], interval=interval_ms, blit=False)
+    save_gif(FuncAnimation(fig, show, frames=frames.shape[0], interval=interval_ms, blit=False),
+             path, interval_ms)
+    plt.close(fig)
+
+
+def save_gif(animation: FuncAnimation, path, interval_ms: int) -> None:
+    """Write ``animation`` as a GIF (Pillow), ``interval_ms`` between frames, atomically."""
     # Pillow picks the format from the file name, so the GIF is made under its own name in a
     # scratch folder, then moved into place whole.
     with tempfile.TemporaryDirectory() as scratch:
         made = Path(scratch) / "animation.gif"
         animation.save(made, writer=PillowWriter(fps=max(1, round(1000 / interval_ms))))
         write_atomically(path, made.read_bytes())
-    plt.close(fig)
 
 
 def save_png(fig: Figure, path) -> None:

@@ -36,6 +36,29 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
         assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+def test_robot_walks_a_path_map_with_a_swarm_and_dstar_and_writes_a_gif(tmp_path, capsys):
+    out = tmp_path / "robot.gif"
+    assert main(["robot", "--map", "pathmap10x10", "--swarm", "improved_max_min_aco",
+                 "--iterations", "10", "--seed", "2", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    optimum = float(re.search(r"optimum with full knowledge (\S+)", text).group(1))
+    for planner in ("Improved Max-Min ACO (paper), memory keep", "D* Lite (repair)"):
+        row = re.search(rf"^{re.escape(planner)}\s+(\S+)\s+(\S+)\s+(\S+)\s+(\d+)", text,
+                        re.MULTILINE)
+        assert row, f"no row for {planner} in:\n{text}"
+        reached, travelled, _, plans = row.groups()
+        assert reached == "True" and float(travelled) >= optimum - 0.01 and int(plans) >= 1
+    assert out.read_bytes()[:3] == b"GIF"
+    assert out.with_suffix(".png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_robot_names_a_bad_option_in_a_line(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["robot", "--map", "maze20", "--blocks", "0"])
+    assert exit_.value.code == 2
+    assert "jaxswarm robot: error: --blocks must be at least 1, got 0" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("arguments, message", [
     (["--map", "nowhere"], "--map must be one of"),
     (["--map", "nosuch.map", "--start", "1,1", "--goal", "2,2"], "--map nosuch.map: no such file"),

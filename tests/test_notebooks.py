@@ -169,4 +169,8 @@ def test_dynamic(notebook_env):
     gif = Path(result["gif"])
     assert gif.parent == notebook_env and gif.stat().st_size > 0
     assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a") and result["frames"] == 16
+    assert set(result["robot"]) == {"keep", "wipe", "D* Lite"}
+    assert all(walk["reached"] and walk["plans"] >= 2 for walk in result["robot"].values())
+    robot_gif = Path(result["robot_gif"])
+    assert robot_gif.parent == notebook_env and robot_gif.read_bytes()[:3] == b"GIF"
     assert count_images(nb) >= 2

@@ -23,6 +23,7 @@ from repo_scripts import ROOT, load_script
 
 provenance = load_script("sweeps/provenance.py")
 pathmaps = load_script("sweeps/aco_pathmaps.py")
+robot_study = load_script("sweeps/robot_study.py")
 
 # Folder -> (script, tiny arguments): the quick reproduction, smaller still than the Makefile's.
 # Both RFD tables run alley20 with the same sizes, so rfd_static reuses compiled runs.
@@ -37,6 +38,9 @@ TINY = {
     "rfd_paper_dynamic": ("sweeps/rfd_paper_dynamic.py",
                           ["--maps", "alley20", "--tables", "2", "--seeds", "1",
                            "--iterations", "2", "--patience", "1", "--agents", "8"]),
+    "robot_study": ("sweeps/robot_study.py",
+                    ["--maps", "pathmap10x10", "--seeds", "1", "--iterations", "3",
+                     "--patience", "2", "--max-plans", "4"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 
@@ -165,6 +169,23 @@ def test_path_map_ratios_are_to_ant_system(quick):
                              ("seconds", "mean_seconds")):
             assert float(r[f"{column}_vs_ant_system"]) == pytest.approx(
                 float(r[ours]) / float(baseline[ours]))
+
+
+def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
+    folder, _ = quick
+    rows = read_csv(folder / "robot_study" / "runs.csv")
+    labels = [row.label for row in robot_study.ROWS]
+    assert [r["algorithm"] for r in rows] == labels
+    for r in rows:
+        # Two hidden blocks on the way: at least one re-plan, never shorter than full knowledge.
+        assert r["reached"] == "True" and int(r["plans"]) >= 2
+        assert float(r["travelled"]) >= float(r["optimum"]) * (1 - 1e-6)
+        assert float(r["ratio"]) == pytest.approx(float(r["travelled"]) / float(r["optimum"]))
+    table = (folder / "robot_study" / "table.md").read_text()
+    assert all(f"| {label} | 1/1 |" in table for label in labels)
+    assert "What keeping the pheromone buys" in table
+    assert (folder / "robot_study" / "robot.gif").read_bytes()[:3] == b"GIF"
+    assert (folder / "robot_study" / "walks.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_path_map_table_has_the_papers_values_beside_ours(quick):

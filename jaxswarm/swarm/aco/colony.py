@@ -123,7 +123,8 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
       default_params: its default Params.
       update: the pheromone update (see :data:`Update`).
       init_best: optional ``(key, graph, task, pheromone, params, length) -> (path i32[length],
-        cost f32[])``: a first best path, found before the first population.
+        cost f32[])``: a first best path, found before the first population, and found again
+        after every change of the map or the task (see :func:`first_path_rule`).
       direction, goal_distance: the transition rule's terms (see :func:`transition_rule`).
       ties: a path as short as the best so far replaces it.
     """
@@ -149,10 +150,28 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
         return ACOState(key=key, pheromone=pheromone, best_path=best_path,
                         best_cost=best_cost), info
 
+    adapt = pheromone_rule if init_best is None else first_path_rule(init_best)
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=default_params, check_params=check_params,
                  memory=lambda state: state.pheromone.sum(axis=-1),
-                 memory_label="pheromone on a node's edges", adapt=pheromone_rule)
+                 memory_label="pheromone on a node's edges", adapt=adapt)
+
+
+def first_path_rule(init_best):
+    """The memory rule of a colony with a first ant (Improved Max-Min ACO): :func:`pheromone_rule`,
+    then the first ant walks again from the (new) start on the changed map, guided by the kept
+    pheromone, and its path becomes the best (the paper's Algorithm 1, where every re-plan
+    begins with the Bug2-like ant)."""
+    def rule(state: ACOState, before: Graph, after: Graph, old: Task, new: Task,
+             params) -> ACOState:
+        state = pheromone_rule(state, before, after, old, new, params)
+        key, first_key = jax.random.split(state.key)
+        best_path, best_cost = init_best(first_key, after, new, state.pheromone, params,
+                                         state.best_path.shape[0])
+        return ACOState(key=key, pheromone=state.pheromone, best_path=best_path,
+                        best_cost=best_cost)
+
+    return rule
 
 
 _RULES = {"rho": "positive", "q": "positive", "alpha": "non-negative", "beta": "non-negative",

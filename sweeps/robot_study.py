@@ -1,0 +1,284 @@
+"""The robot that finds blocked paths as it goes (the Max-Min ACO paper's Algorithm 1): planners
+compared on seeded random path maps and on the RFD paper's nine maps.
+
+Per map and seed, a world: the map the robot knows and ``--blocks`` hidden blocks it does not
+(:func:`jaxswarm.robot.hidden_blocks`: each on the shortest path of the world so far, so the
+robot meets them; passages with a thin wall on path maps, cells on the paper maps). Path maps
+are the Max-Min ACO paper's sizes (10x10, 20x20, 40x25), one random map per seed
+(:func:`jaxswarm.maps.random.random_path_map`, map seed = seed), from the top-left cell to the
+bottom-right one; the paper maps are fixed, their blocks drawn per seed.
+
+Rows: Improved Max-Min ACO as the paper has it (its pheromone kept at every re-plan, its Bug2-like
+first ant walking again from where the robot stands), the same with its memory wiped at every
+re-plan (what keeping the pheromone buys: the paper's claim), ``rfd_star`` (the RFD paper's
+RFD*, altitudes kept), ``rfd_graded`` (ours) and D* Lite repairing its search. Each plan of a
+swarm is a run of at most ``--iterations`` iterations with patience ``--patience``, continuing
+its memory (:func:`jaxswarm.robot.swarm_robot`); the robot stops at the goal or after
+``--max-plans`` plans.
+
+Measured per run: whether the robot reached the goal, the length it travelled against the
+optimum with full knowledge, the plans it made, and the planning time: a swarm's whole robot
+program (planning and walking, one jitted call, compiled once per map shape first), D* Lite's
+``solve`` and ``update`` calls.
+
+Written to ``--out`` (default ``out/robot_study``; ``make reproduce`` uses
+``results/robot_study``), each file atomically: ``runs.csv`` (one row per map, row and seed),
+``table.md`` (the provenance, one table per map, then keeping against wiping the memory),
+``provenance.json``, ``walks.png`` (seed 0's walk of Improved Max-Min ACO on every map) and
+``robot.gif`` (that walk on the 20x20 path map, or the first map).
+
+Run from the repository root::
+
+    python sweeps/robot_study.py
+    python sweeps/robot_study.py --maps pathmap10x10,maze20 --seeds 3
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import sys
+import time
+from pathlib import Path
+from typing import NamedTuple
+
+import jax
+import matplotlib
+
+matplotlib.use("Agg")
+from matplotlib import pyplot as plt
+
+from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.dynamic import Event
+from jaxswarm.graph import Graph, path_map_graph
+from jaxswarm.maps.paper import PAPER_MAPS, paper_map
+from jaxswarm.maps.random import random_path_map
+from jaxswarm.plot_robot import animate_robot, draw_robot
+from jaxswarm.plot import save_png
+from jaxswarm.robot import check_world, dstar_robot, hidden_blocks, swarm_robot
+from jaxswarm.swarm import definition, make, make_task
+
+HERE = str(Path(__file__).resolve().parent)
+if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
+    sys.path.insert(0, HERE)
+import provenance  # noqa: E402
+
+
+class Row(NamedTuple):
+    """One planner of the table: a registered swarm and what its memory does at a re-plan, or
+    None for D* Lite."""
+
+    label: str
+    swarm: str | None
+    memory: str = "keep"
+
+
+ROWS = (Row("Improved Max-Min ACO (paper: pheromone kept)", "improved_max_min_aco"),
+        Row("Improved Max-Min ACO (memory wiped)", "improved_max_min_aco", "wipe"),
+        Row("RFD* (paper)", "rfd_star"),
+        Row("RFD graded (ours)", "rfd_graded"),
+        Row("D* Lite (repair)", None))
+PATH_MAPS = {"pathmap10x10": (10, 10), "pathmap20x20": (20, 20), "pathmap40x25": (40, 25)}
+"""The Max-Min ACO paper's sizes (width, height)."""
+MAPS = (*PATH_MAPS, *PAPER_MAPS)
+COLUMNS = ("map", "algorithm", "planner", "memory", "seed", "blocks", "optimum", "travelled",
+           "ratio", "reached", "plans", "iterations", "moves", "seconds")
+"""Columns of runs.csv (``ratio``: travelled / optimum; ``seconds``: planning time)."""
+TITLE = "The robot that finds blocked paths as it goes (Max-Min ACO paper, Algorithm 1)"
+ABOUT = ("\"Improved Max-Min ACO (paper: pheromone kept)\" is the Max-Min ACO paper's planner and "
+         "re-planning rule; \"(memory wiped)\" is the same with fresh pheromone at every "
+         "re-plan, the paper's point of comparison. \"RFD* (paper)\" is the RFD paper's RFD*, "
+         "its altitudes kept by the RFD paper's rule; \"RFD graded (ours)\" is this project's "
+         "river law with its own memory rule; \"D* Lite (repair)\" is not in the paper.")
+
+
+class World(NamedTuple):
+    """One robot's world: the map it knows, its start and goal, the blocks it does not know,
+    and the optimum with full knowledge."""
+
+    known: Graph
+    start: tuple[int, int]
+    goal: tuple[int, int]
+    hidden: Event
+    optimum: float
+
+
+def world(name: str, seed: int, blocks: int) -> World:
+    """The world of map ``name`` (a path map size or a paper map) for ``seed``."""
+    if name in PATH_MAPS:
+        width, height = PATH_MAPS[name]
+        known = path_map_graph(random_path_map(width, height, seed))
+        start, goal = (0, 0), (width - 1, height - 1)
+    else:
+        chosen = paper_map(name)
+        known, start, goal = chosen.graph(), chosen.start, chosen.goal
+    hidden = hidden_blocks(known, start, goal, count=blocks, seed=seed)
+    optimum = check_world(known, start, goal, hidden, name=f"{name} seed {seed}")
+    return World(known, start, goal, hidden, optimum)
+
+
+def run_row(row: Row, worlds: list[World], *, iterations: int, patience: int,
+            max_plans: int) -> list[tuple]:
+    """``(walk, seconds)`` of ``row`` in each world (a swarm's program compiled first)."""
+    if row.swarm is None:
+        runs = [dstar_robot(w.known, w.start, w.goal, w.hidden, max_plans=max_plans)
+                for w in worlds[:1] + worlds]
+        return runs[1:]  # the first compiled the kernels
+    swarm = make(row.swarm)
+
+    def one(w, key):
+        task = make_task(w.known, w.start, w.goal)
+        began = time.perf_counter()
+        walk = jax.block_until_ready(swarm_robot(
+            swarm, key, w.known, task, w.hidden, swarm.default_params, iterations=iterations,
+            patience=patience, max_plans=max_plans, memory=row.memory))
+        return walk, time.perf_counter() - began
+
+    keys = jax.random.split(jax.random.key(0), len(worlds))
+    one(worlds[0], keys[0])  # compile
+    return [one(w, key) for w, key in zip(worlds, keys)]
+
+
+def study_map(name: str, *, seeds: int, blocks: int, **options) -> tuple[list[dict], dict]:
+    """Every row on map ``name``: (runs.csv rows, label -> seed 0's (world, walk))."""
+    worlds = [world(name, seed, blocks) for seed in range(seeds)]
+    rows, example = [], {}
+    for row in ROWS:
+        began = time.perf_counter()
+        for seed, (w, (walk, seconds)) in enumerate(zip(worlds, run_row(row, worlds,
+                                                                        **options))):
+            travelled = float(walk.travelled)
+            rows.append(dict(map=name, algorithm=row.label, planner=row.swarm or "replanner",
+                             memory=row.memory, seed=seed, blocks=blocks, optimum=w.optimum,
+                             travelled=travelled, ratio=travelled / w.optimum,
+                             reached=bool(walk.reached), plans=int(walk.plans),
+                             iterations=int(walk.iterations), moves=int(walk.moves),
+                             seconds=seconds))
+            if seed == 0:
+                example[row.label] = (w, walk)
+        print(f"{name:13} {row.label:45} {time.perf_counter() - began:.0f} s", flush=True)
+    return rows, example
+
+
+def map_table(rows: list[dict], name: str) -> list[str]:
+    """Markdown lines: one map's table."""
+    mine = [r for r in rows if r["map"] == name]
+    optimum = statistics.mean(r["optimum"] for r in mine)
+    lines = [f"### {name}", "", f"Mean optimum with full knowledge: {optimum:.2f}.", "",
+             "| algorithm | reached | travelled / optimum: mean (max) | plans: mean | "
+             "planning time [ms]: median | iterations: mean |",
+             "| --- | ---: | ---: | ---: | ---: | ---: |"]
+    for row in ROWS:
+        runs = [r for r in mine if r["algorithm"] == row.label]
+        if not runs:
+            continue
+        ratios = [r["ratio"] for r in runs if r["reached"]]
+        ratio = f"{statistics.mean(ratios):.3f} ({max(ratios):.3f})" if ratios else "-"
+        lines.append(
+            f"| {row.label} | {sum(r['reached'] for r in runs)}/{len(runs)} | {ratio} | "
+            f"{statistics.mean(r['plans'] for r in runs):.2f} | "
+            f"{1e3 * statistics.median(r['seconds'] for r in runs):.2f} | "
+            + (f"{statistics.mean(r['iterations'] for r in runs):.1f} |" if row.swarm else "- |"))
+    return lines
+
+
+def memory_table(rows: list[dict], maps) -> list[str]:
+    """Markdown lines: Improved Max-Min ACO keeping its pheromone against wiping it."""
+    keep, wipe = ROWS[0].label, ROWS[1].label
+    lines = ["## What keeping the pheromone buys (Improved Max-Min ACO, same worlds and seeds)",
+             "", "| map | planning time kept / wiped: median of the ratios | "
+             "iterations kept / wiped: mean | travelled kept - wiped: mean |",
+             "| --- | ---: | ---: | ---: |"]
+    for name in maps:
+        pairs = [(a, b) for a in rows for b in rows
+                 if a["map"] == b["map"] == name and a["seed"] == b["seed"]
+                 and a["algorithm"] == keep and b["algorithm"] == wipe]
+        if not pairs:
+            continue
+        time_ratio = statistics.median(a["seconds"] / b["seconds"] for a, b in pairs)
+        iterations = (statistics.mean(a["iterations"] for a, _ in pairs)
+                      / max(statistics.mean(b["iterations"] for _, b in pairs), 1e-9))
+        travelled = statistics.mean(a["travelled"] - b["travelled"] for a, b in pairs)
+        lines.append(f"| {name} | {time_ratio:.2f} | {iterations:.2f} | {travelled:+.2f} |")
+    return lines
+
+
+def markdown(rows: list[dict], maps, args) -> str:
+    """The Markdown body: the set-up, one table per map, then kept against wiped memory."""
+    parts = [f"{args.seeds} seeds, {args.blocks} hidden blocks per world, each plan at most "
+             f"{args.iterations} iterations with patience {args.patience}, at most "
+             f"{args.max_plans} plans. \"reached\": runs that reached the goal; travelled / "
+             "optimum over those runs (1 = what a robot that knew the blocks would walk). "
+             "Planning time: a swarm's whole robot program (compile excluded), D* Lite's "
+             "solve and update calls.", ""]
+    for name in maps:
+        parts += [*map_table(rows, name), ""]
+    parts += memory_table(rows, maps)
+    return "\n".join(parts) + "\n"
+
+
+def walks_figure(examples: dict) -> plt.Figure:
+    """Seed 0's walk of the first row on every map."""
+    names = list(examples)
+    columns = min(len(names), 4)
+    rows = math.ceil(len(names) / columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.5 * columns, 5.2 * rows), squeeze=False,
+                             layout="constrained")
+    for ax in axes.flat[len(names):]:
+        ax.set_visible(False)
+    label = ROWS[0].label
+    for name, ax in zip(names, axes.flat):
+        w, walk = examples[name][label]
+        draw_robot(ax, w.known, w.hidden, walk, start=w.start, goal=w.goal,
+                   title=f"{name}: {float(walk.travelled):.2f} (optimum {w.optimum:.2f})")
+    fig.suptitle(f"{label}, seed 0: the walk, the plan it ended on and the blocks it found")
+    return fig
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--maps", default="all",
+                        help=f"comma-separated, from {', '.join(MAPS)} (default all)")
+    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--blocks", type=int, default=2, help="hidden blocks per world")
+    parser.add_argument("--iterations", type=int, default=100, help="iterations per plan")
+    parser.add_argument("--patience", type=int, default=30)
+    parser.add_argument("--max-plans", type=int, default=16)
+    parser.add_argument("--out", type=Path, default=Path("out/robot_study"))
+    args = parser.parse_args(argv)
+    maps = MAPS if args.maps == "all" else tuple(args.maps.split(","))
+    unknown = [m for m in maps if m not in MAPS]
+    if unknown:
+        parser.error(f"--maps: unknown {', '.join(unknown)}; choose from {', '.join(MAPS)}")
+    for option in ("seeds", "blocks", "iterations", "patience", "max_plans"):
+        if getattr(args, option) < 1:
+            parser.error(f"--{option.replace('_', '-')} must be at least 1, "
+                         f"got {getattr(args, option)}")
+    record = provenance.begin(__file__, argv)
+    rows, examples = [], {}
+    for name in maps:
+        mine, examples[name] = study_map(name, seeds=args.seeds, blocks=args.blocks,
+                                         iterations=args.iterations, patience=args.patience,
+                                         max_plans=args.max_plans)
+        rows += mine
+    swarms = {row.label: dict(definition(make(row.swarm)), memory=row.memory)
+              for row in ROWS if row.swarm}
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args), swarms=swarms)
+    write_csv(args.out / "runs.csv", rows, COLUMNS)
+    text = record.document(markdown(rows, maps, args))
+    write_atomically(args.out / "table.md", text)
+    record.write(args.out)
+    fig = walks_figure(examples)
+    save_png(fig, args.out / "walks.png")
+    plt.close(fig)
+    shown = "pathmap20x20" if "pathmap20x20" in maps else maps[0]
+    w, walk = examples[shown][ROWS[0].label]
+    animate_robot(w.known, w.hidden, walk, args.out / "robot.gif", start=w.start, goal=w.goal,
+                  title=f"{shown}, {ROWS[0].label.split(' (')[0]}: plan {{plan}}, move {{move}}")
+    print("\n" + text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
