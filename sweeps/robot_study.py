@@ -244,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--blocks", type=int, default=2, help="hidden blocks per world")
     parser.add_argument("--iterations", type=int, default=100, help="iterations per plan")
     parser.add_argument("--patience", type=int, default=30)
-    parser.add_argument("--max-plans", type=int, default=16)
+    parser.add_argument("--max-plans", type=int, default=8)
     parser.add_argument("--out", type=Path, default=Path("out/robot_study"))
     args = parser.parse_args(argv)
     maps = MAPS if args.maps == "all" else tuple(args.maps.split(","))
