@@ -23,6 +23,11 @@ factor and both memories give the same walks.)
   whose paths are identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may
   send an agent elsewhere at a tie of cumulative weights).
 
+Water drops (``iwd``) change their soil at every step through the walker's hook, so the table
+is not fixed and the scalar reference does not apply: a second table times IWD's walks (soil at
+its start) beside ACO*'s (pheromone at its start) on the same map and layouts, and prints IWD's
+moves per second as a share of ACO*'s (``iwd / aco``: what the hook costs).
+
 Run from the repository root::
 
     python benchmarks/walk.py
@@ -49,7 +54,8 @@ import numpy as np
 from jaxswarm.lattice import slot_offsets
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, rfd, run
-from jaxswarm.swarm.walking import step_budget, walk
+from jaxswarm.swarm.iwd.soil import SOIL, goal_log_desirability
+from jaxswarm.swarm.walking import edge_table, step_budget, walk
 
 SCALAR_SOURCE = Path(__file__).parent / "scalar" / "walk.c"
 
@@ -146,6 +152,47 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
                 one_core=reference[1], all_cores=reference[os.cpu_count()], same=same)
 
 
+def timed_walks(walks, keys, repeats: int) -> tuple[float, int]:
+    """``(median seconds, moves)`` of ``walks(keys)`` over ``repeats`` runs after a warm-up."""
+    jax.block_until_ready(walks(keys))
+    times = []
+    for _ in range(repeats):
+        began = time.perf_counter()
+        result = jax.block_until_ready(walks(keys))
+        times.append(time.perf_counter() - began)
+    return statistics.median(times), int(result.moves.sum())
+
+
+def measure_drops(graph, task, drops: int, seeds: int, repeats: int) -> dict:
+    """Moves per second of IWD's walks (the soil hook) and of ACO*'s, same keys and layout."""
+    steps = step_budget(graph, None)
+    keys = jax.random.split(jax.random.key(1), seeds)
+    iwd_swarm, aco_swarm = make("iwd", num_agents=drops), make("aco_star", num_agents=drops)
+    soil = iwd_swarm.init(jax.random.key(0), graph, task, iwd_swarm.default_params).soil
+    drop_table = edge_table(graph, iwd_swarm.default_params.beta
+                            * goal_log_desirability(graph, task.goal))
+    aco_params = aco_swarm.default_params
+    pheromone = aco_swarm.init(jax.random.key(0), graph, task, aco_params).pheromone
+    ant_table = aco.transition_rule(graph, task, pheromone, aco_params, goal_distance=True)
+
+    @jax.jit
+    def drop_walks(keys):
+        return jax.vmap(lambda key: walk(key, graph, drop_table, task.start, task.goal,
+                                         num_agents=drops, max_steps=steps, hook=SOIL,
+                                         memory=soil, hook_params=iwd_swarm.default_params))(keys)
+
+    @jax.jit
+    def ant_walks(keys):
+        return jax.vmap(lambda key: walk(key, graph, ant_table, task.start, task.goal,
+                                         num_agents=drops, max_steps=steps))(keys)
+
+    rates = {}
+    for name, walks in (("iwd", drop_walks), ("aco_star", ant_walks)):
+        seconds, moves = timed_walks(walks, keys, repeats)
+        rates[name] = (seconds, moves, moves / seconds)
+    return rates
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default="maze100")
@@ -159,6 +206,8 @@ def main(argv: list[str] | None = None) -> int:
     chosen = paper_map(args.map)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
+    layouts = [tuple(int(part) for part in layout.split("x"))
+               for layout in args.layouts.split(",")]
     print(f"machine: {machine()}")
     print(f"walks on {args.map}, median of {args.repeats} runs after a warm-up compile; "
           f"reference: {SCALAR_SOURCE.name} on 1 and {os.cpu_count()} cores")
@@ -167,8 +216,6 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as directory:
         scalar = build_scalar(directory)
         for swarm_name in args.swarms.split(","):
-            layouts = [tuple(int(part) for part in layout.split("x"))
-                       for layout in args.layouts.split(",")]
             states = memories(swarm_name, graph, task, layouts[0][0], args.converge)
             for memory_name, memory in states.items():
                 for drops, seeds in layouts:
@@ -180,6 +227,15 @@ def main(argv: list[str] | None = None) -> int:
                           f"{r['one_core'] / 1e6:>5.1f} / {r['all_cores'] / 1e6:<5.1f} "
                           f"{r['rate'] / r['all_cores']:>6.2f} "
                           f"{r['same']:>6}/{r['agents']:<5}", flush=True)
+    print(f"\nwater drops (iwd, soil hook) beside ACO* on {args.map}, from their initial memory")
+    print(f"{'agents':>7} {'iwd ms':>8} {'moves':>9} {'M moves/s':>9} {'aco ms':>8} "
+          f"{'moves':>9} {'M moves/s':>9} {'iwd / aco':>9}")
+    for drops, seeds in layouts:
+        r = measure_drops(graph, task, drops, seeds, args.repeats)
+        (iwd_s, iwd_moves, iwd_rate), (aco_s, aco_moves, aco_rate) = r["iwd"], r["aco_star"]
+        print(f"{drops * seeds:>7} {1e3 * iwd_s:>8.1f} {iwd_moves:>9} {iwd_rate / 1e6:>9.2f} "
+              f"{1e3 * aco_s:>8.1f} {aco_moves:>9} {aco_rate / 1e6:>9.2f} "
+              f"{iwd_rate / aco_rate:>9.2f}", flush=True)
     return 0
 
 

@@ -347,7 +347,7 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
         cost = jnp.where(count >= first_path_at, 100.0, jnp.inf)
         cost = cost - sum(jnp.where(count >= t, 1.0, 0.0) for t in improvements)
         info = StepInfo(iteration_cost=cost, arrived=jnp.float32(0), converged=jnp.array(False),
-                        moves=jnp.int32(0), lane_steps=jnp.int32(0))
+                        moves=jnp.int32(0), lane_steps=jnp.int32(0), evaluations=jnp.int32(0))
         return (count, cost.astype(jnp.float32)), info
 
     def best(state):

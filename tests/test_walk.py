@@ -205,7 +205,7 @@ def test_a_batch_of_walks_shares_one_queue_and_walks_as_each_alone():
     for i in range(4):
         alone = one(keys[i], starts[i])
         for name, value in alone._asdict().items():
-            if name != "lane_steps":
+            if name != "lane_steps" and value is not None:  # state, memory: walks with a hook
                 np.testing.assert_array_equal(value, getattr(batch, name)[i], err_msg=name)
     assert int(batch.moves.sum()) <= int(batch.lane_steps[0])  # one loop's count for all
     assert int(one(keys[2], 143).lane_steps) == 0 and bool(batch.arrived[2].all())

@@ -59,6 +59,8 @@ class StepInfo(NamedTuple):
       moves: i32[] moves the agents made (the useful work of the walk).
       lane_steps: i32[] lane-steps the walk's loop executed (a batch of runs shares one loop,
         so under ``vmap`` each run gets the batch's total).
+      evaluations: i32[] complete paths whose length was evaluated: the agents that arrived
+        (the IWD paper's "fitness function calls").
     """
 
     iteration_cost: jax.Array
@@ -66,6 +68,7 @@ class StepInfo(NamedTuple):
     converged: jax.Array
     moves: jax.Array
     lane_steps: jax.Array
+    evaluations: jax.Array
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -118,6 +121,7 @@ class Trace:
       iterations: i32[] iterations actually run (<= T).
       moves: i32[T] moves the agents made in each iteration.
       lane_steps: i32[T] lane-steps of each iteration's walk (see :class:`StepInfo`).
+      evaluations: i32[T] complete paths evaluated in each iteration (fitness calls).
     """
 
     best_cost: jax.Array
@@ -126,11 +130,12 @@ class Trace:
     iterations: jax.Array
     moves: jax.Array
     lane_steps: jax.Array
+    evaluations: jax.Array
 
 
 jax.tree_util.register_dataclass(
     Trace, data_fields=["best_cost", "iteration_cost", "arrived", "iterations", "moves",
-                        "lane_steps"], meta_fields=[])
+                        "lane_steps", "evaluations"], meta_fields=[])
 
 
 def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
@@ -186,7 +191,7 @@ def _run(swarm, key, graph, task, params, iterations, patience, state, budget):
     nan = jnp.full((iterations,), jnp.nan, jnp.float32)
     counts = jnp.zeros((iterations,), jnp.int32)
     trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0),
-                  moves=counts, lane_steps=counts)
+                  moves=counts, lane_steps=counts, evaluations=counts)
     limit = iterations if patience is None else patience
 
     def keep_going(carry):
@@ -210,7 +215,8 @@ def _run(swarm, key, graph, task, params, iterations, patience, state, budget):
                       iteration_cost=trace.iteration_cost.at[t].set(info.iteration_cost),
                       arrived=trace.arrived.at[t].set(info.arrived),
                       iterations=t + 1, moves=trace.moves.at[t].set(info.moves),
-                      lane_steps=trace.lane_steps.at[t].set(info.lane_steps))
+                      lane_steps=trace.lane_steps.at[t].set(info.lane_steps),
+                      evaluations=trace.evaluations.at[t].set(info.evaluations))
         stale = jnp.where((after < before) | ~jnp.isfinite(after), 0, stale + 1)
         return state, trace, stale, info.converged
 
@@ -279,7 +285,7 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False):
     info = StepInfo(iteration_cost=cost,
                     arrived=jnp.mean(walk.arrived.astype(jnp.float32)),
                     converged=all_arrived & same_path, moves=jnp.sum(walk.moves),
-                    lane_steps=walk.lane_steps)
+                    lane_steps=walk.lane_steps, evaluations=jnp.sum(walk.arrived, dtype=jnp.int32))
     return (jnp.where(better, walk.path[winner], best_path), jnp.where(better, cost, best_cost),
             info)
 

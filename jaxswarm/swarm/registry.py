@@ -15,6 +15,7 @@ import numpy as np
 
 from jaxswarm.swarm.aco import ant_system, improved, max_min
 from jaxswarm.swarm.core import Swarm, SwarmConfig
+from jaxswarm.swarm.iwd import iwd
 from jaxswarm.swarm.rfd import graded, paper
 
 
@@ -50,6 +51,8 @@ REGISTRY: dict[str, Entry] = {
                          "Max-Min ACO paper, section 4"),
     "improved_max_min_aco": Entry(improved.ImprovedConfig, improved.build_improved_max_min_aco,
                                   "Improved Max-Min ACO", "Max-Min ACO paper, Algorithm 1"),
+    "iwd": Entry(iwd.IWDConfig, iwd.build_iwd, "IWD",
+                 "IWD_PG paper, eqs. 1-6 (Shah-Hosseini's IWD)"),
 }
 """Registered name -> :class:`Entry`."""
 

@@ -69,7 +69,8 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
       DataFrame, one row per (map, params, seed): ``map``, ``map_index``, ``run``, ``algorithm``,
       ``seed``, one column per swept param, ``cost`` (inf if no path), ``optimum``, ``gap``
       (relative), ``found``, ``success`` (gap < 1e-4), ``iterations`` (used), ``moves`` (made
-      by its agents, all iterations), ``chunk`` (the compiled batch the run was part of) and
+      by its agents, all iterations), ``evaluations`` (complete paths evaluated, all
+      iterations: fitness calls), ``chunk`` (the compiled batch the run was part of) and
       ``chunk_seconds`` (that whole chunk's wall time,
       compile excluded: the same in each of its rows; runs of a chunk run together, so no run
       has a time of its own).
@@ -126,10 +127,12 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 count = _chunk_runs(c, spec.chunk_size, num_runs)
                 inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
                 began = time.perf_counter()
-                cost, iterations, moves = _gather(compiled[program](*inputs, graph, task))
+                cost, iterations, moves, evaluations = _gather(
+                    compiled[program](*inputs, graph, task))
                 seconds = time.perf_counter() - began
                 rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
-                             cost[:count], iterations[:count], moves[:count], best, seconds)
+                             cost[:count], iterations[:count], moves[:count],
+                             evaluations[:count], best, seconds)
                 if writer:
                     store.write_chunk(m, c, rows)
                 bar.update(count)
@@ -169,13 +172,15 @@ def group_size(num_agents: int) -> int:
 
 def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
     """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], graph, task) -> (cost
-    f32[C], iterations i32[C], moves i32[C])``, C a multiple of the mesh size, the runs sharded
-    over the mesh's ``RUNS_AXIS``; each device maps over its runs ``group`` at a time."""
+    f32[C], iterations i32[C], moves i32[C], evaluations i32[C])``, C a multiple of the mesh
+    size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
+    ``group`` at a time."""
     def one(run_input, graph, task):
         seed, params = run_input
         state, trace = run(swarm, jax.random.key(seed), graph, task, params,
                            iterations=spec.iterations, patience=spec.patience)
-        return swarm.best(state).cost, trace.iterations, jnp.sum(trace.moves)
+        return (swarm.best(state).cost, trace.iterations, jnp.sum(trace.moves),
+                jnp.sum(trace.evaluations))
 
     def share(seeds, params, graph, task):
         return jax.lax.map(lambda run_input: one(run_input, graph, task), (seeds, params),
@@ -221,7 +226,7 @@ def _gather(outputs):
 
 
 def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, cost, iterations,
-          moves, best, seconds) -> dict:
+          moves, evaluations, best, seconds) -> dict:
     runs = np.arange(first, first + count)
     cost = np.asarray(cost, np.float64)
     found = np.isfinite(cost)
@@ -233,7 +238,7 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, c
         rows[name] = np.array([grid[r // len(seeds)][name] for r in runs], np.float64)
     rows.update(cost=cost, optimum=np.full(count, best), gap=gap, found=found,
                 success=found & (gap < SUCCESS_GAP), iterations=np.asarray(iterations, np.int32),
-                moves=np.asarray(moves, np.int64),
+                moves=np.asarray(moves, np.int64), evaluations=np.asarray(evaluations, np.int64),
                 chunk_seconds=np.full(count, seconds), chunk=np.full(count, chunk, np.int32))
     return rows
 

@@ -25,6 +25,11 @@ one set of lanes, instead of one lockstep loop per run that runs until the slowe
 agent stops. A run whose walk starts at its goal adds no agent to the queue: the run loop
 starts a finished run of a batch there, so its lanes go to the runs still going.
 
+Memory that changes during a walk (water drops' soil) goes through a per-step hook
+(:mod:`.hooks`): ``walk(..., hook=, memory=, hook_params=)`` returns the memory after the walk and
+each agent's own state. With a hook the lanes of one loop walk in lockstep, and which agents share
+a step depends on the lanes; the walk is still one deterministic function of its key.
+
 Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs, written
 in place as agents move and stop, are each agent's visited set (same layout), its slots
 ``i8[A, max_steps]`` and its path ``i32[A, max_steps + 1]``. Filling the padded outputs is most
@@ -33,7 +38,7 @@ of a large walk's memory traffic (about 40 ms of 120 for 16,384 agents on maze10
 from __future__ import annotations
 
 import functools
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -42,6 +47,7 @@ from jax.custom_batching import custom_vmap
 from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 from jaxswarm.swarm.walking import bits
+from jaxswarm.swarm.walking.hooks import Move, StepHook
 from jaxswarm.swarm.walking.sampler import sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 
@@ -85,6 +91,8 @@ class Walk(NamedTuple):
       lane_steps: i32[] lane-steps the loop executed (lanes times steps, summed over the loop's
         phases); ``sum(moves) / lane_steps`` is the share of the machine's work that moved an
         agent. A batch of walks shares one loop, so each gets the batch's total.
+      state: f32[A, E] each agent's own state when it stopped (with a hook; else None).
+      memory: the hook's memory after the walk (with a hook; else None).
     """
 
     path: jax.Array
@@ -96,6 +104,8 @@ class Walk(NamedTuple):
     visited: jax.Array
     moves: jax.Array
     lane_steps: jax.Array
+    state: Any = None
+    memory: Any = None
 
 
 def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) -> jax.Array:
@@ -106,7 +116,8 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
 
 
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
-         max_steps: int, greedy_agents: int = 0) -> Walk:
+         max_steps: int, greedy_agents: int = 0, hook: StepHook | None = None, memory=None,
+         hook_params=None) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal``.
 
     Args:
@@ -121,38 +132,46 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       max_steps: the step budget (static); paths hold ``max_steps + 1`` nodes.
       greedy_agents: how many agents (the first ones; static) always take their most likely
         admissible move, ties drawn at random, instead of sampling.
+      hook: memory that changes at every step (static; see :mod:`.hooks`), or None.
+      memory: the hook's memory before the walk (a pytree).
+      hook_params: the hook's numbers (a pytree of traced scalars).
 
     Returns:
       A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
     """
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
-    walks = _batched_walk(num_agents, max_steps, greedy_agents)(
+    memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
+                           for tree in (memory, hook_params))  # one run
+    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook)(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
-        jnp.asarray(goal, jnp.int32)[None])
+        jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)
 
 
 @functools.lru_cache(maxsize=None)
-def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int):
-    """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R]) -> Walk``
-    with a leading run axis R, whose ``vmap`` folds the mapped axis into R."""
-    shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
+def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None):
+    """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R], memory,
+    hook_params) -> Walk`` with a leading run axis R on everything but the graph (the table's
+    may be 1), whose ``vmap`` folds the mapped axis into R."""
+    shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
+                 hook=hook)
 
     @custom_vmap
-    def walk_runs(seed, graph, log_weights, start, goal):
-        return _walk_runs(seed, graph, log_weights, start, goal, **shape)
+    def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
+        return _walk_runs(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
 
     @walk_runs.def_vmap
-    def fold_runs(axis_size, in_batched, seed, graph, log_weights, start, goal):
-        seed_b, graph_b, *rest_b = in_batched
+    def fold_runs(axis_size, in_batched, seed, graph, log_weights, start, goal, memory,
+                  hook_params):
+        seed_b, graph_b, weights_b, start_b, goal_b, memory_b, params_b = in_batched
         if any(jax.tree_util.tree_leaves(graph_b)):
             # Walks on different maps cannot share a table of offsets: one loop per map.
             plain = functools.partial(_walk_runs, **shape)
             axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
                          for b in in_batched)
-            out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal)
+            out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal, memory,
+                                                hook_params)
             return out, jax.tree_util.tree_map(lambda _: True, out)
-        weights_b, start_b, goal_b = rest_b
 
         def fold(x, batched):
             """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
@@ -164,8 +183,11 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int):
         # One table for the whole batch stays one table (the walk reads it for every run).
         if weights_b or log_weights.shape[0] > 1:
             log_weights = fold(log_weights, weights_b)
+        memory, hook_params = (jax.tree_util.tree_map(fold, tree, batched) for tree, batched in
+                               ((memory, memory_b), (hook_params, params_b)))
         out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
-                                     walk_runs(seed, graph, log_weights, start, goal))
+                                     walk_runs(seed, graph, log_weights, start, goal, memory,
+                                               hook_params))
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return walk_runs
@@ -185,6 +207,7 @@ class Lanes(NamedTuple):
       walking: bool[l] still moving.
       arrived: bool[l] reached the goal.
       stuck: bool[l] stopped with no admissible neighbour.
+      state: f32[l, E] the agent's own state (with a hook; else None).
     """
 
     agent: jax.Array
@@ -196,6 +219,7 @@ class Lanes(NamedTuple):
     walking: jax.Array
     arrived: jax.Array
     stuck: jax.Array
+    state: Any = None
 
 
 class Results(NamedTuple):
@@ -210,45 +234,50 @@ class Results(NamedTuple):
     diagonal: jax.Array
     arrived: jax.Array
     stuck: jax.Array
+    state: Any = None
 
 
 class Loop(NamedTuple):
-    """The loop's carry: the lanes, the results, the queue's next entry and the lane-steps."""
+    """The loop's carry: the lanes, the results, the queue's next entry, the lane-steps and the
+    hook's memory (None without a hook)."""
 
     lanes: Lanes
     results: Results
     next_queued: jax.Array
     lane_steps: jax.Array
+    memory: Any = None
 
 
-def _walk_runs(seed, graph: Graph, log_weights, start, goal, *, num_agents: int, max_steps: int,
-               greedy_agents: int) -> Walk:
+def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
+               num_agents: int, max_steps: int, greedy_agents: int,
+               hook: StepHook | None) -> Walk:
     """The walks of R runs on one map through one queue (leading axis R on every input; the
     table's may be 1, one table for every run)."""
     runs = start.shape[0]
-    results, lane_steps = _walk_agents(
-        runs * num_agents, seed, graph, log_weights, start, goal,
-        num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents)
+    results, lane_steps, memory = _walk_agents(
+        runs * num_agents, seed, graph, log_weights, start, goal, memory, hook_params,
+        num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents, hook=hook)
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
     else:
         length = total_length(graph, results.path[:, :-1], results.slots)
     per_agent = dict(path=results.path, slots=results.slots, length=length,
                      arrived=results.arrived, stuck=results.stuck, position=results.position,
-                     visited=results.visited, moves=results.moves)
-    return Walk(**{name: x.reshape((runs, num_agents) + x.shape[1:])
+                     visited=results.visited, moves=results.moves, state=results.state)
+    return Walk(**{name: None if x is None else x.reshape((runs, num_agents) + x.shape[1:])
                    for name, x in per_agent.items()},
-                lane_steps=jnp.full((runs,), lane_steps, jnp.int32))
+                lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
 
 
-def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, num_agents: int,
-                 max_steps: int, greedy_agents: int):
+def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memory, hook_params,
+                 *, num_agents: int, max_steps: int, greedy_agents: int,
+                 hook: StepHook | None):
     """Walk the ``count`` agents of a batch of runs (agent ``f`` is agent ``f % num_agents`` of
     run ``f // num_agents``) in one loop: the agents of runs with somewhere to go are queued,
     the others keep their initial results.
 
     Returns:
-      ``(Results, lane_steps i32[])``, the results' rows in agent order.
+      ``(Results, lane_steps i32[], memory)``, the results' rows in agent order.
     """
     n = graph.num_nodes
     words = (n + 31) // 32
@@ -265,13 +294,21 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
         return bits.mark(jnp.zeros((nodes.shape[0], words), jnp.uint32),
                          jnp.arange(nodes.shape[0]), nodes)
 
+    def initial_state(run):
+        """f32[l, E] the hook's state of agents starting in runs ``run`` (None without one)."""
+        if hook is None:
+            return None
+        return jax.vmap(hook.initial_state)(jax.tree_util.tree_map(lambda p: p[run],
+                                                                   hook_params))
+
     here = start[run_of_row]
     results = Results(
         path=jnp.full((count, max_steps + 1), NO_NODE, jnp.int32),  # the start goes in last
         slots=jnp.full((count, max_steps), -1, slot_dtype),
         position=here, visited=start_visited(here),
         moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
-        arrived=here == goal[run_of_row], stuck=jnp.zeros((count,), bool))
+        arrived=here == goal[run_of_row], stuck=jnp.zeros((count,), bool),
+        state=initial_state(run_of_row))
 
     def fresh_lanes(queued):
         """Lanes holding the queue's entries ``queued`` (i32[l]; ``>= live``: none), at the
@@ -282,7 +319,8 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
         zeros = jnp.zeros(queued.shape, jnp.int32)
         return Lanes(agent=agent, run=run, position=start[run], visited=start_visited(start[run]),
                      moves=zeros, diagonal=zeros, walking=holds,
-                     arrived=jnp.zeros(queued.shape, bool), stuck=jnp.zeros(queued.shape, bool))
+                     arrived=jnp.zeros(queued.shape, bool), stuck=jnp.zeros(queued.shape, bool),
+                     state=initial_state(run))
 
     def neighbours_of(here):
         """i32[l, K] each lane's neighbours, clamped into the map: the slot offsets on grids
@@ -292,12 +330,16 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
             return jnp.clip(here[:, None] + offsets, 0, n - 1)
         return jnp.maximum(graph.nbr[here], 0)
 
-    def one_step(lanes: Lanes):
+    def one_step(lanes: Lanes, memory):
         here = lanes.position
         neighbours = neighbours_of(here)
         row = log_weights[lanes.run if log_weights.shape[0] > 1 else 0, here]
         seen = bits.is_marked(lanes.visited, neighbours)
         admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
+        if hook is not None:
+            params = jax.tree_util.tree_map(lambda p: p[lanes.run], hook_params)
+            rows = jax.tree_util.tree_map(lambda m: m[lanes.run, here], memory)
+            row = row + hook.log_weights(params, rows, admissible)
         within_run = lanes.agent % num_agents
         uniform = uniforms(seed[lanes.run], within_run, lanes.moves)
         greedy = within_run < greedy_agents if greedy_agents else None
@@ -307,6 +349,11 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
         there = jnp.where(moving, target, here)
         moves = lanes.moves + moving
         arrived_now = moving & (there == goal[lanes.run])
+        if hook is not None:
+            memory, state = hook.update(params, memory, Move(
+                run=lanes.run, agent=lanes.agent, here=here, slot=jnp.where(moving, choice, -1),
+                moving=moving, state=lanes.state), graph)
+            lanes = lanes._replace(state=state)
         lanes = lanes._replace(
             position=there,
             visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there),
@@ -315,8 +362,8 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
             walking=moving & ~arrived_now & (moves < max_steps),
             arrived=lanes.arrived | arrived_now,
             stuck=lanes.stuck | (lanes.walking & ~has_choice))
-        return lanes, jnp.where(moving, choice, -1).astype(slot_dtype), jnp.where(moving, there,
-                                                                                  NO_NODE)
+        return (lanes, memory, jnp.where(moving, choice, -1).astype(slot_dtype),
+                jnp.where(moving, there, NO_NODE))
 
     def block(loop: Loop) -> Loop:
         """``STEPS_PER_REFILL`` moves of every lane; the moves go to small step-major blocks
@@ -326,21 +373,21 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
         width = lanes.agent.shape[0]
 
         def step_into_blocks(i, inner):
-            lanes, slots, nodes = inner
-            lanes, slot, node = one_step(lanes)
-            return lanes, slots.at[i].set(slot), nodes.at[i].set(node)
+            lanes, memory, slots, nodes = inner
+            lanes, memory, slot, node = one_step(lanes, memory)
+            return lanes, memory, slots.at[i].set(slot), nodes.at[i].set(node)
 
         first_move = lanes.moves
         slots = jnp.full((STEPS_PER_REFILL, width), -1, slot_dtype)
         nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
-        lanes, slots, nodes = jax.lax.fori_loop(0, STEPS_PER_REFILL, step_into_blocks,
-                                                (lanes, slots, nodes))
+        lanes, memory, slots, nodes = jax.lax.fori_loop(
+            0, STEPS_PER_REFILL, step_into_blocks, (lanes, loop.memory, slots, nodes))
         row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
         column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
         results = loop.results._replace(
             slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
             path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
-        return loop._replace(lanes=lanes, results=results,
+        return loop._replace(lanes=lanes, results=results, memory=memory,
                              lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
 
     def retire(results: Results, lanes: Lanes, which) -> Results:
@@ -348,9 +395,11 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
         width = lanes.agent.shape[0]
         held = jnp.minimum(which, width - 1)
         row = jnp.where(which < width, lanes.agent[held], count)
+        kept = ("position", "visited", "moves", "diagonal", "arrived", "stuck") + (
+            ("state",) if hook is not None else ())
         return results._replace(**{
             name: getattr(results, name).at[row].set(getattr(lanes, name)[held], mode="drop")
-            for name in ("position", "visited", "moves", "diagonal", "arrived", "stuck")})
+            for name in kept})
 
     def stopped(lanes: Lanes):
         return (lanes.agent < count) & ~lanes.walking
@@ -384,7 +433,8 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
                              lanes=lanes._replace(agent=jnp.where(done, count, lanes.agent)))
 
     loop = Loop(lanes=fresh_lanes(jnp.arange(num_lanes)), results=results,
-                next_queued=jnp.minimum(jnp.int32(num_lanes), live), lane_steps=jnp.int32(0))
+                next_queued=jnp.minimum(jnp.int32(num_lanes), live), lane_steps=jnp.int32(0),
+                memory=memory)
     few = num_lanes // COMPACT_SHARE
 
     def keep_queueing(loop: Loop):
@@ -403,4 +453,4 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, *, nu
     # Written into the loop's output in place; set in the initial buffer, the start column made
     # XLA fill the whole buffer element by element (a third of a large walk's time).
     results = loop.results._replace(path=loop.results.path.at[:, 0].set(here))
-    return results, loop.lane_steps
+    return results, loop.lane_steps, loop.memory
