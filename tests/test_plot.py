@@ -282,7 +282,8 @@ def test_draw_trace_plots_the_run_and_the_optimum():
     trace = Trace(best_cost=jnp.array([jnp.inf, 12.0, 10.0, nan]),
                   iteration_cost=jnp.array([jnp.inf, 12.0, 10.5, nan]),
                   arrived=jnp.array([0.0, 0.2, 0.5, nan]), iterations=jnp.int32(3),
-                  moves=jnp.array([40, 31, 30, 0]), lane_steps=jnp.array([64, 48, 48, 0]))
+                  moves=jnp.array([40, 31, 30, 0]), lane_steps=jnp.array([64, 48, 48, 0]),
+                  evaluations=jnp.array([0, 2, 5, 0]))
     fig, ax = plt.subplots()
     best, each, optimum = draw_trace(ax, trace, optimum=9.5)
     np.testing.assert_array_equal(best.get_xdata(), [1, 2, 3])
