@@ -4,8 +4,8 @@ compared on seeded random path maps and on the RFD paper's nine maps.
 Per map and seed, a world: the map the robot knows and ``--blocks`` hidden blocks it does not
 (:func:`jaxswarm.robot.hidden_blocks`: each on the shortest path of the world so far, so the
 robot meets them; passages with a thin wall on path maps, cells on the paper maps; fewer where
-no more keep the goal reachable, as on a perfect maze's single way, counted in ``blocks``). Path maps
-are the Max-Min ACO paper's sizes (10x10, 20x20, 40x25), one random map per seed
+no more keep the goal reachable, as on a perfect maze's single way, counted in ``blocks``).
+Path maps are the Max-Min ACO paper's sizes (10x10, 20x20, 40x25), one random map per seed
 (:func:`jaxswarm.maps.random.random_path_map`, map seed = seed), from the top-left cell to the
 bottom-right one; the paper maps are fixed, their blocks drawn per seed.
 
