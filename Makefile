@@ -46,12 +46,14 @@ PATHMAPS_FULL := --sizes 10x10,20x20,40x25 --runs 10 --ants 50 --max-ants 5000 -
 EXACT_FULL := --sizes 10:100:5 --grids 1000
 DYNAMIC_FULL := --maps all --seeds 20 --iterations 100 --patience 30 --agents 256
 ROBOT_FULL := --maps all --seeds 20 --blocks 2 --iterations 100 --patience 30 --max-plans 8
+IWD_FULL := --maps all --seeds 20 --drops 50 --iterations 100 --patience 30
 TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
 RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
 EXACT_QUICK := --sizes 10:20:5 --grids 5
 DYNAMIC_QUICK := --maps mosaic20 --tables 2,3 --seeds 2 --iterations 5 --patience 5 --agents 32
 ROBOT_QUICK := --maps pathmap10x10,maze20 --seeds 2 --iterations 10 --patience 5 --max-plans 8
+IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 min on 2 cores, plus the dynamic tables)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
@@ -59,6 +61,7 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
 	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_FULL) --out $(RESULTS)/rfd_paper_dynamic
 	$(BIN)/python sweeps/robot_study.py $(ROBOT_FULL) --out $(RESULTS)/robot_study
+	$(BIN)/python sweeps/iwd_paper_maps.py $(IWD_FULL) --out $(RESULTS)/iwd_paper_maps
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/provenance.py $(RESULTS)
 
@@ -68,6 +71,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_QUICK) --out $(QUICK_OUT)/aco_pathmaps
 	$(BIN)/python sweeps/rfd_paper_dynamic.py $(DYNAMIC_QUICK) --out $(QUICK_OUT)/rfd_paper_dynamic
 	$(BIN)/python sweeps/robot_study.py $(ROBOT_QUICK) --out $(QUICK_OUT)/robot_study
+	$(BIN)/python sweeps/iwd_paper_maps.py $(IWD_QUICK) --out $(QUICK_OUT)/iwd_paper_maps
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 

@@ -41,6 +41,9 @@ TINY = {
     "robot_study": ("sweeps/robot_study.py",
                     ["--maps", "pathmap10x10", "--seeds", "1", "--iterations", "3",
                      "--patience", "2", "--max-plans", "4"]),
+    "iwd_paper_maps": ("sweeps/iwd_paper_maps.py",
+                       ["--maps", "maze20", "--seeds", "2", "--iterations", "3",
+                        "--patience", "2", "--drops", "8"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 
@@ -186,6 +189,18 @@ def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
     assert "What keeping the pheromone buys" in table
     assert (folder / "robot_study" / "robot.gif").read_bytes()[:3] == b"GIF"
     assert (folder / "robot_study" / "walks.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
+    folder, _ = quick
+    rows = read_csv(folder / "iwd_paper_maps" / "runs.csv")
+    assert [(r["map"], r["seed"]) for r in rows] == [("maze20", "0"), ("maze20", "1")]
+    for r in rows:
+        assert float(r["cost"]) >= float(r["optimum"]) * (1 - 1e-6)
+        # At most one fitness call per drop and iteration.
+        assert 0 <= int(r["evaluations"]) <= 8 * int(r["iterations"])
+        assert (r["found"] == "True") == (int(r["evaluations"]) > 0)
+    assert "| maze20 | 78.00 |" in (folder / "iwd_paper_maps" / "table.md").read_text()
 
 
 def test_path_map_table_has_the_papers_values_beside_ours(quick):
