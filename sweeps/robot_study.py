@@ -168,13 +168,15 @@ def study_map(name: str, *, seeds: int, blocks: int, **options) -> tuple[list[di
     return rows, example
 
 
-def map_table(rows: list[dict], name: str) -> list[str]:
-    """Markdown lines: one map's table."""
+def map_table(rows: list[dict], name: str, blocks: int) -> list[str]:
+    """Markdown lines: one map's table (``blocks`` hidden blocks asked for)."""
     mine = [r for r in rows if r["map"] == name]
     optimum = statistics.mean(r["optimum"] for r in mine)
-    fewer = sorted({r["seed"] for r in mine if r["blocks"] < max(x["blocks"] for x in mine)})
-    note = (f" Seeds {', '.join(map(str, fewer))}: fewer hidden blocks (no more kept the goal "
-            "reachable)." if fewer else "")
+    fewer = sorted({(r["seed"], r["blocks"]) for r in mine if r["blocks"] < blocks})
+    note = ("" if not fewer else " Fewer hidden blocks where no more kept the goal reachable: "
+            + ", ".join(f"seed {seed} {count}" for seed, count in fewer) + ".")
+    if len(fewer) == len({r["seed"] for r in mine}) and len({c for _, c in fewer}) == 1:
+        note = f" {fewer[0][1]} hidden block(s) in every world: no more kept the goal reachable."
     lines = [f"### {name}", "", f"Mean optimum with full knowledge: {optimum:.2f}.{note}", "",
              "| algorithm | reached | travelled / optimum: mean (max) | plans: mean | "
              "planning time [ms]: median | iterations: mean |",
@@ -223,7 +225,7 @@ def markdown(rows: list[dict], maps, args) -> str:
              "Planning time: a swarm's whole robot program (compile excluded), D* Lite's "
              "solve and update calls.", ""]
     for name in maps:
-        parts += [*map_table(rows, name), ""]
+        parts += [*map_table(rows, name, args.blocks), ""]
     parts += memory_table(rows, maps)
     return "\n".join(parts) + "\n"
 
