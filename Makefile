@@ -31,13 +31,13 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # The generated tables of results/ (see results/README.md), one script each; every script writes
 # its Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and
 # sweeps/provenance.py then indexes them in results/README.md. The full run is the scripts'
-# paper-size defaults, spelled out: Table 1 and the RFD table on all nine paper maps with 20 seeds,
-# 100 iterations and 256 agents; the path maps 10x10, 20x20 and 40x25 with 10 runs of populations
-# of 50 ants; the A* study on 1000 grids per size 10..100. Measured: 23 min on 2 cores (AMD EPYC,
-# shared with other work, load 1.5-4): Table 1 6.5 min, RFD table 2.8 min, path maps 0.3 min,
-# A* study 13.6 min (29 min in an earlier run under load 3-6) with the planners of 0.3.0 in
-# plain Python; compiled (0.4.0) it took about 4 min. The dynamic tables (rfd_paper_dynamic, 0.4.0)
-# have not been run at full size yet: about eight times Table 1's runs.
+# paper-size defaults, spelled out: Table 1, the RFD table, the dynamic Tables 2-5 and IWD on all
+# nine paper maps with 20 seeds (100 iterations, 256 drops or ants, 50 water drops); the path maps
+# 10x10, 20x20 and 40x25 with 10 runs of populations of 50 ants; the robot study on the three
+# path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size
+# 10..100. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with other work, load
+# 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables 63 min, robot study
+# 13-17 min, IWD 1 min, A* study about 5 min alone: about 100 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -55,7 +55,7 @@ DYNAMIC_QUICK := --maps mosaic20 --tables 2,3 --seeds 2 --iterations 5 --patienc
 ROBOT_QUICK := --maps pathmap10x10,maze20 --seeds 2 --iterations 10 --patience 5 --max-plans 8
 IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
 
-reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: 23-29 min on 2 cores, plus the dynamic tables)
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 100 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
