@@ -1,7 +1,9 @@
 """The walker shared by every swarm: the loop of queued agents over busy lanes (:mod:`.loop`),
 its random streams (:mod:`.streams`), the masked sampler (:mod:`.sampler`), packed visited sets
-(:mod:`.bits`) and what algorithms hand it (:mod:`.tables`: edge tables, safe neighbour gathers
-and values, the goal heuristic, the step budget)."""
+(:mod:`.bits`), what algorithms hand it (:mod:`.tables`: edge tables, safe neighbour gathers
+and values, the goal heuristic, the step budget) and the per-step hook for memory that changes
+while the agents walk (:mod:`.hooks`)."""
+from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, STEPS_PER_REFILL, Walk,
                                          visited_nodes, walk)
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
@@ -9,6 +11,7 @@ from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
                                            neighbour_slots, step_budget)
 
-__all__ = ["COMPACT_SHARE", "FORCED", "LANES", "STEPS_PER_REFILL", "Walk", "edge_table",
-           "goal_log_distance", "heads", "neighbour_slots", "sample_masked",
-           "step_budget", "uniforms", "visited_nodes", "walk"]
+__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "STEPS_PER_REFILL",
+           "StepHook", "Walk", "edge_groups", "edge_table", "goal_log_distance", "heads",
+           "neighbour_slots", "sample_masked", "step_budget", "uniforms", "visited_nodes",
+           "walk"]
