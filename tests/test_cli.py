@@ -37,6 +37,7 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
         assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow  # the robot program's compile and a GIF, about 20 s
 def test_robot_walks_a_path_map_with_a_swarm_and_dstar_and_writes_a_gif(tmp_path, capsys):
     out = tmp_path / "robot.gif"
     assert main(["robot", "--map", "pathmap10x10", "--swarm", "improved_max_min_aco",

@@ -134,7 +134,7 @@ def test_bad_params_are_named():
 
 def test_every_run_counts_its_fitness_calls():
     graph = grid_graph(np.zeros((4, 4), bool))
-    for name in ("iwd", "rfd_star", "aco_star"):
+    for name in ("iwd", "aco_star"):
         swarm = make(name, num_agents=8)
         _, trace = run(swarm, jax.random.key(2), graph, make_task(graph, 0, 15),
                        swarm.default_params, iterations=5)

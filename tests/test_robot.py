@@ -97,9 +97,10 @@ def test_dstar_robot_takes_the_detour_a_hand_count_gives():
     assert int(walk.seen.start[0]) == 16 and 17 in np.asarray(walk.seen.block[0]).tolist()
 
 
-@pytest.mark.parametrize("name, memory", [("improved_max_min_aco", "keep"),
-                                          ("improved_max_min_aco", "wipe"),
-                                          ("rfd_star", "keep"), ("rfd_graded", "keep")])
+@pytest.mark.parametrize("name, memory", [
+    ("improved_max_min_aco", "keep"),
+    pytest.param("improved_max_min_aco", "wipe", marks=pytest.mark.slow),
+    pytest.param("rfd_star", "keep", marks=pytest.mark.slow), ("rfd_graded", "keep")])
 def test_swarm_robot_reaches_the_goal_without_crossing_a_block(name, memory):
     known, start, goal, hidden = detour_world()
     swarm = make(name, num_agents=32)
@@ -144,6 +145,7 @@ def test_improved_first_ant_walks_again_from_the_new_start():
                                np.asarray(state.pheromone)[kept])
 
 
+@pytest.mark.slow  # two compiles of the robot program, about 25 s
 def test_vmap_over_keys_maps_and_hidden_blocks_equals_a_loop():
     worlds = []
     for seed in range(3):

@@ -30,7 +30,18 @@ def maze():
         graph, chosen.start, chosen.goal)
 
 
-@pytest.mark.parametrize("name", swarms.registered())
+SLOW_CONFORMANCE = {"rfd", "ant_system", "iwd"}
+"""Swarms whose heavier conformance checks (reproducible under vmap, compiled once for a sweep)
+run with the slow checks, to keep the default suite under ten minutes; their rule siblings
+(rfd_star, aco_star, ...) and every swarm's validity check stay in it."""
+
+
+def conformance(names):
+    return [pytest.param(name, marks=pytest.mark.slow) if name in SLOW_CONFORMANCE else name
+            for name in names]
+
+
+@pytest.mark.parametrize("name", conformance(swarms.registered()))
 def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
     graph, task, _ = maze
     check_reproducible(make(name, **SMALL), graph, task, iterations=ITERATIONS)
@@ -42,12 +53,13 @@ def test_results_are_valid_and_never_beat_the_optimum(name, maze):
     check_valid_results(make(name, **SMALL), graph, task, optimum, iterations=ITERATIONS)
 
 
-@pytest.mark.parametrize("name", swarms.registered())
+@pytest.mark.parametrize("name", conformance(swarms.registered()))
 def test_a_sweep_over_sixteen_params_compiles_once(name, maze):
     graph, task, _ = maze
     check_compiles_once(make(name, **SMALL), graph, task)
 
 
+@pytest.mark.slow  # about 25 s
 def test_the_conformance_suite_catches_a_swarm_that_breaks_it(maze):
     graph, task, optimum = maze
     swarm = make("rfd_graded", **SMALL)
@@ -320,6 +332,7 @@ def test_rfd_star_options_are_checked():
         make("rfd_star", climb=0.3)
 
 
+@pytest.mark.slow  # every registered swarm compiled, about 45 s
 def test_unreachable_goal_is_a_clean_not_found_result():
     obstacles = np.zeros((6, 6), bool)
     obstacles[:, 3] = True

@@ -268,6 +268,7 @@ def test_a_store_of_0_1_0s_rfd_star_is_not_resumed(finished, tmp_path):
     assert sorted(p.name for p in (old / "runs").iterdir()) == stamps  # nothing written
 
 
+@pytest.mark.slow  # about 30-40 s
 def test_the_vmap_size_changes_no_row_and_a_store_resumes_with_another(finished, tmp_path):
     spec, out, frame = finished
     # Chunks of 5 runs in groups of 2: two full groups and a remainder of one per chunk.
@@ -350,6 +351,7 @@ def sweep_command(spec: Path, out: Path):
             "sweep", str(spec), "--out", str(out), "--no-progress", "--no-plots"]
 
 
+@pytest.mark.slow  # about 30-40 s
 def test_a_killed_sweep_resumes_without_losing_or_repeating_a_chunk(tmp_path):
     spec = tmp_path / "killed.toml"
     spec.write_text(SLOW_SPEC)
@@ -392,6 +394,7 @@ SHARDED = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow  # about 30-40 s
 def test_sharding_over_four_cpu_devices_gives_identical_rows(finished, tmp_path):
     _, _, frame = finished
     out = tmp_path / "sharded"
