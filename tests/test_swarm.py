@@ -30,10 +30,10 @@ def maze():
         graph, chosen.start, chosen.goal)
 
 
-SLOW_CONFORMANCE = {"rfd", "ant_system", "iwd"}
+SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd"}
 """Swarms whose heavier conformance checks (reproducible under vmap, compiled once for a sweep)
-run with the slow checks, to keep the default suite under ten minutes; their rule siblings
-(rfd_star, aco_star, ...) and every swarm's validity check stay in it."""
+run with the slow checks, to keep the default suite under ten minutes; rfd_star, rfd_graded
+and aco_star's, and every swarm's validity check, stay in it."""
 
 
 def conformance(names):
