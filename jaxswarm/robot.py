@@ -33,7 +33,7 @@ from jaxswarm.dynamic import NO_NODE, Event, apply_event, change, make_event
 from jaxswarm.exact import astar, replanner
 from jaxswarm.graph import Graph
 from jaxswarm.paths import as_node, path_length, step_slots
-from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.core import Swarm, Task, make_task, run
 
 MEMORY = ("keep", "wipe")
 """What a swarm's memory does at a re-plan: adapted by its rule and kept, or started afresh."""
@@ -222,8 +222,7 @@ def dstar_robot(known: Graph, start, goal, hidden: Event, *,
       ``(walk, seconds)``: a :class:`RobotWalk` (host arrays; L = N) and the seconds spent in
       D* Lite's ``solve`` and ``update`` calls.
     """
-    task = Task(start=jnp.int32(as_node(known, start, name="start")),
-                goal=jnp.int32(as_node(known, goal, name="goal")))
+    task = make_task(known, start, goal)
     world = apply_event(hidden, known, task)[0]
     planner = replanner(known, int(task.start), int(task.goal))
     began = time.perf_counter()
@@ -307,11 +306,11 @@ def hidden_blocks(known: Graph, start, goal, *, count: int, seed: int,
     Raises:
       ValueError: fewer than ``count`` places keep the goal reachable.
     """
-    start, goal = as_node(known, start, name="start"), as_node(known, goal, name="goal")
+    task = make_task(known, start, goal)
+    start, goal = int(task.start), int(task.goal)
     if passages is None:
         passages = bool(np.all(np.asarray(known.free)))
     rng = np.random.default_rng(seed)
-    task = Task(start=jnp.int32(start), goal=jnp.int32(goal))
     cells, pairs = [], []
     world = known
     for placed in range(count):
