@@ -1,5 +1,5 @@
 """Intelligent Water Drops: each equation against a hand computation, the soil updates of drops
-that share an edge in one step applied in agent order, bit-identically, and the walker hook."""
+that share an edge in one step applied in lane order, bit-identically, and the walker hook."""
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -11,7 +11,7 @@ from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
 from jaxswarm.swarm.iwd.soil import SOIL, choice_log_weights, goal_log_desirability
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
-from jaxswarm.swarm.walking.hooks import Move, edge_groups
+from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, edge_groups
 
 P = DEFAULT_IWD
 EAST = 0  # slot of the move (x, y) -> (x + 1, y)
@@ -46,34 +46,59 @@ def test_velocity_and_soil_taken_are_eqs_4_and_5():
     assert slow == pytest.approx(1 / (0.01 + (1 / 1e-4) ** 2), rel=1e-5)
 
 
-def test_drops_on_one_edge_in_one_step_update_it_in_agent_order():
+def step_groups(run, here, slot, moving, runs, graph):
+    """The walker's grouping of one step's lanes (fresh claims), and the claims after it."""
+    run, here, slot = (jnp.asarray(x, jnp.int32) for x in (run, here, slot))
+    claims = jnp.full((runs * graph.num_nodes,), UNCLAIMED, jnp.int32)
+    return edge_groups(run, here, slot, jnp.asarray(moving), claims, graph.num_nodes,
+                       graph.max_degree)
+
+
+def test_edge_groups_match_a_count_by_brute_force():
+    graph = grid_graph(np.zeros((2, 2), bool))
+    rng = np.random.default_rng(3)
+    lanes, runs = 200, 3
+    run, here = rng.integers(0, runs, lanes), rng.integers(0, 4, lanes)
+    slot, moving = rng.integers(0, 3, lanes), rng.random(lanes) < 0.8
+    groups, claims = step_groups(run, here, slot, moving, runs, graph)
+    edge = [(r, h, s) if m else None for r, h, s, m in zip(run, here, slot, moving)]
+    rank = [sum(edge[j] == edge[i] for j in range(i)) if edge[i] else 0 for i in range(lanes)]
+    count = [edge.count(edge[i]) if edge[i] else 0 for i in range(lanes)]
+    assert groups.rank.tolist() == rank and groups.count.tolist() == count
+    assert groups.first.tolist() == [bool(m) and r == 0 for m, r in zip(moving, rank)]
+    values = rng.random(lanes).astype(np.float32)
+    want = [sum(values[j] for j in range(lanes) if edge[j] == edge[i]) if edge[i] else 0.0
+            for i in range(lanes)]
+    np.testing.assert_allclose(groups.group_sum(jnp.asarray(values)), want, rtol=1e-5)
+    assert np.all(np.asarray(claims) == UNCLAIMED)  # ready for the next step
+
+
+def test_drops_on_one_edge_in_one_step_update_it_in_lane_order():
     graph = grid_graph(np.zeros((1, 3), bool))
-    soil = jnp.full((1,) + graph.nbr.shape, 50.0)
-    velocities = jnp.array([300.0, 100.0, 200.0])
-    agents = jnp.array([2, 0, 1])  # lane 0 holds agent 2, lane 1 agent 0, lane 2 agent 1
-    move = Move(run=jnp.zeros(3, jnp.int32), agent=agents, here=jnp.zeros(3, jnp.int32),
-                slot=jnp.full((3,), EAST, jnp.int32), moving=jnp.ones(3, bool),
-                state=jnp.stack([velocities, jnp.zeros(3)], axis=-1))
-    groups = edge_groups(move, graph.num_nodes, graph.max_degree)
-    assert groups.rank.tolist() == [2, 0, 1] and groups.count.tolist() == [3, 3, 3]
-    assert groups.last.tolist() == [True, False, False]
-    np.testing.assert_allclose(groups.group_sum(jnp.array([1.0, 2.0, 4.0])), [7.0] * 3)
-    after, state = SOIL.update(per_lane(P, 3), soil, move, graph)
-    # By hand, in agent order (lanes 1, 2, 0), each drop's taken soil from the step's soil 50.
+    soil = jnp.full((2,) + graph.nbr.shape, 50.0)
+    velocities = jnp.array([300.0, 100.0, 200.0, 250.0])
+    # Lanes 0, 2 and 3 cross 0 -> 1 in run 0; lane 1 crosses it in run 1.
+    run, here = jnp.array([0, 1, 0, 0]), jnp.zeros(4, jnp.int32)
+    slot, moving = jnp.full((4,), EAST, jnp.int32), jnp.ones(4, bool)
+    groups, _ = step_groups(run, here, slot, moving, 2, graph)
+    assert groups.rank.tolist() == [0, 0, 1, 2] and groups.count.tolist() == [3, 1, 3, 3]
+    move = Move(run=run, agent=jnp.array([5, 0, 1, 2]), here=here, slot=slot, moving=moving,
+                state=jnp.stack([velocities, jnp.zeros(4)], axis=-1), groups=groups)
+    after, state = SOIL.update(per_lane(P, 4), soil, move, graph)
+    taken = [1 / (0.01 + (1 / (float(v) + 1 / (0.01 + 50.0 ** 2))) ** 2) for v in velocities]
     s = 50.0
-    taken = {}
-    for lane in (1, 2, 0):
-        v = float(velocities[lane]) + 1 / (0.01 + 50.0 ** 2)
-        taken[lane] = 1 / (0.01 + (1 / v) ** 2)
+    for lane in (0, 2, 3):  # by hand, in lane order, each drop's taken soil from the soil 50
         s = 0.1 * s - 0.9 * taken[lane]
     assert float(after[0, 0, EAST]) == pytest.approx(s, rel=1e-5)
-    np.testing.assert_allclose(np.asarray(state[:, 1]), [taken[0], taken[1], taken[2]],
-                               rtol=1e-6)
-    untouched = np.ones(graph.nbr.shape, bool)
-    untouched[0, EAST] = False
-    assert np.all(np.asarray(after[0])[untouched] == 50.0)
-    still = move._replace(moving=jnp.array([False, False, False]), slot=jnp.full((3,), -1))
-    same, kept = SOIL.update(per_lane(P, 3), soil, still, graph)
+    assert float(after[1, 0, EAST]) == pytest.approx(0.1 * 50.0 - 0.9 * taken[1], rel=1e-5)
+    np.testing.assert_allclose(np.asarray(state[:, 1]), taken, rtol=1e-6)
+    untouched = np.ones(after.shape, bool)
+    untouched[:, 0, EAST] = False
+    assert np.all(np.asarray(after)[untouched] == 50.0)
+    still = jnp.zeros(4, bool)
+    move = move._replace(moving=still, slot=jnp.full((4,), -1),
+                         groups=step_groups(run, here, slot, still, 2, graph)[0])
+    same, kept = SOIL.update(per_lane(P, 4), soil, move, graph)
     assert np.array_equal(np.asarray(same), np.asarray(soil))
     assert np.array_equal(np.asarray(kept), np.asarray(move.state))
 

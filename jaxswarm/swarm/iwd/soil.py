@@ -10,9 +10,10 @@ taken. Moving ``i -> j`` (all drops of a lockstep step read the soil as it was a
 * soil taken (eq. 5): ``dsoil = a_s / (b_s + c_s * time^2)``, ``time = HUD(i, j) / max(eps_v,
   vel)`` with the velocity after the move and HUD the edge's length;
 * local update (eq. 6): ``soil(i, j) = (1 - rho_n) * soil(i, j) - rho_n * dsoil``; the drop's
-  soil ``+= dsoil``. Drops crossing one edge in one step apply their updates in agent order:
-  with ``c`` of them, ``soil = (1 - rho_n)^c soil - rho_n * sum_r (1 - rho_n)^(c - 1 - r)
-  dsoil_r`` over their ranks ``r``;
+  soil ``+= dsoil``. Drops crossing one edge in one step apply their updates one after another
+  in the order of the walker's lanes (:mod:`~jaxswarm.swarm.walking.hooks`): with ``c`` of
+  them, ``soil = (1 - rho_n)^c soil - rho_n * sum_r (1 - rho_n)^(c - 1 - r) dsoil_r`` over
+  their ranks ``r``;
 * global update of the iteration-best path (``N_IB`` nodes, its drop's soil ``soil_IB``), on its
   edges: ``soil = (1 + rho_IWD) * soil - rho_IWD * soil_IB / (N_IB - 1)``.
 
@@ -27,9 +28,10 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import Graph
+from jaxswarm.lattice import move_lengths
 from jaxswarm.paths import step_slots
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
-from jaxswarm.swarm.walking.hooks import Move, StepHook, edge_groups
+from jaxswarm.swarm.walking.hooks import Move, StepHook
 
 VELOCITY, CARRIED = 0, 1
 """Columns of a drop's state ``f32[2]``: its velocity and the soil it carries."""
@@ -38,9 +40,8 @@ VELOCITY, CARRIED = 0, 1
 def choice_log_weights(params, soil_rows, admissible) -> jax.Array:
     """f32[l, K] ``alpha * log f(soil(i, j))`` (eqs. 2-3) over each lane's admissible slots
     (0 elsewhere); ``params`` per lane (f32[l] fields)."""
-    smallest = jnp.min(jnp.where(admissible, soil_rows, jnp.inf), axis=-1, keepdims=True)
-    shift = jnp.where(smallest >= 0, 0.0, jnp.where(jnp.isfinite(smallest), smallest, 0.0))
-    g = soil_rows - shift
+    smallest = jnp.min(jnp.where(admissible, soil_rows, jnp.inf), axis=-1)
+    g = soil_rows - jnp.minimum(smallest, 0.0)[:, None]  # shifted only when negative
     log_f = -jnp.log(params.eps_s[:, None] + g)
     return jnp.where(admissible, params.alpha[:, None] * log_f, 0.0)
 
@@ -65,15 +66,17 @@ def local_update(params, soil, move: Move, graph: Graph):
     """Eqs. 4-6 for one lockstep step: ``(soil f32[R, N, K], states f32[l, 2])`` after the
     moves of ``move`` (``params`` per lane)."""
     slot = jnp.maximum(move.slot, 0)
+    # Gathered anew rather than picked from the rows the choice read: XLA then fuses a one-float
+    # gather here instead of the choice's whole row gather.
     before = soil[move.run, move.here, slot]
     velocity = velocity_after(params, move.state[:, VELOCITY], before)
-    taken = soil_taken(params, graph.cost[move.here, slot], velocity)
+    taken = soil_taken(params, move_lengths(graph, move.here, slot), velocity)
     keep = 1.0 - params.rho_n
-    groups = edge_groups(move, graph.num_nodes, graph.max_degree)
+    groups = move.groups
     removed = groups.group_sum(jnp.where(
         move.moving, params.rho_n * keep ** (groups.count - 1 - groups.rank) * taken, 0.0))
-    # The last drop of each edge's group writes the edge's soil once: no two writes collide.
-    row = jnp.where(groups.last, move.run, soil.shape[0])  # dropped
+    # The first drop of each edge's group writes the edge's soil once: no two writes collide.
+    row = jnp.where(groups.first, move.run, soil.shape[0])  # dropped
     soil = soil.at[row, move.here, slot].set(before * keep ** groups.count - removed,
                                              mode="drop", unique_indices=True)
     state = jnp.where(move.moving[:, None],

@@ -6,17 +6,17 @@ its velocity depend on the soil it finds. Such a swarm hands :func:`~.loop.walk`
 :class:`StepHook` (static), its ``memory`` (a pytree per run, e.g. soil ``f32[N, K]``) and its
 ``hook_params`` (traced numbers). At every lockstep step the walker
 
-1. adds ``hook.log_weights(...)`` (computed from the memory as it is at the start of the step)
-   to each agent's row of the fixed table, among the moves the table admits and the agent has
-   not visited;
-2. draws the moves;
+1. reads each lane's row of its run's memory at the lane's node (the memory as it is at the
+   start of the step) and adds ``hook.log_weights(...)`` of it to the lane's row of the fixed
+   table, among the moves the table admits and the agent has not visited;
+2. draws the moves and groups the lanes by the directed edge they cross (:func:`edge_groups`);
 3. lets ``hook.update(...)`` write the step's moves into the memory and into each agent's own
    state (``f32[E]`` per agent, e.g. velocity and carried soil), which the walk returns.
 
 Every agent of a step reads the memory as it was at the start of the step; the writes of agents
-that cross the same edge in one step are applied in agent order (:func:`edge_groups` groups
-them), so one key gives one bit-identical result. A swarm without a hook pays nothing: the
-walker's program is the same as before.
+that cross the same edge in one step are applied in the order of their lanes (the walker's lanes
+are a deterministic function of the walk's inputs), so one key gives one bit-identical result.
+A swarm without a hook pays nothing: the walker's program is the same as before.
 """
 from __future__ import annotations
 
@@ -24,6 +24,9 @@ from typing import Any, Callable, NamedTuple
 
 import jax
 import jax.numpy as jnp
+
+UNCLAIMED = jnp.iinfo(jnp.int32).max
+"""The value of every entry of the walker's claims buffer (:func:`edge_groups`) between steps."""
 
 
 class StepHook(NamedTuple):
@@ -33,9 +36,9 @@ class StepHook(NamedTuple):
       state_width: E, floats of state each agent carries.
       initial_state: ``(params) -> f32[E]``: an agent's state when it starts (``params`` one
         run's hook params).
-      log_weights: ``(params, memory_rows f32[l, K], admissible bool[l, K]) -> f32[l, K]``:
-        added to the fixed table's row of each lane's node (``params`` gathered per lane;
-        ``memory_rows`` each lane's node's row of its run's memory).
+      log_weights: ``(params, memory_rows, admissible bool[l, K]) -> f32[l, K]``: added to the
+        fixed table's row of each lane's node (``params`` per lane, f32[l] leaves;
+        ``memory_rows`` each lane's node's row of its run's memory, e.g. f32[l, K]).
       update: ``(params, memory, move: Move, graph) -> (memory, f32[l, E])``: the memory of
         every run (leading axis R) and the lanes' states after the step's moves.
 
@@ -49,6 +52,39 @@ class StepHook(NamedTuple):
     update: Callable[..., tuple[Any, jax.Array]]
 
 
+class EdgeGroups(NamedTuple):
+    """The lanes of one step grouped by the directed edge they cross (same run, node and slot),
+    in lane order within a group (see :func:`edge_groups`).
+
+    Attributes:
+      group: i32[l] per lane: its group's id, below ``num_groups`` (lanes that did not move
+        share one group of their own).
+      rank: i32[l] per lane: moving lanes of its group before it (0 if not moving).
+      count: i32[l] per lane: moving lanes of its group (0 if not moving).
+      moving: bool[l] the lane crosses an edge.
+      num_groups: how many group ids there are (static).
+    """
+
+    group: jax.Array
+    rank: jax.Array
+    count: jax.Array
+    moving: jax.Array
+    num_groups: int
+
+    @property
+    def first(self) -> jax.Array:
+        """bool[l]: the lane is the first of its group (one per crossed edge: the lane that
+        writes the edge's memory)."""
+        return self.moving & (self.rank == 0)
+
+    def group_sum(self, values: jax.Array) -> jax.Array:
+        """f32[l] per lane: the sum of ``values`` (f32[l]) over its group, summed in lane
+        order (0 for lanes that did not move)."""
+        sums = jax.ops.segment_sum(jnp.where(self.moving, values, 0.0), self.group,
+                                   num_segments=self.num_groups)
+        return jnp.where(self.moving, sums[self.group], 0.0)
+
+
 class Move(NamedTuple):
     """One lockstep step's moves, as a hook's ``update`` sees them (leading axis: the lanes).
 
@@ -59,6 +95,7 @@ class Move(NamedTuple):
       slot: i32[l] the slot it took, -1 if it did not move.
       moving: bool[l] it moved in this step.
       state: f32[l, E] its state before the move.
+      groups: the lanes grouped by the edge they cross (:class:`EdgeGroups`).
     """
 
     run: jax.Array
@@ -67,48 +104,48 @@ class Move(NamedTuple):
     slot: jax.Array
     moving: jax.Array
     state: jax.Array
+    groups: EdgeGroups
 
 
-class EdgeGroups(NamedTuple):
-    """The lanes of one step grouped by the directed edge they cross (same run, node and slot),
-    in agent order within a group; the lanes that did not move form one group of their own, last
-    (see :func:`edge_groups`).
+def edge_groups(run, here, slot, moving, claims, num_nodes: int, max_degree: int):
+    """Group one step's lanes by the directed edge of the same run they cross.
 
-    Attributes:
-      order: i32[l] the lanes sorted by (edge, agent).
-      start, stop: i32[l] per position of ``order``: where its group starts and ends there.
-      rank: i32[l] per lane: moving lanes on its edge before it in agent order (0 if not moving).
-      count: i32[l] per lane: moving lanes on its edge (0 if not moving).
-      last: bool[l] per lane: it is the last of its edge's group (False if not moving).
+    Args:
+      run, here, slot: i32[l] each lane's run, node and slot (-1 or any value where it does not
+        move).
+      moving: bool[l] the lane crosses an edge in this step.
+      claims: i32[R * N], ``UNCLAIMED`` everywhere: scratch with one entry per node of every
+        run, carried by the walker from step to step, so grouping costs a few scatters of
+        ``l`` entries rather than work on the whole memory.
+      num_nodes, max_degree: N and K.
+
+    Returns:
+      ``(EdgeGroups, claims)``, the claims ``UNCLAIMED`` again. The lanes on one node of one
+      run are named by the first of them (a scatter-min of lane numbers into the nodes'
+      claims); a group is such a name and a slot, and a lane's rank is its place in one sort
+      of ``(group, lane)`` packed into one i32 (a sort of a single operand is several times
+      cheaper on CPU than a sort of several).
     """
-
-    order: jax.Array
-    start: jax.Array
-    stop: jax.Array
-    rank: jax.Array
-    count: jax.Array
-    last: jax.Array
-
-    def group_sum(self, values: jax.Array) -> jax.Array:
-        """f32[l] per lane: the sum of ``values`` (f32[l]) over its group, summed in agent
-        order."""
-        sums = jax.ops.segment_sum(values[self.order], self.start,
-                                   num_segments=values.shape[0], indices_are_sorted=True)
-        return jnp.zeros_like(values).at[self.order].set(sums[self.start])
-
-
-def edge_groups(move: Move, num_nodes: int, max_degree: int) -> EdgeGroups:
-    """Group the lanes of one step by the directed edge of the same run they cross, each group
-    in agent order: so that writes of agents that share an edge can be applied in that order."""
-    edge = (move.run * num_nodes + move.here) * max_degree + jnp.maximum(move.slot, 0)
-    key = jnp.where(move.moving, edge, jnp.iinfo(jnp.int32).max)
-    order = jnp.lexsort((move.agent, key))
-    ordered = key[order]
-    start = jnp.searchsorted(ordered, ordered, side="left")
-    stop = jnp.searchsorted(ordered, ordered, side="right")
-    rank = jnp.zeros_like(key).at[order].set(jnp.arange(key.shape[0]) - start)
-    count = jnp.zeros_like(key).at[order].set(stop - start)
-    return EdgeGroups(order=order, start=start, stop=stop,
-                      rank=jnp.where(move.moving, rank, 0),
-                      count=jnp.where(move.moving, count, 0),
-                      last=move.moving & (rank == count - 1))
+    width = run.shape[0]
+    lane = jnp.arange(width, dtype=jnp.int32)
+    at = jnp.where(moving, run * num_nodes + here, claims.shape[0])  # out of range: dropped
+    claims = claims.at[at].min(lane, mode="drop")
+    first_on_node = claims.at[at].get(mode="fill", fill_value=width)
+    # The reset's values are computed from the read, so XLA reads first and resets in place (a
+    # reset that does not depend on the read made it copy the whole buffer at every step).
+    claims = claims.at[at].set(jnp.where(first_on_node >= 0, UNCLAIMED, 0), mode="drop")
+    num_groups = (width + 1) * max_degree  # lanes not moving: group ``width * K``
+    group = first_on_node * max_degree + jnp.where(moving, slot, 0)
+    lane_bits = max(width - 1, 1).bit_length()
+    if num_groups.bit_length() + lane_bits > 31:
+        raise ValueError(f"{width} lanes of {max_degree} slots do not fit one i32 sort key")
+    ordered = jnp.sort((group << lane_bits) | lane)
+    ordered_lane, ordered_group = ordered & ((1 << lane_bits) - 1), ordered >> lane_bits
+    position = jnp.arange(width, dtype=jnp.int32)
+    group_start = jnp.full((num_groups,), width, jnp.int32).at[ordered_group].min(position)
+    rank = jnp.zeros((width,), jnp.int32).at[ordered_lane].set(
+        position - group_start[ordered_group], unique_indices=True)
+    count = jax.ops.segment_sum(moving.astype(jnp.int32), group, num_segments=num_groups)
+    return EdgeGroups(group=group, rank=jnp.where(moving, rank, 0),
+                      count=jnp.where(moving, count[group], 0), moving=moving,
+                      num_groups=num_groups), claims

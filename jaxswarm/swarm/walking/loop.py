@@ -28,7 +28,10 @@ starts a finished run of a batch there, so its lanes go to the runs still going.
 Memory that changes during a walk (water drops' soil) goes through a per-step hook
 (:mod:`.hooks`): ``walk(..., hook=, memory=, hook_params=)`` returns the memory after the walk and
 each agent's own state. With a hook the lanes of one loop walk in lockstep, and which agents share
-a step depends on the lanes; the walk is still one deterministic function of its key.
+a step, and the order in which their writes to one edge apply (the lanes' order), depend on the
+lanes; the walk is still one deterministic function of its key and of how walks are batched.
+Hook params shared by a batch stay one run's, so the lanes read them without a gather; the
+loop carries one i32 per node of every run to group each step's moves (:func:`.hooks.edge_groups`).
 
 Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs, written
 in place as agents move and stop, are each agent's visited set (same layout), its slots
@@ -47,7 +50,7 @@ from jax.custom_batching import custom_vmap
 from jaxswarm.graph import NO_NODE, Graph
 from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 from jaxswarm.swarm.walking import bits
-from jaxswarm.swarm.walking.hooks import Move, StepHook
+from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.sampler import sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 
@@ -183,8 +186,10 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         # One table for the whole batch stays one table (the walk reads it for every run).
         if weights_b or log_weights.shape[0] > 1:
             log_weights = fold(log_weights, weights_b)
-        memory, hook_params = (jax.tree_util.tree_map(fold, tree, batched) for tree, batched in
-                               ((memory, memory_b), (hook_params, params_b)))
+        memory = jax.tree_util.tree_map(fold, memory, memory_b)
+        # Numbers shared by the batch stay one run's (the lanes then need no gather of them).
+        hook_params = jax.tree_util.tree_map(lambda p, b: fold(p, b) if b else p, hook_params,
+                                             params_b)
         out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
                                      walk_runs(seed, graph, log_weights, start, goal, memory,
                                                hook_params))
@@ -238,21 +243,23 @@ class Results(NamedTuple):
 
 
 class Loop(NamedTuple):
-    """The loop's carry: the lanes, the results, the queue's next entry, the lane-steps and the
-    hook's memory (None without a hook)."""
+    """The loop's carry: the lanes, the results, the queue's next entry, the lane-steps, and
+    with a hook its memory and the claims buffer that groups each step's moves
+    (:func:`~.hooks.edge_groups`; both None without a hook)."""
 
     lanes: Lanes
     results: Results
     next_queued: jax.Array
     lane_steps: jax.Array
     memory: Any = None
+    claims: Any = None
 
 
 def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
                num_agents: int, max_steps: int, greedy_agents: int,
                hook: StepHook | None) -> Walk:
     """The walks of R runs on one map through one queue (leading axis R on every input; the
-    table's may be 1, one table for every run)."""
+    table's and the hook params' may be 1, shared by every run)."""
     runs = start.shape[0]
     results, lane_steps, memory = _walk_agents(
         runs * num_agents, seed, graph, log_weights, start, goal, memory, hook_params,
@@ -294,12 +301,17 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
         return bits.mark(jnp.zeros((nodes.shape[0], words), jnp.uint32),
                          jnp.arange(nodes.shape[0]), nodes)
 
+    def params_of(run):
+        """The hook params of runs ``run`` (i32[l]), f32[l] leaves."""
+        return jax.tree_util.tree_map(
+            lambda p: p[run] if p.shape[0] > 1 else jnp.broadcast_to(p[0], run.shape),
+            hook_params)
+
     def initial_state(run):
         """f32[l, E] the hook's state of agents starting in runs ``run`` (None without one)."""
         if hook is None:
             return None
-        return jax.vmap(hook.initial_state)(jax.tree_util.tree_map(lambda p: p[run],
-                                                                   hook_params))
+        return jax.vmap(hook.initial_state)(params_of(run))
 
     here = start[run_of_row]
     results = Results(
@@ -330,14 +342,14 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
             return jnp.clip(here[:, None] + offsets, 0, n - 1)
         return jnp.maximum(graph.nbr[here], 0)
 
-    def one_step(lanes: Lanes, memory):
+    def one_step(lanes: Lanes, memory, claims):
         here = lanes.position
         neighbours = neighbours_of(here)
         row = log_weights[lanes.run if log_weights.shape[0] > 1 else 0, here]
         seen = bits.is_marked(lanes.visited, neighbours)
         admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
         if hook is not None:
-            params = jax.tree_util.tree_map(lambda p: p[lanes.run], hook_params)
+            params = params_of(lanes.run)
             rows = jax.tree_util.tree_map(lambda m: m[lanes.run, here], memory)
             row = row + hook.log_weights(params, rows, admissible)
         within_run = lanes.agent % num_agents
@@ -350,9 +362,12 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
         moves = lanes.moves + moving
         arrived_now = moving & (there == goal[lanes.run])
         if hook is not None:
+            slot = jnp.where(moving, choice, -1)
+            groups, claims = edge_groups(lanes.run, here, slot, moving, claims, n,
+                                         graph.max_degree)
             memory, state = hook.update(params, memory, Move(
-                run=lanes.run, agent=lanes.agent, here=here, slot=jnp.where(moving, choice, -1),
-                moving=moving, state=lanes.state), graph)
+                run=lanes.run, agent=lanes.agent, here=here, slot=slot, moving=moving,
+                state=lanes.state, groups=groups), graph)
             lanes = lanes._replace(state=state)
         lanes = lanes._replace(
             position=there,
@@ -362,7 +377,7 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
             walking=moving & ~arrived_now & (moves < max_steps),
             arrived=lanes.arrived | arrived_now,
             stuck=lanes.stuck | (lanes.walking & ~has_choice))
-        return (lanes, memory, jnp.where(moving, choice, -1).astype(slot_dtype),
+        return (lanes, memory, claims, jnp.where(moving, choice, -1).astype(slot_dtype),
                 jnp.where(moving, there, NO_NODE))
 
     def block(loop: Loop) -> Loop:
@@ -373,21 +388,22 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
         width = lanes.agent.shape[0]
 
         def step_into_blocks(i, inner):
-            lanes, memory, slots, nodes = inner
-            lanes, memory, slot, node = one_step(lanes, memory)
-            return lanes, memory, slots.at[i].set(slot), nodes.at[i].set(node)
+            lanes, memory, claims, slots, nodes = inner
+            lanes, memory, claims, slot, node = one_step(lanes, memory, claims)
+            return lanes, memory, claims, slots.at[i].set(slot), nodes.at[i].set(node)
 
         first_move = lanes.moves
         slots = jnp.full((STEPS_PER_REFILL, width), -1, slot_dtype)
         nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
-        lanes, memory, slots, nodes = jax.lax.fori_loop(
-            0, STEPS_PER_REFILL, step_into_blocks, (lanes, loop.memory, slots, nodes))
+        lanes, memory, claims, slots, nodes = jax.lax.fori_loop(
+            0, STEPS_PER_REFILL, step_into_blocks,
+            (lanes, loop.memory, loop.claims, slots, nodes))
         row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
         column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
         results = loop.results._replace(
             slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
             path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
-        return loop._replace(lanes=lanes, results=results, memory=memory,
+        return loop._replace(lanes=lanes, results=results, memory=memory, claims=claims,
                              lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
 
     def retire(results: Results, lanes: Lanes, which) -> Results:
@@ -432,9 +448,10 @@ def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memor
         return loop._replace(results=results,
                              lanes=lanes._replace(agent=jnp.where(done, count, lanes.agent)))
 
+    claims = None if hook is None else jnp.full((start.shape[0] * n,), UNCLAIMED, jnp.int32)
     loop = Loop(lanes=fresh_lanes(jnp.arange(num_lanes)), results=results,
                 next_queued=jnp.minimum(jnp.int32(num_lanes), live), lane_steps=jnp.int32(0),
-                memory=memory)
+                memory=memory, claims=claims)
     few = num_lanes // COMPACT_SHARE
 
     def keep_queueing(loop: Loop):
