@@ -174,3 +174,16 @@ def test_dynamic(notebook_env):
     robot_gif = Path(result["robot_gif"])
     assert robot_gif.parent == notebook_env and robot_gif.read_bytes()[:3] == b"GIF"
     assert count_images(nb) >= 2
+
+
+@pytest.mark.slow  # IWD_PG compiles its local searches: about two minutes
+def test_water_drops(notebook_env):
+    nb = execute("water_drops.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+    assert math.isfinite(result["optimum"])
+    assert result["iwd_pg"] >= result["optimum"] * (1 - 1e-5)
+    assert result["smoothed_not_longer"] and result["scores_in_range"]
+    assert set(result["finals"]) == {"IWD_PG", "smoothing alone"}
+    assert count_images(nb) >= 4

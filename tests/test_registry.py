@@ -21,7 +21,7 @@ again then."""
 
 def test_the_registry_holds_the_papers_algorithms_and_ours():
     assert set(registered()) == {"rfd", "rfd_star", "rfd_graded", "ant_system", "aco_star",
-                                 "max_min_aco", "improved_max_min_aco", "iwd"}
+                                 "max_min_aco", "improved_max_min_aco", "iwd", "iwd_pg"}
     ours = {name for name, entry in REGISTRY.items() if not entry.faithful}
     assert ours == {"rfd_graded"}
     with pytest.raises(ValueError, match="unknown swarm 'bees'; registered: .*rfd_star"):

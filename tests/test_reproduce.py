@@ -44,6 +44,9 @@ TINY = {
     "iwd_paper_maps": ("sweeps/iwd_paper_maps.py",
                        ["--maps", "maze20", "--seeds", "2", "--iterations", "3",
                         "--patience", "2", "--drops", "8"]),
+    "iwd_pg_experiments": ("sweeps/iwd_pg_experiments.py",
+                           ["--experiments", "1", "--runs-smooth", "1", "--iterations", "2",
+                            "--drops", "8"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 

@@ -30,14 +30,20 @@ def maze():
         graph, chosen.start, chosen.goal)
 
 
-SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd"}
+SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd",
+                    "iwd_pg"}
 """Swarms whose heavier conformance checks (reproducible under vmap, compiled once for a sweep)
 run with the slow checks, to keep the default suite under ten minutes; rfd_star, rfd_graded
-and aco_star's, and every swarm's validity check, stay in it."""
+and aco_star's, and every swarm's validity check but IWD_PG's, stay in it."""
+
+SLOW_VALIDITY = {"iwd_pg"}
+"""Swarms whose validity check runs with the slow checks too: IWD_PG compiles its local
+searches (IWD runs inside its iteration) for most of a minute; tests/test_iwd_pg.py checks
+its results in the default suite on a smaller map."""
 
 
-def conformance(names):
-    return [pytest.param(name, marks=pytest.mark.slow) if name in SLOW_CONFORMANCE else name
+def conformance(names, slow=SLOW_CONFORMANCE):
+    return [pytest.param(name, marks=pytest.mark.slow) if name in slow else name
             for name in names]
 
 
@@ -47,7 +53,7 @@ def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
     check_reproducible(make(name, **SMALL), graph, task, iterations=ITERATIONS)
 
 
-@pytest.mark.parametrize("name", swarms.registered())
+@pytest.mark.parametrize("name", conformance(swarms.registered(), SLOW_VALIDITY))
 def test_results_are_valid_and_never_beat_the_optimum(name, maze):
     graph, task, optimum = maze
     check_valid_results(make(name, **SMALL), graph, task, optimum, iterations=ITERATIONS)

@@ -15,7 +15,7 @@ import numpy as np
 
 from jaxswarm.swarm.aco import ant_system, improved, max_min
 from jaxswarm.swarm.core import Swarm, SwarmConfig
-from jaxswarm.swarm.iwd import iwd
+from jaxswarm.swarm.iwd import iwd, iwd_pg
 from jaxswarm.swarm.rfd import graded, paper
 
 
@@ -53,6 +53,8 @@ REGISTRY: dict[str, Entry] = {
                                   "Improved Max-Min ACO", "Max-Min ACO paper, Algorithm 1"),
     "iwd": Entry(iwd.IWDConfig, iwd.build_iwd, "IWD",
                  "IWD_PG paper, eqs. 1-6 (Shah-Hosseini's IWD)"),
+    "iwd_pg": Entry(iwd_pg.IWDPGConfig, iwd_pg.build_iwd_pg, "IWD_PG",
+                    "IWD_PG paper: IWD with smoothing, memory, intersections, fuzzy local search"),
 }
 """Registered name -> :class:`Entry`."""
 

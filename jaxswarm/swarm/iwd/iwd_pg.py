@@ -1,0 +1,288 @@
+"""IWD_PG (``iwd_pg``): the paper's generalised IWD on a partitioned graph.
+
+Each iteration is an IWD iteration (:mod:`.iwd`: the drops walk and change the soil as they go)
+followed by IWD_PG's stages, each a static switch of :class:`IWDPGConfig` so that experiments
+can turn it off:
+
+1. ``smooth``: every drop's path through the global smooth operator (:mod:`.smooth`) before it
+   is measured; the iteration's best (smoothed) path gets the global soil update;
+2. the memory of the ``memory_size`` best distinct paths (:mod:`.memory`), offered every
+   arrived path;
+3. when the best has not improved for ``operator_patience`` iterations ("if there is no progress
+   in successive generations then more heuristic operations will be performed"), the memory
+   operators, on the pairs (best, other) of the memory:
+
+   * ``first_intersection``: children across a shared node (:mod:`.intersect`), each improved
+     by local search within ``local_span`` moves of its joint (with ``local_search``);
+   * ``second_intersection``: for a pair without a shared node, children across a local
+     search's connection of their closest inner nodes;
+   * a child replaces its parent only if shorter;
+   * ``local_search``: each remembered path improved by a local search on its sub-path inside
+     one section of the map, the section drawn with probability ``1 - score`` of the fuzzy
+     section scores (``fuzzy``, :mod:`.fuzzy`) or uniformly among the sections it enters
+     (``fuzzy=False``).
+
+Local searches are small IWD runs (``local_agents`` drops, ``local_iterations`` iterations,
+fresh soil: :mod:`.local`) of one batch each stage, all through the shared walker. Every
+complete path measured counts as a fitness call: the drops that arrived, the local searches'
+drops that arrived, each child and each spliced path. After a change of the map (see
+:func:`jaxswarm.dynamic.change`) the soil is kept as IWD keeps it and the memory is emptied: its
+paths may cross the change.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.graph import Graph
+from jaxswarm.paths import path_length
+from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, best_solution, keep_best
+from jaxswarm.swarm.iwd import fuzzy
+from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
+                                          second_intersection)
+from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, IWDConfig, IWDParams, build_iwd, check_iwd,
+                                    soil_rule)
+from jaxswarm.swarm.iwd.local import connect, improve_between
+from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
+from jaxswarm.swarm.iwd.smooth import smooth_path
+from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
+from jaxswarm.swarm.walking import edge_table, step_budget, walk
+
+
+@dataclasses.dataclass(frozen=True)
+class IWDPGConfig(SwarmConfig):
+    """Static sizes and switches of IWD_PG (every operator on by default).
+
+    Attributes:
+      num_agents: drops per iteration (50).
+      smooth, first_intersection, second_intersection, local_search, fuzzy: the stages (see the
+        module docstring).
+      memory_size: paths the memory holds (at least 2).
+      sections: sections the fuzzy scores split the map into.
+      local_agents, local_iterations: the size of a local search's IWD run.
+      local_span: moves on each side of a child's joint that its local search covers.
+      operator_patience: iterations without progress before the memory operators run.
+    """
+
+    num_agents: int = 50
+    smooth: bool = True
+    first_intersection: bool = True
+    second_intersection: bool = True
+    local_search: bool = True
+    fuzzy: bool = True
+    memory_size: int = 5
+    sections: int = 4
+    local_agents: int = 10
+    local_iterations: int = 10
+    local_span: int = 8
+    operator_patience: int = 1
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name in ("sections", "local_agents", "local_iterations", "local_span",
+                     "operator_patience"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be at least 1, got {getattr(self, name)}")
+        if self.memory_size < 2:
+            raise ValueError(f"memory_size must be at least 2, got {self.memory_size}")
+
+
+@dataclasses.dataclass(frozen=True)
+class IWDPGState:
+    """Memory of an IWD_PG run (a pytree).
+
+    Attributes:
+      key: PRNG key for the next iteration.
+      soil: f32[N, K] soil on each directed edge slot.
+      memory: the best distinct paths (:class:`~.memory.Memory`), best first.
+      stale: i32[] iterations since the best last improved.
+    """
+
+    key: jax.Array
+    soil: jax.Array
+    memory: Memory
+    stale: jax.Array
+
+    @property
+    def best_path(self) -> jax.Array:
+        """i32[L] the best path so far (the memory's first)."""
+        return self.memory.paths[0]
+
+    @property
+    def best_cost(self) -> jax.Array:
+        """f32[] its length (inf before any drop arrived)."""
+        return self.memory.costs[0]
+
+
+jax.tree_util.register_dataclass(
+    IWDPGState, data_fields=["key", "soil", "memory", "stale"], meta_fields=[])
+
+
+def _replace_parents(memory: Memory, paths, costs) -> Memory:
+    """The memory after children ``paths`` (i32[M - 1, 2, L]) of lengths ``costs`` (f32[M - 1,
+    2]) of the pairs (0, q), q = 1..M-1: path q is replaced by its child (column 1) when that is
+    shorter, path 0 by the shortest of its children (column 0) when that is shorter."""
+    better_q = costs[:, 1] < memory.costs[1:]
+    new_paths = memory.paths.at[1:].set(jnp.where(better_q[:, None], paths[:, 1],
+                                                  memory.paths[1:]))
+    new_costs = memory.costs.at[1:].set(jnp.where(better_q, costs[:, 1], memory.costs[1:]))
+    best = jnp.argmin(costs[:, 0])
+    better_0 = costs[best, 0] < memory.costs[0]
+    new_paths = new_paths.at[0].set(jnp.where(better_0, paths[best, 0], new_paths[0]))
+    new_costs = new_costs.at[0].set(jnp.where(better_0, costs[best, 0], new_costs[0]))
+    return Memory(paths=new_paths, costs=new_costs)
+
+
+def build_iwd_pg(config: IWDPGConfig) -> Swarm:
+    """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams`."""
+    local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps))
+    size = config.memory_size
+
+    def init(key, graph: Graph, task: Task, params: IWDParams) -> IWDPGState:
+        length = step_budget(graph, config.max_steps) + 1
+        return IWDPGState(key=key,
+                          soil=jnp.full(graph.nbr.shape, params.initial_soil, jnp.float32),
+                          memory=empty_memory(size, length), stale=jnp.int32(0))
+
+    def improve_around(keys, graph, paths, begins, ends, params):
+        """Local searches (vmapped) on sub-paths ``[begins, ends]`` of ``paths``."""
+        def one(key, path, begin, end):
+            return improve_between(key, graph, path, begin, end, params, swarm=local,
+                                   iterations=config.local_iterations)
+        return jax.vmap(one)(keys, paths, begins, ends)
+
+    def intersections(key, graph, memory: Memory, params):
+        """The intersection operators on the pairs (0, q): ``(memory, evaluations)``."""
+        first_key, second_key = jax.random.split(key)
+        a = memory.paths[0]
+        others = memory.paths[1:]
+        pair = jnp.isfinite(memory.costs[0]) & jnp.isfinite(memory.costs[1:])
+        evaluations = jnp.int32(0)
+        first = jax.vmap(lambda b: first_intersection(graph, a, b))(others)
+        crossing = jnp.isfinite(first.costs[:, 0]) & pair
+        kids_paths, kids_costs = first.paths, jnp.where(crossing[:, None], first.costs, jnp.inf)
+        evaluations += 2 * jnp.sum(crossing, dtype=jnp.int32)
+        if config.local_search:
+            flat_paths = kids_paths.reshape((-1,) + a.shape)
+            joints = first.joints.reshape(-1)
+            ends = jnp.minimum(joints + config.local_span,
+                               jax.vmap(last_position)(flat_paths))
+            begins = jnp.maximum(joints - config.local_span, 0)
+            keys = jax.random.split(first_key, flat_paths.shape[0])
+            improved, improved_costs, local_evals = improve_around(keys, graph, flat_paths,
+                                                                   begins, ends, params)
+            used = jnp.repeat(crossing, 2)
+            evaluations += jnp.sum(jnp.where(used, local_evals, 0))
+            kids_paths = improved.reshape(kids_paths.shape)
+            kids_costs = jnp.where(crossing[:, None], improved_costs.reshape(kids_costs.shape),
+                                   jnp.inf)
+        if not config.first_intersection:
+            crossing = jnp.zeros_like(crossing)
+            kids_costs = jnp.full_like(kids_costs, jnp.inf)
+        if config.second_intersection:
+            apart = pair & ~crossing
+            i, j = jax.vmap(lambda b: closest_inner_pair(graph, a, b))(others)
+            keys = jax.random.split(second_key, others.shape[0])
+            connections, _, connect_evals = jax.vmap(
+                lambda k, here, there: connect(k, graph, here, there, params, swarm=local,
+                                               iterations=config.local_iterations))(
+                keys, a[i], others[jnp.arange(others.shape[0]), j])
+            second = jax.vmap(lambda b, i, j, c: second_intersection(graph, a, b, i, j, c))(
+                others, i, j, connections)
+            evaluations += jnp.sum(jnp.where(apart, connect_evals, 0))
+            evaluations += 2 * jnp.sum(apart & jnp.isfinite(second.costs[:, 0]), dtype=jnp.int32)
+            kids_paths = jnp.where(apart[:, None, None], second.paths, kids_paths)
+            kids_costs = jnp.where(apart[:, None], second.costs, kids_costs)
+        return _replace_parents(memory, kids_paths, kids_costs), evaluations
+
+    def section_search(key, graph, memory: Memory, params):
+        """Local search on one section's sub-path of each remembered path: ``(memory,
+        evaluations)``."""
+        axis_key, section_key, search_key = jax.random.split(key, 3)
+        axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
+        lengths = jax.vmap(lambda p: fuzzy.section_lengths(graph, p, axis, config.sections))(
+            memory.paths)
+        present = jnp.isfinite(memory.costs)
+        enters = lengths > 0
+        if config.fuzzy:
+            weight = 1.0 - fuzzy.section_scores(lengths, present)
+        else:
+            weight = jnp.ones_like(lengths)
+        # A section every path enters with score 1 still gets a small chance.
+        weight = jnp.where(enters, jnp.maximum(weight, 1e-3), 0.0)
+        keys = jax.random.split(section_key, size)
+        section = jax.vmap(lambda k, w: jax.random.categorical(k, jnp.log(w)))(keys, weight)
+        node_section = fuzzy.section_of(graph, graph.xy[jnp.maximum(memory.paths, 0), axis],
+                                        axis, config.sections)
+        inside = (node_section == section[:, None]) & (memory.paths >= 0)
+        position = jnp.arange(memory.paths.shape[1])
+        begins = jnp.min(jnp.where(inside, position, memory.paths.shape[1]), axis=1)
+        ends = jnp.max(jnp.where(inside, position, -1), axis=1)
+        begins = jnp.minimum(begins, jnp.maximum(ends, 0))
+        paths, costs, evals = improve_around(jax.random.split(search_key, size), graph,
+                                             memory.paths, begins, jnp.maximum(ends, 0), params)
+        better = present & (costs < memory.costs)
+        return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
+                       costs=jnp.where(better, costs, memory.costs)),
+                jnp.sum(jnp.where(present, evals, 0)))
+
+    def operators(key, graph, memory: Memory, params):
+        intersection_key, section_key = jax.random.split(key)
+        evaluations = jnp.int32(0)
+        if config.first_intersection or config.second_intersection:
+            memory, count = intersections(intersection_key, graph, memory, params)
+            evaluations += count
+        if config.local_search:
+            memory, count = section_search(section_key, graph, memory, params)
+            evaluations += count
+        # Sorted again, duplicates dropped.
+        return remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs), \
+            evaluations
+
+    def step(state: IWDPGState, graph: Graph, task: Task, params: IWDParams):
+        key, walk_key, operator_key = jax.random.split(state.key, 3)
+        table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
+        drops = walk(walk_key, graph, table, task.start, task.goal,
+                     num_agents=config.num_agents,
+                     max_steps=step_budget(graph, config.max_steps), hook=SOIL,
+                     memory=state.soil, hook_params=params)
+        paths = drops.path
+        if config.smooth:
+            paths = jax.vmap(lambda p, arrived: jax.lax.cond(
+                arrived, lambda p: smooth_path(graph, p), lambda p: p, p))(paths, drops.arrived)
+        lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
+                            drops.length)
+        smoothed = drops._replace(path=paths, length=lengths)
+        _, _, info = keep_best(smoothed, state.best_path, state.best_cost)
+        costs = jnp.where(drops.arrived, lengths, jnp.inf)
+        winner = jnp.argmin(costs)
+        soil = jnp.where(jnp.isfinite(costs[winner]),
+                         global_update(graph, drops.memory, paths[winner],
+                                       drops.state[winner, CARRIED], params),
+                         drops.memory)
+        memory = remember(state.memory, paths, costs)
+        stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
+        run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
+        walked = memory
+        memory, extra = jax.lax.cond(
+            run_operators, lambda m: operators(operator_key, graph, m, params),
+            lambda m: (m, jnp.int32(0)), memory)
+        stale = jnp.where(memory.costs[0] < state.best_cost, 0, stale)
+        # Drops that all took one path have converged only if the operators found nothing.
+        converged = info.converged & ~(memory.costs[0] < walked.costs[0])
+        return (IWDPGState(key=key, soil=soil, memory=memory, stale=stale),
+                info._replace(evaluations=info.evaluations + extra, converged=converged))
+
+    def memory_view(state: IWDPGState) -> jax.Array:
+        return jnp.mean(state.soil, axis=-1)
+
+    def adapt(state, before, after, old, new, params):
+        return dataclasses.replace(soil_rule(state, before, after, old, new, params),
+                                   memory=empty_memory(*state.memory.paths.shape),
+                                   stale=jnp.int32(0))
+
+    return Swarm(name="iwd_pg", config=config, init=jax.jit(init), step=jax.jit(step),
+                 best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd,
+                 memory=memory_view, memory_label="soil on a node's edges (mean)", adapt=adapt)

@@ -1,0 +1,39 @@
+"""IWD_PG's local search: a small IWD run between two nodes of a path, spliced in when shorter.
+
+The run is the ``iwd`` swarm itself with fewer drops and iterations and a memory of its own
+(fresh soil, no IWD_PG memory), through the engine's run loop; its fitness calls count.
+"""
+from __future__ import annotations
+
+import jax.numpy as jnp
+
+from jaxswarm.graph import Graph
+from jaxswarm.paths import path_length
+from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.iwd.memory import prefix_lengths, splice
+from jaxswarm.swarm.iwd.smooth import IMPROVEMENT
+
+
+def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations: int):
+    """The best path of a small IWD run from node ``here`` to ``there``: ``(path i32[L], cost
+    f32[] (inf if no drop arrived), evaluations i32[])``."""
+    state, trace = run(swarm, key, graph, Task(start=here, goal=there), params,
+                       iterations=iterations)
+    return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
+
+
+def improve_between(key, graph: Graph, path, begin, end, params, *, swarm: Swarm,
+                    iterations: int):
+    """Local search on the sub-path of ``path`` (i32[L]) from position ``begin`` to ``end``.
+
+    Returns:
+      ``(path, cost, evaluations)``: the path with the small run's path spliced in when it is
+      shorter than the sub-path (else as it was), its length, and the fitness calls (the small
+      run's, and one for the spliced path).
+    """
+    middle, middle_cost, evaluations = connect(key, graph, path[begin], path[end], params,
+                                               swarm=swarm, iterations=iterations)
+    prefix = prefix_lengths(graph, path)
+    better = (end > begin + 1) & (middle_cost < prefix[end] - prefix[begin] - IMPROVEMENT)
+    new_path = jnp.where(better, splice(path, begin, end, middle), path)
+    return new_path, path_length(graph, new_path), evaluations + better.astype(jnp.int32)
