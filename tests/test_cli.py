@@ -19,7 +19,7 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     exact = ("Dijkstra", "A*", "bidirectional A*")
     swarms = ("RFD (paper)", "RFD* (paper)", "RFD graded (ours)", "Ant System (paper)",
               "ACO* (paper)", "Max-Min ACO (paper)", "Improved Max-Min ACO (paper)",
-              "IWD (paper)")
+              "IWD (paper)", "IWD_PG (paper)")
     for planner in exact + swarms:
         row = re.search(rf"^{re.escape(planner)}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
         assert row, f"no row for {planner} in:\n{text}"
@@ -32,7 +32,7 @@ def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     assert len({lengths[planner] for planner in exact}) == 1
     assert "(paper): the paper's algorithm as written; (ours): jaxswarm's own" in text
     names = ("rfd", "rfd_star", "rfd_graded", "ant_system", "aco_star", "max_min_aco",
-             "improved_max_min_aco", "iwd")
+             "improved_max_min_aco", "iwd", "iwd_pg")
     for png in (out, *(tmp_path / f"demo_{name}.png" for name in names)):
         assert png.read_bytes()[:4] == b"\x89PNG"
 

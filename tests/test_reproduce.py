@@ -206,6 +206,19 @@ def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
     assert "| maze20 | 78.00 |" in (folder / "iwd_paper_maps" / "table.md").read_text()
 
 
+def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
+    folder, _ = quick
+    rows = read_csv(folder / "iwd_pg_experiments" / "runs.csv")
+    assert [(r["experiment"], r["variant"], r["seed"]) for r in rows] == [
+        ("1", "IWD + memory", "0"), ("1", "+ smoothing", "0")]
+    for r in rows:
+        assert float(r["optimum"]) == pytest.approx(29.2132, abs=1e-4)
+        assert float(r["cost"]) >= float(r["optimum"]) * (1 - 1e-6)
+        assert int(r["evaluations"]) <= 8 * int(r["iterations"])  # drops only: no operator
+    table = (folder / "iwd_pg_experiments" / "table.md").read_text()
+    assert "## 1. Smoothing" in table and "| + smoothing | 1 |" in table
+
+
 def test_path_map_table_has_the_papers_values_beside_ours(quick):
     folder, _ = quick
     rows = {(r["map"], r["algorithm"]): r for r in read_csv(folder / "aco_pathmaps" /

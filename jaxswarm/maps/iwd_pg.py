@@ -74,6 +74,10 @@ _COMPLEX = """
 """
 
 
+OPTIMA = {"field": 29.213203435596434, "complex": 47.455844122715696}
+"""The shortest path length from start to goal of each map (8-connected, no corner cutting)."""
+
+
 def _grid(text: str) -> np.ndarray:
     rows = text.strip().splitlines()
     grid = np.array([[cell == "#" for cell in row] for row in rows], dtype=bool)

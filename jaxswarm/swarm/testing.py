@@ -70,14 +70,22 @@ def check_reproducible(swarm: Swarm, graph: Graph, task: Task, *, iterations: in
 def check_valid_results(swarm: Swarm, graph: Graph, task: Task, optimum: float, *,
                         iterations: int = 8) -> None:
     """One run's best path is found, valid, measured right and never below ``optimum`` (the
-    optimum measured as swarm paths are, see :func:`jaxswarm.exact.optimal_length`)."""
+    optimum measured as swarm paths are, see :func:`jaxswarm.exact.optimal_length`), and the
+    state's float arrays are finite (remembered path lengths, ``costs``, may be +inf where no
+    path is held yet)."""
     state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                        iterations=iterations)
     solution = swarm.best(state)
     assert bool(solution.found), f"{swarm.name}: no path within {iterations} iterations"
-    assert all(np.isfinite(np.asarray(leaf)).all() for leaf in jax.tree_util.tree_leaves(state)
-               if jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0), (
-        f"{swarm.name}: memory not finite")
+    for where, leaf in jax.tree_util.tree_leaves_with_path(state):
+        if not (jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0):
+            continue
+        values = np.asarray(leaf)
+        # Path lengths (``costs``) are +inf where a memory slot holds no path yet.
+        if jax.tree_util.keystr(where).endswith("costs"):
+            values = values[values != np.inf]
+        assert np.isfinite(values).all(), (
+            f"{swarm.name}: memory not finite at {jax.tree_util.keystr(where)}")
     ran = int(trace.iterations)
     assert 1 <= ran <= iterations
     best = np.asarray(trace.best_cost)

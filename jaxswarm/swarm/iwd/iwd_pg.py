@@ -44,7 +44,7 @@ from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection
                                           second_intersection)
 from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, IWDConfig, IWDParams, build_iwd, check_iwd,
                                     soil_rule)
-from jaxswarm.swarm.iwd.local import connect, improve_between
+from jaxswarm.swarm.iwd.local import connect, improve_between, splice_if_shorter
 from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
 from jaxswarm.swarm.iwd.smooth import smooth_path
 from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
@@ -146,52 +146,59 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
                           soil=jnp.full(graph.nbr.shape, params.initial_soil, jnp.float32),
                           memory=empty_memory(size, length), stale=jnp.int32(0))
 
-    def improve_around(keys, graph, paths, begins, ends, params):
-        """Local searches (vmapped) on sub-paths ``[begins, ends]`` of ``paths``."""
-        def one(key, path, begin, end):
-            return improve_between(key, graph, path, begin, end, params, swarm=local,
-                                   iterations=config.local_iterations)
-        return jax.vmap(one)(keys, paths, begins, ends)
+    def connect_all(key, graph, heres, theres, params):
+        """Small IWD runs (one batch through the walker) from ``heres`` to ``theres``
+        (i32[B]): ``(paths i32[B, L], costs f32[B], evaluations i32[B])``."""
+        keys = jax.random.split(key, heres.shape[0])
+        return jax.vmap(lambda k, here, there: connect(
+            k, graph, here, there, params, swarm=local,
+            iterations=config.local_iterations))(keys, heres, theres)
 
     def intersections(key, graph, memory: Memory, params):
-        """The intersection operators on the pairs (0, q): ``(memory, evaluations)``."""
-        first_key, second_key = jax.random.split(key)
-        a = memory.paths[0]
-        others = memory.paths[1:]
+        """The intersection operators on the pairs (0, q): ``(memory, evaluations)``. Their
+        local searches (around the first operator's joints, and the second's connections) run
+        as one batch."""
+        a, others = memory.paths[0], memory.paths[1:]
+        pairs = others.shape[0]
         pair = jnp.isfinite(memory.costs[0]) & jnp.isfinite(memory.costs[1:])
-        evaluations = jnp.int32(0)
         first = jax.vmap(lambda b: first_intersection(graph, a, b))(others)
-        crossing = jnp.isfinite(first.costs[:, 0]) & pair
-        kids_paths, kids_costs = first.paths, jnp.where(crossing[:, None], first.costs, jnp.inf)
-        evaluations += 2 * jnp.sum(crossing, dtype=jnp.int32)
-        if config.local_search:
-            flat_paths = kids_paths.reshape((-1,) + a.shape)
-            joints = first.joints.reshape(-1)
-            ends = jnp.minimum(joints + config.local_span,
-                               jax.vmap(last_position)(flat_paths))
-            begins = jnp.maximum(joints - config.local_span, 0)
-            keys = jax.random.split(first_key, flat_paths.shape[0])
-            improved, improved_costs, local_evals = improve_around(keys, graph, flat_paths,
-                                                                   begins, ends, params)
+        crossing = (jnp.isfinite(first.costs[:, 0]) & pair if config.first_intersection
+                    else jnp.zeros((pairs,), bool))
+        kids_paths = first.paths
+        kids_costs = jnp.where(crossing[:, None], first.costs, jnp.inf)
+        evaluations = 2 * jnp.sum(crossing, dtype=jnp.int32)
+        heres, theres = [], []
+        improve_first = config.first_intersection and config.local_search
+        if improve_first:
+            flat = kids_paths.reshape((-1,) + a.shape)
+            begins = jnp.maximum(first.joints.reshape(-1) - config.local_span, 0)
+            ends = jnp.minimum(first.joints.reshape(-1) + config.local_span,
+                               jax.vmap(last_position)(flat))
+            rows = jnp.arange(flat.shape[0])
+            heres.append(flat[rows, begins])
+            theres.append(flat[rows, ends])
+        if config.second_intersection:
+            i, j = jax.vmap(lambda b: closest_inner_pair(graph, a, b))(others)
+            heres.append(a[i])
+            theres.append(others[jnp.arange(pairs), j])
+        if not heres:
+            return _replace_parents(memory, kids_paths, kids_costs), evaluations
+        paths, costs, calls = connect_all(key, graph, jnp.concatenate(heres),
+                                          jnp.concatenate(theres), params)
+        if improve_first:
+            improved, improved_costs, spliced = jax.vmap(
+                lambda p, b, e, m, c: splice_if_shorter(graph, p, b, e, m, c))(
+                flat, begins, ends, paths[:2 * pairs], costs[:2 * pairs])
             used = jnp.repeat(crossing, 2)
-            evaluations += jnp.sum(jnp.where(used, local_evals, 0))
+            evaluations += jnp.sum(jnp.where(used, calls[:2 * pairs] + spliced, 0))
             kids_paths = improved.reshape(kids_paths.shape)
             kids_costs = jnp.where(crossing[:, None], improved_costs.reshape(kids_costs.shape),
                                    jnp.inf)
-        if not config.first_intersection:
-            crossing = jnp.zeros_like(crossing)
-            kids_costs = jnp.full_like(kids_costs, jnp.inf)
         if config.second_intersection:
             apart = pair & ~crossing
-            i, j = jax.vmap(lambda b: closest_inner_pair(graph, a, b))(others)
-            keys = jax.random.split(second_key, others.shape[0])
-            connections, _, connect_evals = jax.vmap(
-                lambda k, here, there: connect(k, graph, here, there, params, swarm=local,
-                                               iterations=config.local_iterations))(
-                keys, a[i], others[jnp.arange(others.shape[0]), j])
             second = jax.vmap(lambda b, i, j, c: second_intersection(graph, a, b, i, j, c))(
-                others, i, j, connections)
-            evaluations += jnp.sum(jnp.where(apart, connect_evals, 0))
+                others, i, j, paths[-pairs:])
+            evaluations += jnp.sum(jnp.where(apart, calls[-pairs:], 0))
             evaluations += 2 * jnp.sum(apart & jnp.isfinite(second.costs[:, 0]), dtype=jnp.int32)
             kids_paths = jnp.where(apart[:, None, None], second.paths, kids_paths)
             kids_costs = jnp.where(apart[:, None], second.costs, kids_costs)
@@ -221,8 +228,9 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
         begins = jnp.min(jnp.where(inside, position, memory.paths.shape[1]), axis=1)
         ends = jnp.max(jnp.where(inside, position, -1), axis=1)
         begins = jnp.minimum(begins, jnp.maximum(ends, 0))
-        paths, costs, evals = improve_around(jax.random.split(search_key, size), graph,
-                                             memory.paths, begins, jnp.maximum(ends, 0), params)
+        paths, costs, evals = jax.vmap(lambda k, p, b, e: improve_between(
+            k, graph, p, b, e, params, swarm=local, iterations=config.local_iterations))(
+            jax.random.split(search_key, size), memory.paths, begins, jnp.maximum(ends, 0))
         better = present & (costs < memory.costs)
         return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
                        costs=jnp.where(better, costs, memory.costs)),

@@ -22,6 +22,19 @@ def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations:
     return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
 
 
+def splice_if_shorter(graph: Graph, path, begin, end, middle, middle_cost):
+    """``path`` (i32[L]) with ``middle`` (a path from ``path[begin]`` to ``path[end]`` of length
+    ``middle_cost``) spliced in when shorter than the sub-path it replaces.
+
+    Returns:
+      ``(path, cost, spliced bool[])``: the path, its length, whether it changed.
+    """
+    prefix = prefix_lengths(graph, path)
+    better = (end > begin + 1) & (middle_cost < prefix[end] - prefix[begin] - IMPROVEMENT)
+    new_path = jnp.where(better, splice(path, begin, end, middle), path)
+    return new_path, path_length(graph, new_path), better
+
+
 def improve_between(key, graph: Graph, path, begin, end, params, *, swarm: Swarm,
                     iterations: int):
     """Local search on the sub-path of ``path`` (i32[L]) from position ``begin`` to ``end``.
@@ -33,7 +46,5 @@ def improve_between(key, graph: Graph, path, begin, end, params, *, swarm: Swarm
     """
     middle, middle_cost, evaluations = connect(key, graph, path[begin], path[end], params,
                                                swarm=swarm, iterations=iterations)
-    prefix = prefix_lengths(graph, path)
-    better = (end > begin + 1) & (middle_cost < prefix[end] - prefix[begin] - IMPROVEMENT)
-    new_path = jnp.where(better, splice(path, begin, end, middle), path)
-    return new_path, path_length(graph, new_path), evaluations + better.astype(jnp.int32)
+    new_path, cost, better = splice_if_shorter(graph, path, begin, end, middle, middle_cost)
+    return new_path, cost, evaluations + better.astype(jnp.int32)

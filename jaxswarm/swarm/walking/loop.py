@@ -16,8 +16,9 @@ Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk
 batch of that many lanes.
 
 Random streams belong to agents, not lanes: agent ``a``'s ``m``-th move draws a uniform hashed
-from the walk's key, ``a`` and ``m`` (:func:`.streams.uniforms`). So neither the number of lanes, nor the
-order in which agents get one, nor batching walks together changes any walk.
+from the walk's key, ``a`` and ``m`` (:func:`.streams.uniforms`). So without a hook neither the
+number of lanes, nor the order in which agents get one, nor batching walks together changes any
+walk.
 
 Batching: :func:`walk` has its own ``vmap`` rule (``jax.custom_batching``). A ``vmap`` of walks
 (a batch of runs in a sweep, a batch of seeds) becomes one queue holding every run's agents over
