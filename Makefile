@@ -57,7 +57,7 @@ EXACT_QUICK := --sizes 10:20:5 --grids 5
 DYNAMIC_QUICK := --maps mosaic20 --tables 2,3 --seeds 2 --iterations 5 --patience 5 --agents 32
 ROBOT_QUICK := --maps pathmap10x10,maze20 --seeds 2 --iterations 10 --patience 5 --max-plans 8
 IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
-IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --iterations 5 --drops 20
+IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --runs 2 --iterations 5 --drops 20
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 125 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
