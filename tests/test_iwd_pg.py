@@ -199,6 +199,7 @@ def check_iwd_pg(options, seeds):
         assert int(trace.evaluations.sum()) > drops  # the operators' calls count too
 
 
+@pytest.mark.slow  # IWD_PG's compile, about 30 s; the demo's test runs it in the default suite
 def test_iwd_pg_reaches_the_optimum_where_iwd_does_not():
     check_iwd_pg({}, seeds=(0, 2))
 
