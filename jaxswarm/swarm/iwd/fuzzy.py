@@ -30,7 +30,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
-from jaxswarm.swarm.iwd.smooth import edge_cost
+from jaxswarm.lattice import move_lengths
+from jaxswarm.paths import step_slots
 
 LOW, MEDIUM, HIGH = 0, 1, 2
 
@@ -75,11 +76,10 @@ def section_of(graph: Graph, coordinate: jax.Array, axis, sections: int) -> jax.
 def section_lengths(graph: Graph, path: jax.Array, axis, sections: int) -> jax.Array:
     """f32[S]: the length of the moves of ``path`` (i32[L], -1 padded) inside each section."""
     here, there = path[:-1], path[1:]
-    cost = edge_cost(graph, graph.valid_edges(), here, there)
-    is_move = (here >= 0) & (there >= 0)
+    cost = move_lengths(graph, here, step_slots(graph, path))  # 0 past the end
     middle = 0.5 * (graph.xy[jnp.maximum(here, 0), axis] + graph.xy[jnp.maximum(there, 0), axis])
-    return jax.ops.segment_sum(jnp.where(is_move, cost, 0.0),
-                               section_of(graph, middle, axis, sections), num_segments=sections)
+    return jax.ops.segment_sum(cost, section_of(graph, middle, axis, sections),
+                               num_segments=sections)
 
 
 def section_scores(lengths: jax.Array, present: jax.Array) -> jax.Array:

@@ -21,7 +21,7 @@ from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
                                  default_params, keep_best)
 from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
-from jaxswarm.swarm.walking import edge_table, step_budget, walk
+from jaxswarm.swarm.walking import Walk, edge_table, step_budget, walk
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,33 +115,58 @@ def check_iwd(params: IWDParams) -> None:
             raise ValueError(f"{name} must be at most 1, got {getattr(params, name)}")
 
 
+def initial_soil(graph: Graph, params: IWDParams) -> jax.Array:
+    """f32[N, K] every edge slot's soil at the start, ``initial_soil``."""
+    return jnp.full(graph.nbr.shape, params.initial_soil, jnp.float32)
+
+
+def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_agents: int,
+              max_steps: int | None) -> Walk:
+    """One iteration's drops walking from ``task.start`` over ``soil`` (f32[N, K]), which they
+    change as they go (the walker's soil hook); the Walk's ``memory`` is the soil after them."""
+    table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
+    return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
+                max_steps=step_budget(graph, max_steps), hook=SOIL, memory=soil,
+                hook_params=params)
+
+
+def soil_after_best(graph: Graph, drops: Walk, paths, costs, params: IWDParams) -> jax.Array:
+    """f32[N, K] the soil after ``drops`` walked and the global update of the shortest of their
+    ``paths`` (i32[A, L]; ``costs`` f32[A], inf for a drop that did not arrive); no global
+    update when none arrived."""
+    winner = jnp.argmin(costs)
+    return jnp.where(jnp.isfinite(costs[winner]),
+                     global_update(graph, drops.memory, paths[winner],
+                                   drops.state[winner, CARRIED], params),
+                     drops.memory)
+
+
+def soil_per_node(state) -> jax.Array:
+    """f32[N] the mean soil on each node's edge slots (the figures' view of the memory)."""
+    return jnp.mean(state.soil, axis=-1)
+
+
+SOIL_LABEL = "soil on a node's edges (mean)"
+"""What :func:`soil_per_node` shows, for colorbars."""
+
+
 def build_iwd(config: IWDConfig) -> Swarm:
     """Intelligent Water Drops (see the module docstring), with :class:`IWDParams`."""
     def init(key, graph: Graph, task: Task, params: IWDParams) -> IWDState:
         length = step_budget(graph, config.max_steps) + 1
-        return IWDState(key=key, soil=jnp.full(graph.nbr.shape, params.initial_soil, jnp.float32),
+        return IWDState(key=key, soil=initial_soil(graph, params),
                         best_path=jnp.full((length,), -1, jnp.int32),
                         best_cost=jnp.float32(jnp.inf))
 
     def step(state: IWDState, graph: Graph, task: Task, params: IWDParams):
         key, walk_key = jax.random.split(state.key)
-        table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
-        drops = walk(walk_key, graph, table, task.start, task.goal,
-                     num_agents=config.num_agents,
-                     max_steps=step_budget(graph, config.max_steps), hook=SOIL,
-                     memory=state.soil, hook_params=params)
+        drops = drop_walk(walk_key, graph, task, state.soil, params,
+                          num_agents=config.num_agents, max_steps=config.max_steps)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
-        winner = jnp.argmin(costs)
-        soil = jnp.where(jnp.isfinite(costs[winner]),
-                         global_update(graph, drops.memory, drops.path[winner],
-                                       drops.state[winner, CARRIED], params),
-                         drops.memory)
+        soil = soil_after_best(graph, drops, drops.path, costs, params)
         return IWDState(key=key, soil=soil, best_path=best_path, best_cost=best_cost), info
-
-    def memory(state: IWDState) -> jax.Array:
-        return jnp.mean(state.soil, axis=-1)
 
     return Swarm(name="iwd", config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd,
-                 memory=memory, memory_label="soil on a node's edges (mean)", adapt=soil_rule)
+                 memory=soil_per_node, memory_label=SOIL_LABEL, adapt=soil_rule)

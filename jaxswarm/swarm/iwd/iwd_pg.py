@@ -42,13 +42,13 @@ from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, best_solution, keep_be
 from jaxswarm.swarm.iwd import fuzzy
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
                                           second_intersection)
-from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, IWDConfig, IWDParams, build_iwd, check_iwd,
-                                    soil_rule)
+from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, SOIL_LABEL, IWDConfig, IWDParams, build_iwd,
+                                    check_iwd, drop_walk, initial_soil, soil_after_best,
+                                    soil_per_node, soil_rule)
 from jaxswarm.swarm.iwd.local import connect, improve_between, splice_if_shorter
 from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
 from jaxswarm.swarm.iwd.smooth import smooth_path
-from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
-from jaxswarm.swarm.walking import edge_table, step_budget, walk
+from jaxswarm.swarm.walking import step_budget
 
 
 @dataclasses.dataclass(frozen=True)
@@ -143,7 +143,7 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
     def init(key, graph: Graph, task: Task, params: IWDParams) -> IWDPGState:
         length = step_budget(graph, config.max_steps) + 1
         return IWDPGState(key=key,
-                          soil=jnp.full(graph.nbr.shape, params.initial_soil, jnp.float32),
+                          soil=initial_soil(graph, params),
                           memory=empty_memory(size, length), stale=jnp.int32(0))
 
     def connect_all(key, graph, heres, theres, params):
@@ -251,25 +251,20 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
 
     def step(state: IWDPGState, graph: Graph, task: Task, params: IWDParams):
         key, walk_key, operator_key = jax.random.split(state.key, 3)
-        table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
-        drops = walk(walk_key, graph, table, task.start, task.goal,
-                     num_agents=config.num_agents,
-                     max_steps=step_budget(graph, config.max_steps), hook=SOIL,
-                     memory=state.soil, hook_params=params)
+        drops = drop_walk(walk_key, graph, task, state.soil, params,
+                          num_agents=config.num_agents, max_steps=config.max_steps)
         paths = drops.path
         if config.smooth:
-            paths = jax.vmap(lambda p, arrived: jax.lax.cond(
-                arrived, lambda p: smooth_path(graph, p), lambda p: p, p))(paths, drops.arrived)
+            # Every drop's path is smoothed (under vmap a cond would run both sides anyway); a
+            # drop that did not arrive keeps its path.
+            smoothed = jax.vmap(lambda p: smooth_path(graph, p))(paths)
+            paths = jnp.where(drops.arrived[:, None], smoothed, paths)
         lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
                             drops.length)
-        smoothed = drops._replace(path=paths, length=lengths)
-        _, _, info = keep_best(smoothed, state.best_path, state.best_cost)
+        _, _, info = keep_best(drops._replace(path=paths, length=lengths), state.best_path,
+                               state.best_cost)
         costs = jnp.where(drops.arrived, lengths, jnp.inf)
-        winner = jnp.argmin(costs)
-        soil = jnp.where(jnp.isfinite(costs[winner]),
-                         global_update(graph, drops.memory, paths[winner],
-                                       drops.state[winner, CARRIED], params),
-                         drops.memory)
+        soil = soil_after_best(graph, drops, paths, costs, params)
         memory = remember(state.memory, paths, costs)
         stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
         run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
@@ -283,9 +278,6 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
         return (IWDPGState(key=key, soil=soil, memory=memory, stale=stale),
                 info._replace(evaluations=info.evaluations + extra, converged=converged))
 
-    def memory_view(state: IWDPGState) -> jax.Array:
-        return jnp.mean(state.soil, axis=-1)
-
     def adapt(state, before, after, old, new, params):
         return dataclasses.replace(soil_rule(state, before, after, old, new, params),
                                    memory=empty_memory(*state.memory.paths.shape),
@@ -293,4 +285,4 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
 
     return Swarm(name="iwd_pg", config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd,
-                 memory=memory_view, memory_label="soil on a node's edges (mean)", adapt=adapt)
+                 memory=soil_per_node, memory_label=SOIL_LABEL, adapt=adapt)

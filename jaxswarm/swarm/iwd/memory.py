@@ -13,7 +13,8 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.graph import NO_NODE, Graph
-from jaxswarm.swarm.iwd.smooth import edge_cost
+from jaxswarm.lattice import move_lengths
+from jaxswarm.paths import step_slots
 
 
 class Memory(NamedTuple):
@@ -77,8 +78,7 @@ def splice(path: jax.Array, begin, end, middle: jax.Array) -> jax.Array:
 def prefix_lengths(graph: Graph, path: jax.Array) -> jax.Array:
     """f32[L]: the length of ``path`` (i32[L], -1 padded) from its start to each position
     (constant past its end)."""
-    cost = edge_cost(graph, graph.valid_edges(), path[:-1], path[1:])
-    moves = jnp.where((path[:-1] >= 0) & (path[1:] >= 0), cost, 0.0)
+    moves = move_lengths(graph, path[:-1], step_slots(graph, path))
     return jnp.concatenate([jnp.zeros((1,), jnp.float32), jnp.cumsum(moves)])
 
 
