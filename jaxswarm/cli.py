@@ -24,7 +24,7 @@ import jax
 
 from jaxswarm.cpu import configure
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
-from jaxswarm.graph import path_map_graph
+from jaxswarm.graph import Graph, path_map_graph
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.maps.random import random_path_map
@@ -59,8 +59,9 @@ def main(argv: list[str] | None = None) -> int:
                       help="agents per swarm iteration (default: each swarm's own, e.g. 256 "
                            "drops, the Max-Min ACO paper's 50 ants)")
     demo.add_argument("--iterations", type=int, default=100, help="swarm iteration budget")
-    demo.add_argument("--swarms", type=_swarm_names, default=registry.registered(),
-                      help="comma-separated registered swarms (default: all)")
+    demo.add_argument("--swarms", type=_swarm_names, default=registry.registered(Graph),
+                      help="comma-separated registered swarms that plan on graphs (default: "
+                           "all)")
     demo.add_argument("--out", type=Path,
                       help="figure path (default out/demo_MAP.png); each swarm's figure is "
                            "written beside it with the swarm's name appended")
@@ -268,10 +269,11 @@ def _load(args):
 
 def _swarm_names(text: str) -> tuple[str, ...]:
     names = tuple(name.strip() for name in text.split(",") if name.strip())
-    unknown = [name for name in names if name not in registry.REGISTRY]
+    graph_swarms = registry.registered(Graph)
+    unknown = [name for name in names if name not in graph_swarms]
     if unknown or not names:
         raise argparse.ArgumentTypeError(
-            f"unknown swarms {unknown}; registered: {', '.join(registry.registered())}"
+            f"unknown swarms {unknown}; registered on graphs: {', '.join(graph_swarms)}"
             if unknown else "name at least one swarm")
     return names
 

@@ -7,7 +7,9 @@ import jax
 import numpy as np
 import pytest
 
+from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.plane import Plane
 from jaxswarm.swarm import config_options, definition, make, make_task, registered, run
 from jaxswarm.swarm.registry import REGISTRY
 
@@ -21,7 +23,9 @@ again then."""
 
 def test_the_registry_holds_the_papers_algorithms_and_ours():
     assert set(registered()) == {"rfd", "rfd_star", "rfd_graded", "ant_system", "aco_star",
-                                 "max_min_aco", "improved_max_min_aco", "iwd", "iwd_pg"}
+                                 "max_min_aco", "improved_max_min_aco", "iwd", "iwd_pg", "cabc"}
+    assert registered(Plane) == ("cabc",)
+    assert set(registered(Graph)) == set(registered()) - {"cabc"}
     ours = {name for name, entry in REGISTRY.items() if not entry.faithful}
     assert ours == {"rfd_graded"}
     with pytest.raises(ValueError, match="unknown swarm 'bees'; registered: .*rfd_star"):
@@ -33,7 +37,8 @@ def test_equal_configs_give_one_swarm(name):
     explicit = {option: getattr(REGISTRY[name].config(), option)
                 for option in config_options(name)}
     assert make(name) is make(name, **explicit)
-    assert make(name, num_agents=32) is make(name, num_agents=32, max_steps=None)
+    default_steps = REGISTRY[name].config().max_steps
+    assert make(name, num_agents=32) is make(name, num_agents=32, max_steps=default_steps)
     assert make(name, num_agents=32) is not make(name, num_agents=16)
     assert definition(make(name, num_agents=32))["config"]["num_agents"] == 32
 

@@ -9,8 +9,9 @@ import pytest
 
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra, optimal_length
-from jaxswarm.graph import grid_graph
+from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.plane import Plane, make_plane, shortest_path
 from jaxswarm.paths import Solution
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
@@ -28,6 +29,20 @@ def maze():
     graph = chosen.graph()
     return graph, make_task(graph, chosen.start, chosen.goal), optimal_length(
         graph, chosen.start, chosen.goal)
+
+
+@pytest.fixture(scope="module")
+def field():
+    """A 6 x 6 plane with a rectangle beside the straight way from start to goal, for the
+    bees."""
+    plane = make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0))
+    start, goal = (0.5, 2.5), (5.5, 2.5)
+    return plane, make_task(plane, start, goal), shortest_path(plane, start, goal)[0]
+
+
+def world_of(name, maze, field):
+    """The conformance world of a swarm: maze20 for the walkers, the 6 x 6 plane for the bees."""
+    return field if make(name).world is Plane else maze
 
 
 SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd",
@@ -48,21 +63,21 @@ def conformance(names, slow=SLOW_CONFORMANCE):
 
 
 @pytest.mark.parametrize("name", conformance(swarms.registered()))
-def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze):
-    graph, task, _ = maze
-    check_reproducible(make(name, **SMALL), graph, task, iterations=ITERATIONS)
+def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze, field):
+    world, task, _ = world_of(name, maze, field)
+    check_reproducible(make(name, **SMALL), world, task, iterations=ITERATIONS)
 
 
 @pytest.mark.parametrize("name", conformance(swarms.registered(), SLOW_VALIDITY))
-def test_results_are_valid_and_never_beat_the_optimum(name, maze):
-    graph, task, optimum = maze
-    check_valid_results(make(name, **SMALL), graph, task, optimum, iterations=ITERATIONS)
+def test_results_are_valid_and_never_beat_the_optimum(name, maze, field):
+    world, task, optimum = world_of(name, maze, field)
+    check_valid_results(make(name, **SMALL), world, task, optimum, iterations=ITERATIONS)
 
 
 @pytest.mark.parametrize("name", conformance(swarms.registered()))
-def test_a_sweep_over_sixteen_params_compiles_once(name, maze):
-    graph, task, _ = maze
-    check_compiles_once(make(name, **SMALL), graph, task)
+def test_a_sweep_over_sixteen_params_compiles_once(name, maze, field):
+    world, task, _ = world_of(name, maze, field)
+    check_compiles_once(make(name, **SMALL), world, task)
 
 
 @pytest.mark.slow  # about 25 s
@@ -344,7 +359,7 @@ def test_unreachable_goal_is_a_clean_not_found_result():
     obstacles[:, 3] = True
     graph = grid_graph(obstacles)
     task = make_task(graph, (0, 0), (5, 5))
-    for name in swarms.registered():
+    for name in swarms.registered(Graph):
         swarm = make(name, num_agents=16)
         state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                            iterations=20, patience=5)

@@ -20,6 +20,7 @@ import pytest
 
 from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.plane import paper_plane, shortest_path
 from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
@@ -84,6 +85,12 @@ def test_spec_grid_ranges_and_seeds():
     (dict(config={"num_ants": 4}), "config.num_ants: unknown config of rfd_star"),
     (dict(config={"num_agents": 0}), r"\[config\]: num_agents must be at least 1"),
     (dict(extra={"x": 1}), "extra: unknown section"),
+    (dict(sweep={"maps": [{"plane": "map3"}]}), r"sweep.maps\[0\]: plane = 'map3': one of map1"),
+    (dict(sweep={"maps": [{"plane": "random"}]}), r"sweep.maps\[0\]: seed = None: a random"),
+    (dict(sweep={"maps": ["mosaic20", {"plane": "map1"}]}),
+     r"sweep.maps\[1\]: rfd_star plans on a Graph, this map is a Plane"),
+    (dict(sweep={"algorithm": "cabc"}, config={"num_agents": 8}, params={"w1": [1.0]}),
+     r"sweep.maps\[0\]: cabc plans on a Plane, this map is a Graph"),
 ])
 def test_bad_specs_name_the_key(changes, message):
     with pytest.raises(SpecError, match=message):
@@ -188,6 +195,38 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     assert spec.vmap_size is None and metadata["vmap_size"] == min(
         group_size(spec.config["num_agents"]), spec.chunk_size)  # the walker's lanes filled
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
+
+
+def test_a_bees_spec_checks_its_params():
+    document = {"sweep": {"algorithm": "cabc", "maps": [{"plane": "map1"}], "seeds": 1},
+                "params": {"inner_iterations": [2, 1.5]}}
+    with pytest.raises(SpecError, match="params.inner_iterations: inner_iterations must be a "
+                                        "whole number"):
+        spec_from_dict(document, source="bees.toml")
+
+
+def test_a_bees_sweep_over_planes_carries_the_visibility_graph_optimum(tmp_path):
+    document = {"sweep": {"name": "bees", "algorithm": "cabc", "maps": [{"plane": "map2"}],
+                          "seeds": 2, "iterations": 200, "chunk_size": 4},
+                "params": {"w3": [0.0, 0.03]}}
+    frame = run_sweep(spec_from_dict(document), tmp_path / "out", progress=False,
+                      log=lambda _: None)
+    chosen = paper_plane("map2")
+    optimum, _ = shortest_path(chosen.plane, chosen.start, chosen.goal)
+    assert len(frame) == 4 and (frame["optimum"] == optimum).all()
+    assert (frame["gap"][frame["found"]] >= 0).all() and (frame["evaluations"] > 0).all()
+    swarm = make("cabc")
+    task = make_task(chosen.plane, chosen.start, chosen.goal)
+    for _, row in frame.iloc[[1, 2]].iterrows():  # a row equals run() with key(seed)
+        params = swarm.default_params._replace(w3=np.float32(row.w3))
+        state, trace = run(swarm, jax.random.key(int(row.seed)), chosen.plane, task, params,
+                           iterations=200)
+        assert float(swarm.best(state).cost) == row.cost
+        assert int(trace.iterations) == row.iterations
+        assert int(np.sum(trace.moves)) == row.moves
+    metadata = json.loads((tmp_path / "out" / "metadata.json").read_text())
+    assert metadata["maps"] == [dict(label="map2", start=[3.0, 3.0], goal=[47.0, 47.0],
+                                     size="50x50")]
 
 
 def test_a_sweep_with_patience_stops_its_runs_as_run_does(tmp_path):

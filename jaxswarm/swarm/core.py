@@ -24,29 +24,45 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.graph import Graph
+from jaxswarm.maps.plane import Plane, check_point
 from jaxswarm.paths import Solution, as_node
+
+World = Graph | Plane
+"""What a swarm plans in: a graph (the walkers) or a plane of rectangles (the bees)."""
 
 
 class Task(NamedTuple):
-    """Where to go (a pytree of traced scalars: moving the goal is data, not a new shape).
+    """Where to go (a pytree of traced arrays: moving the goal is data, not a new shape).
 
     Attributes:
-      start: i32[] start node.
-      goal: i32[] goal node.
+      start: the start: i32[] node of a graph, f32[2] point (x, y) of a plane.
+      goal: the goal, likewise.
     """
 
     start: jax.Array
     goal: jax.Array
 
 
-def make_task(graph: Graph, start, goal) -> Task:
-    """Host-side: a Task from (x, y) cells or node indices, checked like the exact planners'.
+def make_task(world: World, start, goal) -> Task:
+    """Host-side: a Task from (x, y) cells or node indices of a graph, or (x, y) points of a
+    plane, checked like the exact planners'.
 
     Raises:
       ValueError: start or goal off the map or blocked.
     """
-    return Task(start=jnp.int32(as_node(graph, start, name="start")),
-                goal=jnp.int32(as_node(graph, goal, name="goal")))
+    if isinstance(world, Plane):
+        return Task(start=jnp.asarray(check_point(world, start, name="start"), jnp.float32),
+                    goal=jnp.asarray(check_point(world, goal, name="goal"), jnp.float32))
+    return Task(start=jnp.int32(as_node(world, start, name="start")),
+                goal=jnp.int32(as_node(world, goal, name="goal")))
+
+
+def require_world(swarm: "Swarm", world) -> None:
+    """Host-side: raise a ValueError when ``swarm`` does not plan in a world of ``world``'s kind
+    (a graph swarm given a plane, the bees given a graph)."""
+    if not isinstance(world, swarm.world):
+        raise ValueError(f"{swarm.name} plans on a {swarm.world.__name__}, got a "
+                         f"{type(world).__name__}")
 
 
 class StepInfo(NamedTuple):
@@ -59,8 +75,9 @@ class StepInfo(NamedTuple):
       moves: i32[] moves the agents made (the useful work of the walk).
       lane_steps: i32[] lane-steps the walk's loop executed (a batch of runs shares one loop,
         so under ``vmap`` each run gets the batch's total).
-      evaluations: i32[] complete paths whose length was evaluated: the agents that arrived
-        (the IWD paper's "fitness function calls").
+      evaluations: i32[] fitness calls: complete paths whose length was evaluated (the agents
+        that arrived; the IWD paper's "fitness function calls"), guided-function evaluations of
+        the bees.
     """
 
     iteration_cost: jax.Array
@@ -73,7 +90,7 @@ class StepInfo(NamedTuple):
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Swarm:
-    """A swarm algorithm: pure functions over (State, Graph, Task, Params).
+    """A swarm algorithm: pure functions over (State, World, Task, Params).
 
     Hashable by identity (it is a static argument of ``run``); factories are cached per Config, so
     equal configs give the same Swarm and share compiled code. ``init`` and ``step`` are jitted,
@@ -83,18 +100,22 @@ class Swarm:
     Attributes:
       name: registry name.
       config: the static Config it was built with.
-      init: ``(key, graph, task, params) -> State``.
-      step: ``(state, graph, task, params) -> (State, StepInfo)``: all agents walk once, then the
-        memory is updated.
-      best: ``(state) -> Solution``: the best path found so far.
+      init: ``(key, world, task, params) -> State``.
+      step: ``(state, world, task, params) -> (State, StepInfo)``: all agents walk once, then the
+        memory is updated (the bees: the vehicle takes one step).
+      best: ``(state) -> Solution``: the best path found so far (on a plane: waypoints
+        f32[L, 2], NaN padded).
       default_params: Params that work on the paper maps.
       check_params: ``(params) -> None``, host-side; raises ValueError naming a bad value.
-      memory: ``(state) -> f32[N]``: the swarm's memory per node (altitude, pheromone), for
-        figures and for inspecting what persists between iterations.
+      memory: ``(state) -> f32[...]``: what persists between iterations, for figures: the
+        memory per node (f32[N]: altitude, pheromone) of a graph swarm, the trajectory so far
+        (f32[L, 2]) of the bees' vehicle.
       memory_label: what ``memory`` shows, for colorbars.
       adapt: ``(state, before, after, old_task, new_task, params) -> State``: the memory rule of
         a change of the map (``before`` to ``after``) or the task (see
         :func:`jaxswarm.dynamic.change`); each family documents its own.
+      world: the kind of world it plans in, :class:`~jaxswarm.graph.Graph` or
+        :class:`~jaxswarm.maps.plane.Plane`.
     """
 
     name: str
@@ -107,6 +128,7 @@ class Swarm:
     memory: Callable
     memory_label: str
     adapt: Callable
+    world: type = Graph
 
 
 @dataclasses.dataclass(frozen=True)
@@ -121,7 +143,7 @@ class Trace:
       iterations: i32[] iterations actually run (<= T).
       moves: i32[T] moves the agents made in each iteration.
       lane_steps: i32[T] lane-steps of each iteration's walk (see :class:`StepInfo`).
-      evaluations: i32[T] complete paths evaluated in each iteration (fitness calls).
+      evaluations: i32[T] fitness calls in each iteration (see :class:`StepInfo`).
     """
 
     best_cost: jax.Array
@@ -152,7 +174,7 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
     Args:
       swarm: the algorithm (static).
       key: PRNG key; the same key and inputs give bit-identical results.
-      graph: the map.
+      graph: the world: a Graph, or a Plane for the swarms that plan on one (``swarm.world``).
       task: start and goal (see :func:`make_task`).
       params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
       iterations: the iteration budget T (static).
@@ -170,12 +192,14 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
       ``(state, trace)``: the final State and a :class:`Trace`.
 
     Raises:
-      ValueError: concrete params out of range (checked on the host, outside jit).
+      ValueError: a world of the wrong kind, or concrete params out of range (checked on the
+        host, outside jit).
     """
     if iterations < 1:
         raise ValueError(f"iterations must be at least 1, got {iterations}")
     if patience is not None and patience < 1:
         raise ValueError(f"patience must be at least 1, got {patience}")
+    require_world(swarm, graph)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)

@@ -14,6 +14,7 @@ from typing import Callable, NamedTuple
 import numpy as np
 
 from jaxswarm.swarm.aco import ant_system, improved, max_min
+from jaxswarm.swarm.bees import cabc
 from jaxswarm.swarm.core import Swarm, SwarmConfig
 from jaxswarm.swarm.iwd import iwd, iwd_pg
 from jaxswarm.swarm.rfd import graded, paper
@@ -55,6 +56,8 @@ REGISTRY: dict[str, Entry] = {
                  "IWD_PG paper, eqs. 1-6 (Shah-Hosseini's IWD)"),
     "iwd_pg": Entry(iwd_pg.IWDPGConfig, iwd_pg.build_iwd_pg, "IWD_PG",
                     "IWD_PG paper: IWD with smoothing, memory, intersections, fuzzy local search"),
+    "cabc": Entry(cabc.CABCConfig, cabc.build_cabc, "cABC",
+                  "bees paper, eqs. 1-10: constrained ABC in the sensor window, on a plane"),
 }
 """Registered name -> :class:`Entry`."""
 
@@ -83,9 +86,11 @@ def config_options(name: str) -> tuple[str, ...]:
     return tuple(field.name for field in dataclasses.fields(entry(name).config))
 
 
-def registered() -> tuple[str, ...]:
-    """Names of all registered swarms."""
-    return tuple(sorted(REGISTRY))
+def registered(world: type | None = None) -> tuple[str, ...]:
+    """Names of the registered swarms, sorted; with ``world`` (:class:`~jaxswarm.graph.Graph` or
+    :class:`~jaxswarm.maps.plane.Plane`) only those that plan in that kind of world."""
+    return tuple(name for name in sorted(REGISTRY)
+                 if world is None or make(name).world is world)
 
 
 def definition(swarm: Swarm) -> dict:

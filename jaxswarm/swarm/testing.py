@@ -7,12 +7,14 @@ Each check raises ``AssertionError`` naming what failed:
   equals a loop over them, and another key gives another run.
 * :func:`check_valid_results`: the best path is a valid path from start to goal, its cost is
   its length measured as :func:`jaxswarm.paths.path_length` measures it, never below the
-  optimum; the trace's best cost never rises; the memory stays finite.
+  optimum; the trace's best cost never rises; the memory stays finite. On a plane the path is a
+  trajectory of waypoints: it starts at the start, ends at the goal, no waypoint lies inside a
+  rectangle, and its cost is :func:`jaxswarm.maps.plane.trajectory_length`.
 * :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
   and new values of the same shapes do not compile again.
 
 Use a small map every agent reaches within a few iterations (the project's own suite uses the
-RFD paper's maze20 with 32 agents and 8 iterations).
+RFD paper's maze20 with 32 agents and 8 iterations, and for the bees a 6 x 6 plane).
 """
 from __future__ import annotations
 
@@ -22,9 +24,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph
+from jaxswarm.maps.plane import Plane, in_plane, trajectory_length, violations
 from jaxswarm.paths import is_valid_path, path_length
-from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.core import Swarm, Task, World, run
 
 
 def leaves_equal(a, b) -> bool:
@@ -48,7 +50,7 @@ def outcome(result):
     return key_data((state, dataclasses.replace(trace, lane_steps=None)))
 
 
-def check_reproducible(swarm: Swarm, graph: Graph, task: Task, *, iterations: int = 8,
+def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
                        keys: int = 3) -> None:
     """Same key, same result; ``vmap`` over ``keys`` keys equals the loop (see :func:`outcome`);
     keys differ."""
@@ -67,12 +69,12 @@ def check_reproducible(swarm: Swarm, graph: Graph, task: Task, *, iterations: in
         f"{swarm.name}: two keys gave the same run")
 
 
-def check_valid_results(swarm: Swarm, graph: Graph, task: Task, optimum: float, *,
+def check_valid_results(swarm: Swarm, graph: World, task: Task, optimum: float, *,
                         iterations: int = 8) -> None:
     """One run's best path is found, valid, measured right and never below ``optimum`` (the
     optimum measured as swarm paths are, see :func:`jaxswarm.exact.optimal_length`), and the
     state's float arrays are finite (remembered path lengths, ``costs``, may be +inf where no
-    path is held yet)."""
+    path is held yet, and a trajectory's ``waypoints`` are NaN after its end)."""
     state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                        iterations=iterations)
     solution = swarm.best(state)
@@ -81,9 +83,12 @@ def check_valid_results(swarm: Swarm, graph: Graph, task: Task, optimum: float, 
         if not (jnp.issubdtype(leaf.dtype, jnp.floating) and leaf.ndim > 0):
             continue
         values = np.asarray(leaf)
-        # Path lengths (``costs``) are +inf where a memory slot holds no path yet.
+        # Path lengths (``costs``) are +inf where a memory slot holds no path yet; waypoints
+        # are NaN after the trajectory's end.
         if jax.tree_util.keystr(where).endswith("costs"):
             values = values[values != np.inf]
+        if jax.tree_util.keystr(where).endswith("waypoints"):
+            values = values[~np.isnan(values).all(axis=-1)]
         assert np.isfinite(values).all(), (
             f"{swarm.name}: memory not finite at {jax.tree_util.keystr(where)}")
     ran = int(trace.iterations)
@@ -91,15 +96,32 @@ def check_valid_results(swarm: Swarm, graph: Graph, task: Task, optimum: float, 
     best = np.asarray(trace.best_cost)
     assert np.isnan(best[ran:]).all(), f"{swarm.name}: trace entries after the stop"
     assert (best[1:ran] <= best[:ran - 1]).all(), f"{swarm.name}: best cost rose"
-    assert bool(is_valid_path(graph, solution.path, task.start, task.goal)), (
-        f"{swarm.name}: invalid path")
-    assert float(path_length(graph, solution.path)) == float(solution.cost), (
-        f"{swarm.name}: cost is not the path's length")
+    if isinstance(graph, Plane):
+        _check_trajectory(swarm, graph, task, solution)
+    else:
+        assert bool(is_valid_path(graph, solution.path, task.start, task.goal)), (
+            f"{swarm.name}: invalid path")
+        assert float(path_length(graph, solution.path)) == float(solution.cost), (
+            f"{swarm.name}: cost is not the path's length")
     assert float(solution.cost) >= optimum, f"{swarm.name}: beats the optimum {optimum}"
     assert float(solution.cost) == best[ran - 1], f"{swarm.name}: trace and state disagree"
 
 
-def check_compiles_once(swarm: Swarm, graph: Graph, task: Task, *, iterations: int = 4,
+def _check_trajectory(swarm: Swarm, plane: Plane, task: Task, solution) -> None:
+    """A found trajectory runs from start to goal, every waypoint on the plane and in no
+    rectangle, and its cost is its length."""
+    waypoints = np.asarray(solution.path)
+    points = waypoints[~np.isnan(waypoints).any(axis=-1)]
+    assert np.isnan(waypoints[len(points):]).all(), f"{swarm.name}: gaps in the trajectory"
+    assert np.array_equal(points[0], np.asarray(task.start)), f"{swarm.name}: not from start"
+    assert np.array_equal(points[-1], np.asarray(task.goal)), f"{swarm.name}: not to the goal"
+    assert bool(np.all(in_plane(plane, points))), f"{swarm.name}: a waypoint off the plane"
+    assert not np.any(violations(plane, points)), f"{swarm.name}: a waypoint in an obstacle"
+    assert float(trajectory_length(solution.path)) == float(solution.cost), (
+        f"{swarm.name}: cost is not the trajectory's length")
+
+
+def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: int = 4,
                         runs: int = 16) -> None:
     """A ``vmap`` of ``runs`` runs over valid values of the first param traces the swarm's step
     once, and new values of the same shapes do not trace it again."""
@@ -112,15 +134,15 @@ def check_compiles_once(swarm: Swarm, graph: Graph, task: Task, *, iterations: i
         swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
     grid = jax.tree_util.tree_map(lambda x: jnp.full((runs,), x), counted.default_params)
     grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
-    sweep = jax.jit(jax.vmap(lambda p: run(counted, jax.random.key(0), graph, task, p,
-                                           iterations=iterations)[0].best_cost))
+    sweep = jax.jit(jax.vmap(lambda p: swarm.best(run(counted, jax.random.key(0), graph, task, p,
+                                                      iterations=iterations)[0]).cost))
     costs = sweep(grid)
     sweep(grid._replace(**{first: grid[0] * 0.9}))  # new values, same shapes: no retrace
     assert costs.shape == (runs,)
     assert len(traces) == 1, f"{swarm.name}: traced {len(traces)} times"
 
 
-def check_swarm(swarm: Swarm, graph: Graph, task: Task, optimum: float) -> None:
+def check_swarm(swarm: Swarm, graph: World, task: Task, optimum: float) -> None:
     """Every check of this module, with their defaults."""
     check_reproducible(swarm, graph, task)
     check_valid_results(swarm, graph, task, optimum)

@@ -1,7 +1,10 @@
-"""Map entries of a sweep spec, resolved to a graph and a start-goal query.
+"""Map entries of a sweep spec, resolved to a world (a graph or a plane) and a start-goal query.
 
 An entry is a paper map name (``"mosaic50"``), a seeded random grid
-(``{ random = 50, seed = 3, density = 0.3 }``, corner to corner) or one row of a Moving AI
+(``{ random = 50, seed = 3, density = 0.3 }``, corner to corner), a plane of rectangles for the
+bees (``{ plane = "map1" }``, the bees paper's map #1 or #2, or
+``{ plane = "random", seed = 3, rectangles = 40 }``, see
+:func:`jaxswarm.maps.plane.random_plane`) or one row of a Moving AI
 scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 counted from 0;
 ``scenario_file = "random"`` takes the MAPF set's ``<map>-random-1.scen`` instead of the default
 ``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map).
@@ -14,13 +17,18 @@ import dataclasses
 import os
 from pathlib import Path
 
+import jax
+
+from jaxswarm.exact import optimal_length
 from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.maps import movingai
-from jaxswarm.paths import as_node
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
+from jaxswarm.maps.plane import PAPER_PLANES, Plane, paper_plane, random_plane, shortest_path
 from jaxswarm.maps.random import random_grid
+from jaxswarm.swarm import make_task
 
 RANDOM_KEYS = {"random", "seed", "density"}
+PLANE_KEYS = {"plane", "seed", "rectangles"}
 MOVINGAI_KEYS = {"movingai", "scenario", "scenario_file"}
 MOVINGAI_DATA = "JAXSWARM_MOVINGAI"
 """The environment variable naming the folder of Moving AI maps (relative entries are looked up
@@ -33,15 +41,30 @@ class SweepMap:
 
     Attributes:
       label: the name written in every results row (e.g. ``mosaic50``, ``random50-s3``,
-        ``maze-32-32-2#5``).
-      graph: the map's Graph.
-      start, goal: (x, y) cells.
+        ``maze-32-32-2#5``, ``map1``, ``plane-s3``).
+      world: the map's Graph, or a Plane.
+      start, goal: (x, y) cells of a graph, (x, y) points of a plane.
     """
 
     label: str
-    graph: Graph
-    start: tuple[int, int]
-    goal: tuple[int, int]
+    world: Graph | Plane
+    start: tuple
+    goal: tuple
+
+    @property
+    def size(self) -> str:
+        """``WIDTHxHEIGHT`` of a grid or a plane ("" for a general graph)."""
+        if isinstance(self.world, Plane):
+            return "x".join(f"{float(v):g}" for v in jax.device_get(self.world.extent))
+        return f"{self.world.shape[1]}x{self.world.shape[0]}" if self.world.shape else ""
+
+    def optimum(self) -> float:
+        """The optimal path length, measured as the swarms measure theirs: Dijkstra's path on a
+        graph (:func:`jaxswarm.exact.optimal_length`), the visibility-graph shortest path on a
+        plane (:func:`jaxswarm.maps.plane.shortest_path`); inf when the goal is unreachable."""
+        if isinstance(self.world, Plane):
+            return shortest_path(self.world, self.start, self.goal)[0]
+        return optimal_length(self.world, self.start, self.goal)
 
 
 def check_map_entry(entry) -> str | None:
@@ -50,10 +73,28 @@ def check_map_entry(entry) -> str | None:
     if isinstance(entry, str):
         if entry not in PAPER_MAPS:
             return (f"unknown map {entry!r}; paper maps: {', '.join(PAPER_MAPS)} (or a table "
-                    "{ random = SIZE, seed = S } / { movingai = FILE, scenario = ROW })")
+                    "{ random = SIZE, seed = S } / { movingai = FILE, scenario = ROW } / "
+                    "{ plane = NAME })")
         return None
     if not isinstance(entry, dict):
         return f"a map is a paper map name or a table, got {entry!r}"
+    if "plane" in entry:
+        unknown = set(entry) - PLANE_KEYS
+        if unknown:
+            return f"unknown keys {sorted(unknown)} for a plane ({', '.join(sorted(PLANE_KEYS))})"
+        name = entry["plane"]
+        if name == "random":
+            if not _int_at_least(entry.get("seed"), 0):
+                return (f"seed = {entry.get('seed')!r}: a random plane needs a non-negative "
+                        "integer seed")
+            if not _int_at_least(entry.get("rectangles", 40), 0):
+                return (f"rectangles = {entry['rectangles']!r}: must be a non-negative "
+                        "integer")
+            return None
+        if name not in PAPER_PLANES or set(entry) != {"plane"}:
+            return (f"plane = {name!r}: one of {', '.join(PAPER_PLANES)} (alone) or "
+                    "'random' (with seed and rectangles)")
+        return None
     if "random" in entry:
         unknown = set(entry) - RANDOM_KEYS
         if unknown:
@@ -80,7 +121,12 @@ def check_map_entry(entry) -> str | None:
             return (f"scenario_file = {entry['scenario_file']!r}: 'even', 'random' or a .scen "
                     "file beside the map")
         return None
-    return f"a map table needs a 'random' or a 'movingai' key, got {sorted(entry)}"
+    return f"a map table needs a 'random', 'movingai' or 'plane' key, got {sorted(entry)}"
+
+
+def entry_world(entry) -> type:
+    """The kind of world a well-formed map entry resolves to: Plane or Graph."""
+    return Plane if isinstance(entry, dict) and "plane" in entry else Graph
 
 
 def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
@@ -99,6 +145,15 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
     if isinstance(entry, str):
         chosen = paper_map(entry)
         return SweepMap(entry, chosen.graph(), tuple(chosen.start), tuple(chosen.goal))
+    if "plane" in entry:
+        if entry["plane"] == "random":
+            count = entry.get("rectangles", 40)
+            chosen = random_plane(jax.random.key(entry["seed"]), num_rectangles=count)
+            label = f"plane-s{entry['seed']}-r{count}"
+        else:
+            chosen = paper_plane(entry["plane"])
+            label = chosen.label
+        return SweepMap(label, chosen.plane, chosen.start, chosen.goal)
     if "random" in entry:
         density = float(entry.get("density", 0.3))
         grid = random_grid(entry["random"], entry["seed"], density=density)
@@ -123,10 +178,9 @@ def check_query(sweep_map: SweepMap) -> None:
     """Check that a resolved map's start and goal are on the map and free.
 
     Raises:
-      ValueError: naming the endpoint (see :func:`jaxswarm.paths.as_node`).
+      ValueError: naming the endpoint (see :func:`jaxswarm.swarm.make_task`).
     """
-    as_node(sweep_map.graph, sweep_map.start, name="start")
-    as_node(sweep_map.graph, sweep_map.goal, name="goal")
+    make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
 
 
 def _find_movingai(name: str, base_dir: Path | None) -> Path:

@@ -13,8 +13,10 @@ Maps of the same shape share the compiled program; each compile is logged. A run
 ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
 whatever the chunk size, the group size and the number of devices.
 
-Each map's optimum is Dijkstra's path measured as the swarms measure theirs
-(:func:`jaxswarm.exact.optimal_length`), so every row carries its optimality gap, never negative.
+Each map's optimum is measured as the swarms measure their paths (Dijkstra's path on a graph,
+:func:`jaxswarm.exact.optimal_length`; the visibility-graph shortest path on a plane,
+:func:`jaxswarm.maps.plane.shortest_path`), so every row carries its optimality gap, never
+negative.
 Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec again
 skips them.
 """
@@ -36,7 +38,6 @@ import pandas as pd
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
-from jaxswarm.exact import optimal_length
 from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap, check_query, resolve_map
@@ -111,14 +112,14 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
             todo = [c for mm, c in chunks if mm == m and (mm, c) not in done]
             if not todo:
                 continue
-            task = make_task(sweep_map.graph, sweep_map.start, sweep_map.goal)
-            best = optimal_length(sweep_map.graph, sweep_map.start, sweep_map.goal)
-            graph, task = jax.device_put((sweep_map.graph, task), replicated)
-            program = _program_key(sweep_map.graph)
+            task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
+            best = sweep_map.optimum()
+            world, task = jax.device_put((sweep_map.world, task), replicated)
+            program = _program_key(sweep_map.world)
             if program not in compiled:
                 began = time.perf_counter()
                 example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
-                compiled[program] = batch.lower(*example, graph, task).compile()
+                compiled[program] = batch.lower(*example, world, task).compile()
                 log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
                     f"per chunk on {len(devices)} device(s), {group} at a time, in "
                     f"{time.perf_counter() - began:.1f} s")
@@ -128,7 +129,7 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                 inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
                 began = time.perf_counter()
                 cost, iterations, moves, evaluations = _gather(
-                    compiled[program](*inputs, graph, task))
+                    compiled[program](*inputs, world, task))
                 seconds = time.perf_counter() - began
                 rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
                              cost[:count], iterations[:count], moves[:count],
@@ -158,9 +159,9 @@ def _resolve_maps(spec: SweepSpec, base_dir: Path | None) -> list[SweepMap]:
     return maps
 
 
-def _program_key(graph) -> tuple:
-    """Graphs with equal structure and array shapes share one compiled program."""
-    leaves, treedef = jax.tree_util.tree_flatten(graph)
+def _program_key(world) -> tuple:
+    """Worlds with equal structure and array shapes share one compiled program."""
+    leaves, treedef = jax.tree_util.tree_flatten(world)
     return treedef, tuple(leaf.shape for leaf in leaves)
 
 
@@ -171,19 +172,19 @@ def group_size(num_agents: int) -> int:
 
 
 def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
-    """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], graph, task) -> (cost
+    """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], world, task) -> (cost
     f32[C], iterations i32[C], moves i32[C], evaluations i32[C])``, C a multiple of the mesh
     size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
     ``group`` at a time."""
-    def one(run_input, graph, task):
+    def one(run_input, world, task):
         seed, params = run_input
-        state, trace = run(swarm, jax.random.key(seed), graph, task, params,
+        state, trace = run(swarm, jax.random.key(seed), world, task, params,
                            iterations=spec.iterations, patience=spec.patience)
         return (swarm.best(state).cost, trace.iterations, jnp.sum(trace.moves),
                 jnp.sum(trace.evaluations))
 
-    def share(seeds, params, graph, task):
-        return jax.lax.map(lambda run_input: one(run_input, graph, task), (seeds, params),
+    def share(seeds, params, world, task):
+        return jax.lax.map(lambda run_input: one(run_input, world, task), (seeds, params),
                            batch_size=min(group, seeds.shape[0]))
 
     return jax.jit(jax.shard_map(share, mesh=mesh,
@@ -253,8 +254,8 @@ def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm, group: int) -> dict:
         algorithm=spec.algorithm, config=spec.config, swarm=definition(swarm),
         seeds=list(spec.seeds),
         vmap_size=group,
-        maps=[dict(label=m.label, start=m.start, goal=m.goal,
-                   size=f"{m.graph.shape[1]}x{m.graph.shape[0]}") for m in maps])
+        maps=[dict(label=m.label, start=list(m.start), goal=list(m.goal), size=m.size)
+              for m in maps])
 
 
 def _version() -> str | None:

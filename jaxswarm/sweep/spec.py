@@ -47,7 +47,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from jaxswarm.swarm import registry as swarm_registry
-from jaxswarm.sweep.maps import check_map_entry
+from jaxswarm.sweep.maps import check_map_entry, entry_world
 
 SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size",
@@ -196,6 +196,10 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         swarm = swarm_registry.make(algorithm, **config)
     except (TypeError, ValueError) as error:
         fail("[config]", str(error))
+    for i, entry in enumerate(maps):
+        if entry_world(entry) is not swarm.world:
+            fail(f"sweep.maps[{i}]", f"{algorithm} plans on a {swarm.world.__name__}, this map "
+                 f"is a {entry_world(entry).__name__}")
 
     params = document.get("params", {})
     if not isinstance(params, dict):

@@ -1,0 +1,111 @@
+"""The guided function of the constrained ABC paper (eq. 4) and its constraints (eq. 6).
+
+``Phi(x) = w1 f1(x) + w2 f2(x) + w3 f3(x)`` scores a candidate next position ``x`` of the vehicle,
+which stands at ``here`` and came from ``previous``:
+
+* ``f1`` (eq. 1): the distance from ``x`` to the goal.
+* ``f2`` (pushback): the text lost the formula and defines it as "the sum of minimum distances to
+  obstacles in the current region", to be minimised so that the vehicle keeps away from them. We
+  cast four rays from ``x`` along the world axes (+x, -x, +y, -y), each reaching ``reach`` (half
+  the sensor window), and let each meet only the rectangles' parts inside the window (what the
+  sensor sees). A ray that meets an obstacle at distance ``d`` adds ``reach - d``; one that meets
+  nothing adds 0. So ``f2 = 4 reach - (sum of the four minimum distances)``, in ``[0, 4 reach]``:
+  the paper's sum with the sign that makes minimising ``Phi`` push the vehicle away.
+* ``f3`` (smoothness): the turn, in degrees, between the last move (``previous`` to ``here``) and
+  the candidate move (``here`` to ``x``); 0 before the first move. Degrees, because the paper's
+  weights (``w3`` = 0.03 to 0.2 beside ``w1`` near 1) would make a turn in radians worth less
+  than a fifth of a unit of distance, and its tables show ``w3`` changing the outcome.
+
+A candidate violates eq. 6 for every rectangle it lies strictly inside
+(:func:`jaxswarm.maps.plane.violations`); with ``forbid_crossing`` the move from ``here`` to it
+also violates for every rectangle it passes through (off in the paper's variant, whose vehicle
+only ever checks where it lands).
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+from jaxswarm.maps.plane import Plane, crossings, violations
+
+
+def goal_distance(points: jax.Array, goal: jax.Array) -> jax.Array:
+    """f1, eq. 1: f32[N], the distance of each point (f32[N, 2]) to the goal (f32[2])."""
+    return jnp.linalg.norm(points - goal, axis=-1)
+
+
+def visible_rectangles(plane: Plane, lower: jax.Array, upper: jax.Array):
+    """The obstacles' parts inside the window ``[lower, upper]`` (f32[2] each).
+
+    Returns:
+      ``(boxes f32[R, 4], seen bool[R])``: each rectangle clipped to the window, and whether
+      anything of it is left.
+    """
+    low = jnp.maximum(plane.rectangles[:, :2], lower)
+    high = jnp.minimum(plane.rectangles[:, 2:], upper)
+    seen = plane.mask & jnp.all(low <= high, axis=-1)
+    return jnp.concatenate([low, high], axis=-1), seen
+
+
+def ray_distances(points: jax.Array, boxes: jax.Array, seen: jax.Array,
+                  reach: jax.Array) -> jax.Array:
+    """f32[N, 4]: how far each point (f32[N, 2]) sees along +x, -x, +y and -y before it meets a
+    seen box (f32[R, 4], bool[R]), at most ``reach`` (0 when the point is inside a box)."""
+    x, y = points[:, 0:1], points[:, 1:2]
+    x0, y0, x1, y1 = (boxes[None, :, i] for i in range(4))
+    across_x = seen & (y0 <= y) & (y <= y1)  # boxes a horizontal ray can meet
+    across_y = seen & (x0 <= x) & (x <= x1)
+    far = jnp.inf
+    right = jnp.where(across_x & (x1 >= x), jnp.maximum(x0 - x, 0.0), far)
+    left = jnp.where(across_x & (x0 <= x), jnp.maximum(x - x1, 0.0), far)
+    up = jnp.where(across_y & (y1 >= y), jnp.maximum(y0 - y, 0.0), far)
+    down = jnp.where(across_y & (y0 <= y), jnp.maximum(y - y1, 0.0), far)
+    nearest = jnp.stack([jnp.min(d, axis=-1) for d in (right, left, up, down)], axis=-1)
+    return jnp.minimum(nearest, reach)
+
+
+def pushback(points: jax.Array, plane: Plane, lower: jax.Array, upper: jax.Array,
+             reach: jax.Array) -> jax.Array:
+    """f2: f32[N], ``sum over the four rays of (reach - distance)`` (see the module docstring)."""
+    boxes, seen = visible_rectangles(plane, lower, upper)
+    return jnp.sum(reach - ray_distances(points, boxes, seen, reach), axis=-1)
+
+
+def turn_degrees(points: jax.Array, here: jax.Array, previous: jax.Array,
+                 has_turn: jax.Array) -> jax.Array:
+    """f3: f32[N], the angle in degrees (0 to 180) between the move ``previous -> here`` and each
+    move ``here -> point``; 0 where ``has_turn`` is False or a move has no length."""
+    last = here - previous
+    moves = points - here
+    cross = last[0] * moves[:, 1] - last[1] * moves[:, 0]
+    dot = moves @ last
+    degenerate = (jnp.all(last == 0)) | jnp.all(moves == 0, axis=-1) | ~has_turn
+    return jnp.where(degenerate, 0.0, jnp.degrees(jnp.arctan2(jnp.abs(cross), dot)))
+
+
+def guided(points: jax.Array, weights: jax.Array, plane: Plane, goal: jax.Array,
+           here: jax.Array, previous: jax.Array, has_turn: jax.Array, lower: jax.Array,
+           upper: jax.Array, reach: jax.Array) -> jax.Array:
+    """Phi, eq. 4: f32[N] for candidate points f32[N, 2].
+
+    Args:
+      points: f32[N, 2] candidates.
+      weights: f32[3] ``(w1, w2, w3)``.
+      plane: the world; goal: f32[2].
+      here, previous: f32[2] the vehicle's position and the one before (``has_turn`` bool[]:
+        whether there was one).
+      lower, upper: f32[2] the sensor window; reach: f32[] the rays' length.
+    """
+    return (weights[0] * goal_distance(points, goal)
+            + weights[1] * pushback(points, plane, lower, upper, reach)
+            + weights[2] * turn_degrees(points, here, previous, has_turn))
+
+
+def constraint_violations(points: jax.Array, plane: Plane, here: jax.Array, *,
+                          forbid_crossing: bool) -> jax.Array:
+    """Eq. 6: i32[N], the rectangles each candidate (f32[N, 2]) lies inside, plus (with
+    ``forbid_crossing``) those the move from ``here`` (f32[2]) to it passes through."""
+    count = violations(plane, points)
+    if forbid_crossing:
+        count = count + crossings(plane, here, points)
+    return count

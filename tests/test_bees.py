@@ -1,0 +1,300 @@
+"""The bees: the guided function's parts and the rays against hand computations, Deb's rules on
+each pair case, eqs. 9-10, the colony's search, and the vehicle (never inside an obstacle, its
+trajectory checked by shapely, its length beside the visibility-graph optimum)."""
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxswarm.graph import grid_graph
+from jaxswarm.maps.plane import (PLANE_CAPACITY, make_plane, paper_plane, shortest_path,
+                                 violations)
+from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.bees.colony import (deb_best, deb_better, fitness, onlooker_probabilities,
+                                        search)
+from jaxswarm.swarm.bees.guided import (constraint_violations, goal_distance, guided, pushback,
+                                        turn_degrees)
+
+shapely = pytest.importorskip("shapely")
+STEPS = 200
+"""Every run here has the paper's budget and a plane of PLANE_CAPACITY slots: one compile."""
+
+
+def f32(values):
+    return jnp.asarray(values, jnp.float32)
+
+
+def test_f1_is_the_distance_to_the_goal():
+    assert goal_distance(f32([[0, 0], [3, 4]]), f32([3, 0])).tolist() == [3.0, 4.0]
+
+
+def test_f2_pushes_back_from_what_the_four_rays_meet_inside_the_window():
+    # A wall x in [3, 4] crosses the window [0, 3.5] x [3, 7] (side 4 round (1.5, 5), reach 2);
+    # a second one, x in [6, 7], lies outside it and is not seen.
+    plane = make_plane([(3, 0, 4, 10), (6, 0, 7, 10)], (10, 10))
+    lower, upper, reach = f32([0, 3]), f32([3.5, 7]), jnp.float32(2)
+    points = f32([[2, 5], [2.5, 5], [0.5, 5], [3.2, 5], [2, 2]])
+    # (2, 5): the +x ray meets the wall at 1, so 2 - 1; (2.5, 5): 2 - 0.5; (0.5, 5): 2.5 away,
+    # beyond reach; (3.2, 5): inside, every ray meets it at 0, so 4 x 2; (2, 2) is below the
+    # window, where the sensor sees nothing of the wall.
+    assert pushback(points, plane, lower, upper, reach).tolist() == pytest.approx(
+        [1.0, 1.5, 0.0, 8.0, 0.0])
+
+
+def test_f2_sees_along_both_axes_and_takes_the_nearest():
+    plane = make_plane([(0, 4, 10, 5), (5.5, 0, 6, 10)], (10, 10))
+    # From (5, 3.5): up to the wall y >= 4 at 0.5, right to x >= 5.5 at 0.5; reach 1.
+    value = pushback(f32([[5, 3.5]]), plane, f32([4, 2.5]), f32([6, 4.5]), jnp.float32(1))
+    assert float(value[0]) == pytest.approx(0.5 + 0.5)
+
+
+def test_f3_is_the_turn_in_degrees():
+    previous, here = f32([0, 0]), f32([1, 0])
+    points = f32([[2, 0], [2, 1], [1, 1], [0, 0], [1, 0]])
+    assert turn_degrees(points, here, previous, jnp.array(True)).tolist() == pytest.approx(
+        [0.0, 45.0, 90.0, 180.0, 0.0])  # the last stays put: no turn
+    assert turn_degrees(points, here, previous, jnp.array(False)).tolist() == [0.0] * 5
+
+
+def test_phi_is_the_weighted_sum_of_eq_4():
+    plane = make_plane([(3, 0, 4, 10)], (10, 10))
+    points = f32([[2, 5], [2, 6]])
+    args = (plane, f32([2, 9]), f32([1, 5]), f32([0, 5]), jnp.array(True), f32([0, 3]),
+            f32([3.5, 7]), jnp.float32(2))
+    phi = guided(points, f32([0.5, 2.0, 0.1]), *args)
+    f1 = np.hypot([0, 0], [4, 3])
+    f3 = np.asarray([0.0, 45.0])
+    assert phi.tolist() == pytest.approx(0.5 * f1 + 2.0 * 1.0 + 0.1 * f3)
+
+
+def test_violations_count_rectangles_and_optionally_the_crossed_ones():
+    plane = make_plane([(1, 0, 2, 10), (3, 0, 4, 10)], (10, 10))
+    here, points = f32([0, 5]), f32([[1.5, 5], [5, 5], [0.5, 5]])
+    assert constraint_violations(points, plane, here, forbid_crossing=False).tolist() == [1, 0, 0]
+    assert constraint_violations(points, plane, here, forbid_crossing=True).tolist() == [2, 2, 0]
+
+
+def test_fitness_is_eq_9():
+    assert fitness(f32([3, 0, -2])).tolist() == [0.25, 1.0, 3.0]
+
+
+@pytest.mark.parametrize("a, b, wins", [
+    ((5.0, 0), (1.0, 2), True),  # feasible beats infeasible, however good
+    ((1.0, 2), (5.0, 0), False),
+    ((1.0, 0), (2.0, 0), True),  # both feasible: the fitter
+    ((2.0, 0), (1.0, 0), False),
+    ((1.0, 0), (1.0, 0), False),  # a tie does not beat
+    ((9.0, 1), (1.0, 3), True),  # both infeasible: fewer violations, whatever phi
+    ((1.0, 3), (9.0, 1), False),
+    ((1.0, 2), (9.0, 2), False),
+])
+def test_debs_rules_on_each_pair_case(a, b, wins):
+    assert bool(deb_better(f32(a[0]), jnp.int32(a[1]), f32(b[0]), jnp.int32(b[1]))) is wins
+
+
+def test_the_deb_best_of_a_population():
+    assert int(deb_best(f32([0.5, 3.0, 2.0, 0.1]), jnp.asarray([1, 0, 0, 2]))) == 2
+    assert int(deb_best(f32([0.5, 3.0]), jnp.asarray([2, 1]))) == 1
+
+
+def test_onlooker_probabilities_are_eq_10():
+    # fit = [0.5, 0.25, 0.5], summed over all sources: 1.25; violations sum to 2.
+    p = onlooker_probabilities(f32([1, 3, 1]), jnp.asarray([0, 0, 2]))
+    assert p.tolist() == pytest.approx([0.5 + 0.5 * 0.5 / 1.25, 0.5 + 0.5 * 0.25 / 1.25, 0.0])
+    p = onlooker_probabilities(f32([1, 1, 1]), jnp.asarray([1, 1, 2]))
+    assert p.tolist() == pytest.approx([0.375, 0.375, 0.25])
+
+
+def _bowl(target, wall=None):
+    """The distance to ``target``; points inside ``wall`` violate it."""
+    def evaluate(points):
+        phi = jnp.linalg.norm(points - target, axis=-1)
+        if wall is None:
+            return phi, jnp.zeros(points.shape[0], jnp.int32)
+        inside = jnp.all((points > wall[:2]) & (points < wall[2:]), axis=-1)
+        return phi, inside.astype(jnp.int32)
+    return evaluate
+
+
+def test_cycles_bring_the_colony_to_the_minimum_and_are_counted():
+    lower, upper = f32([0, 0]), f32([4, 4])
+    evaluate = _bowl(f32([1.0, 3.0]))
+    colony = jax.jit(jax.vmap(lambda cycles: search(
+        jax.random.key(1), evaluate, lower, upper, num_sources=20, cycles=cycles,
+        limit=jnp.int32(40))))
+    cycles = np.asarray([0, 2, 20])
+    best = colony(jnp.asarray(cycles, jnp.int32))
+    gaps = np.asarray(best.phi)
+    assert gaps == pytest.approx(np.asarray(evaluate(best.point)[0]))
+    # N at the start, then per cycle N employed tries, at most N onlookers, scouts.
+    evaluations = np.asarray(best.evaluations)
+    assert (20 + 20 * cycles <= evaluations).all() and (evaluations <= 20 + 60 * cycles).all()
+    assert gaps[2] < gaps[1] <= gaps[0] and gaps[2] < 0.05
+
+
+def test_the_search_keeps_to_the_box_and_prefers_feasible_points():
+    lower, upper = f32([0, 0]), f32([4, 4])
+    wall = f32([0.5, 2.5, 1.5, 3.5])  # covers the unconstrained minimum (1, 3)
+    best = jax.jit(jax.vmap(lambda key: search(
+        key, _bowl(f32([1.0, 3.0]), wall), lower, upper, num_sources=12, cycles=jnp.int32(6),
+        limit=jnp.int32(4))))(jax.random.split(jax.random.key(0), 8))
+    points = np.asarray(best.point)
+    assert (np.asarray(best.violations) == 0).all()
+    assert (points >= 0).all() and (points <= 4).all()
+    assert not ((points > [0.5, 2.5]) & (points < [1.5, 3.5])).all(axis=1).any()
+
+
+def test_zero_cycles_is_the_greedy_pick_of_the_first_sources():
+    lower, upper = f32([0, 0]), f32([4, 4])
+    key = jax.random.key(3)
+    best = search(key, _bowl(f32([2.0, 2.0])), lower, upper, num_sources=10,
+                  cycles=jnp.int32(0), limit=jnp.int32(20))
+    first = lower + jax.random.uniform(jax.random.split(key)[0], (10, 2)) * (upper - lower)
+    distances = np.linalg.norm(np.asarray(first) - 2.0, axis=1)
+    assert np.allclose(best.point, first[np.argmin(distances)]) and int(best.evaluations) == 10
+
+
+def shapely_collisions(plane, waypoints) -> int:
+    """Segments of a trajectory that enter an obstacle's interior, counted by shapely."""
+    points = waypoints[~np.isnan(waypoints).any(axis=1)]
+    boxes = [shapely.box(*b).buffer(-1e-5, join_style="mitre") for b in plane.obstacles()]
+    return sum(any(box.intersects(shapely.LineString([a, b])) for box in boxes)
+               for a, b in zip(points[:-1], points[1:]) if not np.array_equal(a, b))
+
+
+@pytest.fixture(scope="module")
+def map2_runs():
+    """Ten runs of each variant on map #2 (weights of the paper's Table 5 best)."""
+    chosen = paper_plane("map2")
+    task = make_task(chosen.plane, chosen.start, chosen.goal)
+    runs = {}
+    for forbid in (False, True):
+        swarm = make("cabc", forbid_crossing=forbid)
+        params = swarm.default_params._replace(w1=np.float32(0.8), w2=np.float32(0.1))
+        runs[forbid] = swarm, jax.vmap(lambda k: run(swarm, k, chosen.plane, task, params,
+                                                     iterations=STEPS))(
+            jax.random.split(jax.random.key(0), 10))
+    return chosen, task, runs
+
+
+def test_the_vehicle_never_stands_inside_an_obstacle(map2_runs):
+    chosen, _, runs = map2_runs
+    for swarm, (state, trace) in runs.values():
+        waypoints = np.asarray(state.waypoints)
+        held = ~np.isnan(waypoints).any(axis=-1)
+        assert int(np.asarray(violations(chosen.plane, jnp.asarray(waypoints[held]))).sum()) == 0
+        assert (held.sum(axis=1) == np.asarray(state.count)).all()
+        assert (np.asarray(trace.moves).sum(axis=1) <= 200).all()
+
+
+def test_with_forbid_crossing_every_trajectory_is_collision_free(map2_runs):
+    chosen, task, runs = map2_runs
+    swarm, (state, _) = runs[True]
+    assert sum(shapely_collisions(chosen.plane, w) for w in np.asarray(state.waypoints)) == 0
+    # The paper's vehicle checks only where it lands, and clips corners.
+    paper_swarm, (paper_state, _) = runs[False]
+    assert sum(shapely_collisions(chosen.plane, w)
+               for w in np.asarray(paper_state.waypoints)) > 0
+
+
+def test_an_arrived_trajectory_ends_at_the_goal_and_is_never_shorter_than_the_optimum(map2_runs):
+    chosen, task, runs = map2_runs
+    optimum, _ = shortest_path(chosen.plane, chosen.start, chosen.goal)
+    arrived = 0
+    for swarm, (state, trace) in runs.values():
+        solution = jax.vmap(swarm.best)(state)
+        for found, cost, waypoints, count in zip(np.asarray(solution.found),
+                                                 np.asarray(solution.cost),
+                                                 np.asarray(solution.path),
+                                                 np.asarray(state.count)):
+            if not found:
+                assert math.isinf(cost)
+                continue
+            arrived += 1
+            assert np.array_equal(waypoints[count - 1], np.asarray(chosen.goal, np.float32))
+            assert cost >= optimum
+            length = np.sum(np.linalg.norm(np.diff(waypoints[:count], axis=0), axis=1))
+            assert cost == pytest.approx(length, rel=1e-5)
+    assert arrived > 0
+
+
+def test_a_vehicle_with_no_feasible_candidate_stays():
+    # Four squares meet where the vehicle stands: all its window but two lines is blocked.
+    plane = make_plane([(3, 3, 5, 5), (5, 3, 7, 5), (3, 5, 5, 7), (5, 5, 7, 7)], (10, 10),
+                       capacity=PLANE_CAPACITY)
+    swarm = make("cabc")
+    task = make_task(plane, (5, 5), (9, 9))
+    state, trace = run(swarm, jax.random.key(0), plane, task, swarm.default_params,
+                       iterations=STEPS)
+    assert int(state.count) == 1 and int(np.asarray(trace.moves).sum()) == 0
+    assert int(trace.iterations) == STEPS and not bool(swarm.best(state).found)
+
+
+def test_the_vehicle_moves_at_most_max_steps_times():
+    chosen = paper_plane("map1")
+    swarm = make("cabc", max_steps=5)
+    task = make_task(chosen.plane, chosen.start, chosen.goal)
+    state, trace = run(swarm, jax.random.key(0), chosen.plane, task, swarm.default_params,
+                       iterations=STEPS)
+    assert int(np.asarray(trace.moves).sum()) == 5 and int(state.count) == 6
+    assert state.waypoints.shape == (7, 2)
+
+
+def test_a_vehicle_started_at_the_goal_has_arrived():
+    chosen = paper_plane("map1")
+    swarm = make("cabc")
+    task = make_task(chosen.plane, chosen.goal, (47.2, 47.0))
+    state, trace = run(swarm, jax.random.key(0), chosen.plane, task, swarm.default_params,
+                       iterations=STEPS)
+    assert int(trace.iterations) == 1 and bool(swarm.best(state).found)
+    assert float(swarm.best(state).cost) == pytest.approx(0.2, abs=1e-5)
+
+
+def test_after_a_new_goal_the_vehicle_goes_on_from_where_it_stands():
+    chosen = paper_plane("map1")
+    swarm = make("cabc")
+    params = swarm.default_params._replace(w2=np.float32(0), w3=np.float32(0))
+    task = make_task(chosen.plane, (3.0, 3.0), (6.0, 3.0))
+    state, _ = run(swarm, jax.random.key(0), chosen.plane, task, params, iterations=STEPS)
+    assert bool(state.reached)
+    new_task = make_task(chosen.plane, (3.0, 3.0), (3.0, 6.5))
+    adapted = swarm.adapt(state, chosen.plane, chosen.plane, task, new_task, params)
+    assert not bool(adapted.reached) and int(adapted.count) == int(state.count)
+    after, _ = run(swarm, jax.random.key(1), chosen.plane, new_task, params, iterations=STEPS,
+                   state=adapted)
+    assert bool(after.reached) and int(after.count) > int(state.count)
+    assert np.array_equal(after.waypoints[:int(state.count)], state.waypoints[:int(state.count)])
+
+
+def test_bees_and_walkers_refuse_each_others_worlds():
+    chosen = paper_plane("map1")
+    graph = grid_graph(np.zeros((4, 4), bool))
+    bees, drops = make("cabc"), make("rfd_star", num_agents=8)
+    with pytest.raises(ValueError, match="cabc plans on a Plane, got a Graph"):
+        run(bees, jax.random.key(0), graph, make_task(graph, (0, 0), (3, 3)),
+            bees.default_params)
+    with pytest.raises(ValueError, match="rfd_star plans on a Graph, got a Plane"):
+        run(drops, jax.random.key(0), chosen.plane,
+            make_task(chosen.plane, chosen.start, chosen.goal), drops.default_params)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("w2", -0.1, "w2 must be non-negative"),
+    ("inner_iterations", 2.5, "inner_iterations must be a whole number >= 0"),
+    ("limit", 0, "limit must be a whole number >= 1"),
+    ("window", 0, "window must be positive"),
+    ("tolerance", np.nan, "tolerance must be finite"),
+])
+def test_bad_params_are_named(field, value, message):
+    swarm = make("cabc")
+    with pytest.raises(ValueError, match=message):
+        swarm.check_params(swarm.default_params._replace(**{field: np.float32(value)}))
+
+
+def test_bad_sizes_are_named():
+    with pytest.raises(ValueError, match="cabc needs num_agents >= 2"):
+        make("cabc", num_agents=1)
+    with pytest.raises(ValueError, match="cabc needs max_steps"):
+        make("cabc", max_steps=None)
