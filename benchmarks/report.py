@@ -60,6 +60,11 @@ BENCHMARKS = [
      "RFD paper's Tables 2-5 on the 100 x 100 paper maps (5 seeds here; the issue's check runs "
      "20): time from the change to the first iteration with the new optimum and to the run's "
      "own stop, beside A* from scratch on the changed map and D* Lite's repair."),
+    ("Bees: evaluations per second", "bees.py", [], ["--quick", "--maps", "map1"],
+     "`cabc` on the bees paper's maps #1 and #2 (ours): one run alone, and a 1,000-run weight "
+     "sweep (10 x 10 x 10 values of w1, w2, w3) in one compiled `vmap`; guided-function "
+     "evaluations per second (the useful work the traces count), the share of the sweep loop's "
+     "iterations that belonged to a run still going, and the peak resident memory."),
 ]
 """(title, script, arguments, quick arguments, what it measures) of each section."""
 

@@ -36,7 +36,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.exact import dijkstra
 from jaxswarm.graph import path_map_graph
 from jaxswarm.maps.random import random_path_map
@@ -242,8 +242,7 @@ def main(argv: list[str] | None = None) -> int:
     write_csv(args.out / "results.csv", rows, COLUMNS)
     markdown = table(rows, ants=args.ants, max_ants=args.max_ants, patience=args.patience,
                      seed=args.seed)
-    write_atomically(args.out / "table.md", record.document(markdown))
-    record.write(args.out)
+    record.publish(args.out, markdown)
     print("\n" + markdown)
     return 0
 

@@ -52,7 +52,7 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import atomic_path, write_atomically, write_csv
+from jaxswarm.atomic import atomic_path, write_csv
 from jaxswarm.exact import astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra
 from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
@@ -298,8 +298,7 @@ def main(argv: list[str] | None = None) -> int:
     write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
     write_csv(args.out / "summary.csv", summary, SUMMARY_COLUMNS)
     plot_summary(summary, args.out / "exact_study.png")
-    write_atomically(args.out / "table.md", record.document(summary_markdown(summary)))
-    record.write(args.out)
+    record.publish(args.out, summary_markdown(summary))
 
     print("\n" + format_summary(summary))
     print(f"\n{len(rows)} runs in {time.perf_counter() - began:.0f} s; costs of the planners "

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.exact import astar
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
 from jaxswarm.swarm import definition, make, make_task, run
@@ -124,10 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args),
                   swarm=definition(make("iwd", num_agents=args.drops)))
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    text = record.document(markdown(rows, args.maps, args))
-    write_atomically(args.out / "table.md", text)
-    record.write(args.out)
-    print("\n" + text)
+    print("\n" + record.publish(args.out, markdown(rows, args.maps, args)))
     return 0
 
 

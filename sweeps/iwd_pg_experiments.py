@@ -52,7 +52,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from jaxswarm.atomic import write_atomically, write_csv  # noqa: E402
+from jaxswarm.atomic import write_csv  # noqa: E402
 from jaxswarm.exact import dijkstra  # noqa: E402
 from jaxswarm.maps.iwd_pg import iwd_pg_map  # noqa: E402
 from jaxswarm.maps.paper import paper_map  # noqa: E402
@@ -339,11 +339,7 @@ def main(argv: list[str] | None = None) -> int:
     write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
     write_csv(args.out / "curves.csv", curves, CURVE_COLUMNS)
     write_csv(args.out / "scores.csv", scores, SCORE_COLUMNS)
-    body = "\n\n".join(f"## {title}\n\n" + "\n".join(lines) for title, lines in sections)
-    text = record.document(body)
-    write_atomically(args.out / "table.md", text)
-    record.write(args.out)
-    print("\n" + text)
+    print("\n" + record.publish(args.out, provenance.join_sections(sections)))
     return 0
 
 

@@ -111,6 +111,19 @@ class Provenance:
         text = json.dumps(dataclasses.asdict(self), indent=2, default=str)
         write_atomically(Path(folder) / METADATA, text + "\n")
 
+    def publish(self, folder, body: str) -> str:
+        """Write the table, ``folder / table.md`` (:meth:`document` of ``body``), and the record
+        beside it (:meth:`write`), each atomically; returns the Markdown."""
+        text = self.document(body)
+        write_atomically(Path(folder) / "table.md", text)
+        self.write(folder)
+        return text
+
+
+def join_sections(sections: Sequence[tuple[str, Sequence[str]]]) -> str:
+    """Markdown of ``(title, lines)`` sections: a ``##`` heading each, then its lines."""
+    return "\n\n".join(f"## {title}\n\n" + "\n".join(lines) for title, lines in sections)
+
 
 def begin(script: str, argv: Sequence[str] | None) -> Provenance:
     """The record of a run of ``script`` (its ``__file__``) with arguments ``argv`` (None: the

@@ -46,7 +46,7 @@ import matplotlib
 matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
 from jaxswarm.exact import astar, replanner
 from jaxswarm.graph import grid_graph
@@ -290,9 +290,7 @@ def main(argv: list[str] | None = None) -> int:
     record_.finish(title=TITLE, about=ABOUT, arguments=vars(args),
                    rows=static.row_definitions(args.agents))
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    text = record_.document(markdown(rows, args.maps, tables, args))
-    write_atomically(args.out / "table.md", text)
-    record_.write(args.out)
+    text = record_.publish(args.out, markdown(rows, args.maps, tables, args))
     for table in tables:
         fig = figure(best, table)
         save_png(fig, args.out / f"table{table}.png")

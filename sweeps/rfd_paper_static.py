@@ -62,7 +62,7 @@ matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.exact import astar, dijkstra
 from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import (
@@ -365,10 +365,8 @@ def main(argv: list[str] | None = None) -> int:
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args),
                   rows=row_definitions(args.agents))
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    markdown = record.document(table(rows, args.maps, seeds=args.seeds,
-                                     iterations=args.iterations, agents=args.agents))
-    write_atomically(args.out / "table.md", markdown)
-    record.write(args.out)
+    markdown = record.publish(args.out, table(rows, args.maps, seeds=args.seeds,
+                                              iterations=args.iterations, agents=args.agents))
     fig = figure(best)
     save_png(fig, args.out / "best_paths.png")
     plt.close(fig)

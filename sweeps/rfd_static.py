@@ -28,7 +28,7 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
 from jaxswarm.swarm import definition, make, make_task, run
@@ -146,8 +146,7 @@ def main(argv: list[str] | None = None) -> int:
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args), swarms=swarms)
     write_csv(args.out / "runs.csv", rows, COLUMNS)
     markdown = table(rows, args.maps)
-    write_atomically(args.out / "table.md", record.document(markdown))
-    record.write(args.out)
+    record.publish(args.out, markdown)
     print("\n" + markdown)
     return 0
 

@@ -49,7 +49,7 @@ import matplotlib
 matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 
-from jaxswarm.atomic import write_atomically, write_csv
+from jaxswarm.atomic import write_csv
 from jaxswarm.dynamic import Event
 from jaxswarm.graph import Graph, path_map_graph
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
@@ -279,9 +279,7 @@ def main(argv: list[str] | None = None) -> int:
               for row in ROWS if row.swarm}
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args), swarms=swarms)
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    text = record.document(markdown(rows, maps, args))
-    write_atomically(args.out / "table.md", text)
-    record.write(args.out)
+    text = record.publish(args.out, markdown(rows, maps, args))
     fig = walks_figure(examples)
     save_png(fig, args.out / "walks.png")
     plt.close(fig)

@@ -47,6 +47,7 @@ TINY = {
     "iwd_pg_experiments": ("sweeps/iwd_pg_experiments.py",
                            ["--experiments", "1", "--runs-smooth", "1", "--iterations", "2",
                             "--drops", "8"]),
+    "bees_tables": ("sweeps/bees_tables.py", ["--tables", "6", "--runs", "1"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 
@@ -217,6 +218,24 @@ def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
         assert int(r["evaluations"]) <= 8 * int(r["iterations"])  # drops only: no operator
     table = (folder / "iwd_pg_experiments" / "table.md").read_text()
     assert "## 1. Smoothing" in table and "| + smoothing | 1 |" in table
+
+
+def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
+    folder, _ = quick
+    rows = read_csv(folder / "bees_tables" / "runs.csv")
+    assert [(r["variant"], r["cycles"]) for r in rows] == [
+        (variant, cycles) for variant in ("cabc", "cabc, forbid_crossing")
+        for cycles in ("0", "1", "2", "5", "8", "10")]
+    for r in rows:
+        assert (r["map"], (r["w1"], r["w2"], r["w3"])) == ("map1", ("1.0", "0.2", "0.03"))
+        assert float(r["optimum"]) == pytest.approx(63.3667, abs=1e-4)
+        assert float(r["length"]) >= float(r["optimum"])  # inf when not reached
+        assert (r["reached"] == "True") == math.isfinite(float(r["length"]))
+        assert int(r["evaluations"]) >= 20 * int(r["steps"]) and float(r["seconds"]) > 0
+        assert r["clipped"] == "False" or r["variant"] == "cabc"
+    table = (folder / "bees_tables" / "table.md").read_text()
+    assert "| 0 | paper | 34 | 137 | 30 |" in table and "| 10 | cabc, forbid_crossing |" in table
+    assert (folder / "bees_tables" / "map1.png").is_file()
 
 
 def test_path_map_table_has_the_papers_values_beside_ours(quick):

@@ -1,6 +1,7 @@
-"""Swarm planners on the graph tensors: the protocol and run loop (``core``), the walker
-(``walking``), the algorithms (``rfd``, ``aco``), the registry of names (``registry``:
-``make(name, **config)``) and the conformance suite every swarm passes (``testing``)."""
+"""Swarm planners on the graph tensors and on planes: the protocol and run loop (``core``), the
+walker (``walking``), the algorithms (``rfd``, ``aco``, ``iwd`` on graphs; ``bees`` on planes),
+the registry of names (``registry``: ``make(name, **config)``) and the conformance suite every
+swarm passes (``testing``)."""
 from jaxswarm.swarm.core import Swarm, Task, Trace, make_task, run
 from jaxswarm.swarm.registry import config_options, definition, make, registered
 

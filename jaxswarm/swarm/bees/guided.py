@@ -31,7 +31,7 @@ from jaxswarm.maps.plane import Plane, crossings, violations
 
 def goal_distance(points: jax.Array, goal: jax.Array) -> jax.Array:
     """f1, eq. 1: f32[N], the distance of each point (f32[N, 2]) to the goal (f32[2])."""
-    return jnp.linalg.norm(points - goal, axis=-1)
+    return jnp.hypot(points[:, 0] - goal[0], points[:, 1] - goal[1])
 
 
 def visible_rectangles(plane: Plane, lower: jax.Array, upper: jax.Array):
@@ -77,9 +77,11 @@ def turn_degrees(points: jax.Array, here: jax.Array, previous: jax.Array,
     move ``here -> point``; 0 where ``has_turn`` is False or a move has no length."""
     last = here - previous
     moves = points - here
+    # Products written out, not a matmul: the same elementwise code alone and under vmap (a
+    # batched dot may be lowered differently).
     cross = last[0] * moves[:, 1] - last[1] * moves[:, 0]
-    dot = moves @ last
-    degenerate = (jnp.all(last == 0)) | jnp.all(moves == 0, axis=-1) | ~has_turn
+    dot = last[0] * moves[:, 0] + last[1] * moves[:, 1]
+    degenerate = jnp.all(last == 0) | jnp.all(moves == 0, axis=-1) | ~has_turn
     return jnp.where(degenerate, 0.0, jnp.degrees(jnp.arctan2(jnp.abs(cross), dot)))
 
 

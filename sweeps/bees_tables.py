@@ -1,0 +1,292 @@
+"""The bees paper's Tables 1-7: cABC on maps #1 and #2, ours beside the paper's.
+
+Every row is ``--runs`` runs (seeds 0, 1, ...) of ``cabc`` with the paper's M = 200 steps:
+
+* **Tables 1-5**: the paper's weight settings (Table 1: ``w1, w2``; Tables 2-3: ``w1, w3``;
+  Tables 4-5: all three), 8 colony cycles a step (the paper's "number of cABC runs during each
+  iteration equals to 8").
+* **Tables 6-7**: 0 to 10 colony cycles a step; the paper does not say with which weights: we
+  use its best of Tables 4 and 5 (:data:`FIGURE_WEIGHTS`).
+
+Columns: target (runs that reached the goal), the mean and standard deviation of the path length
+of those runs (avgP, stdP) and of one run's wall time (avgT, stdT: each run timed alone after a
+warm-up compile), then ours only: the vehicle's steps and the bee evaluations per run (means),
+the runs whose trajectory passes through an obstacle (the paper's vehicle checks only where it
+lands, so it may clip a corner; shapely-free check: :func:`jaxswarm.maps.plane.crossings`) and
+the best length found against the visibility-graph optimum. Each table has the paper's variant
+(``cabc``) and the one that also forbids moves through obstacles (``forbid_crossing``).
+
+Written to ``--out`` (default ``out/bees_tables``; ``make reproduce`` uses
+``results/bees_tables``), each file atomically: ``runs.csv`` (one row per run), ``table.md``,
+``provenance.json`` and ``map1.png``, ``map2.png`` (the first runs of the paper's best weights,
+with the sensor windows they saw, beside the shortest path; drawn when a table that runs them,
+4 to 7, is asked for).
+
+Run from the repository root (about 5 minutes on 2 cores)::
+
+    python sweeps/bees_tables.py
+    python sweeps/bees_tables.py --tables 1,6 --runs 4
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import jax
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from jaxswarm.atomic import write_csv  # noqa: E402
+from jaxswarm.maps.plane import crossings, paper_plane, shortest_path  # noqa: E402
+from jaxswarm.plot import save_png  # noqa: E402
+from jaxswarm.plot_plane import draw_plane, draw_trajectory  # noqa: E402
+from jaxswarm.swarm import definition, make, make_task, run  # noqa: E402
+
+HERE = str(Path(__file__).resolve().parent)
+if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
+    sys.path.insert(0, HERE)
+import provenance  # noqa: E402
+
+STEPS = 200
+"""The paper's M: the most vehicle steps of a run."""
+CYCLES = 8
+"""Colony cycles per step in Tables 1-5."""
+VARIANTS = {"cabc": False, "cabc, forbid_crossing": True}
+"""Row label -> the ``forbid_crossing`` switch."""
+FIGURE_WEIGHTS = {"map1": (1.0, 0.2, 0.03), "map2": (0.8, 0.1, 0.03)}
+"""The paper's best weights per map (Tables 4 and 5; Tables 6-7 use them too): their runs with
+8 cycles, from whichever table ran them first, are drawn."""
+
+PAPER = {
+    # table: (map, [(w1, w2, w3, target, avgP, stdP, avgT, stdT)])
+    1: ("map1", [(0.7, 0.3, 0.0, 5, 113, 31, 1.9, 0.98), (0.9, 0.1, 0.0, 17, 68, 0.8, 0.4, 0.06),
+                 (1.0, 0.0, 0.0, 16, 66, 1.9, 0.35, 0.05)]),
+    2: ("map1", [(0.5, 0.0, 0.05, 6, 141, 32, 0.92, 0.3), (0.6, 0.0, 0.05, 5, 201, 30, 1.5, 0.3),
+                 (0.7, 0.0, 0.03, 17, 118, 44, 0.96, 0.6), (0.7, 0.0, 0.1, 5, 153, 53, 1.0, 0.53),
+                 (0.8, 0.0, 0.05, 12, 155, 57, 1.1, 0.6), (0.9, 0.0, 0.1, 3, 180, 58, 1.2, 0.6),
+                 (0.9, 0.0, 0.05, 12, 155, 51, 1.23, 0.7)]),
+    3: ("map2", [(0.6, 0.0, 0.01, 1, 94.6, 0.0, 0.27, 0.0), (0.7, 0.0, 0.03, 14, 166, 53, 0.5, 0.2),
+                 (0.7, 0.0, 0.1, 10, 178, 61, 0.36, 0.2), (0.8, 0.0, 0.05, 13, 179, 46, 0.4, 0.1),
+                 (0.9, 0.0, 0.1, 8, 188, 83, 0.4, 0.2), (0.9, 0.0, 0.05, 10, 154, 35, 0.35, 0.1),
+                 (1.0, 0.0, 0.05, 14, 173, 70, 0.4, 0.2)]),
+    4: ("map1", [(0.8, 0.1, 0.05, 16, 146, 39, 1.1, 0.5), (0.8, 0.2, 0.1, 9, 186, 50, 1.4, 0.5),
+                 (0.8, 0.3, 0.2, 7, 164, 30, 1.2, 0.3), (0.9, 0.2, 0.05, 14, 171, 41, 1.6, 0.5),
+                 (0.9, 0.1, 0.1, 6, 133, 25, 0.95, 0.3), (0.9, 0.3, 0.03, 17, 105, 30, 0.9, 0.4),
+                 (1.0, 0.1, 0.1, 7, 168, 48, 1.2, 0.5), (1.0, 0.2, 0.03, 17, 90, 30, 0.7, 0.4),
+                 (1.2, 0.1, 0.05, 17, 132, 36, 1.1, 0.5)]),
+    5: ("map2", [(0.8, 0.1, 0.05, 11, 141, 41, 0.8, 0.4), (0.8, 0.2, 0.05, 5, 195, 50, 1.4, 0.4),
+                 (0.8, 0.3, 0.05, 10, 203, 53, 1.43, 0.4), (0.9, 0.2, 0.05, 14, 165, 58, 1.2, 0.5),
+                 (0.9, 0.1, 0.03, 12, 153, 55, 1.3, 0.6), (0.8, 0.1, 0.03, 16, 183, 54, 1.5, 0.6),
+                 (0.7, 0.1, 0.03, 14, 166, 60, 1.3, 0.6), (1.0, 0.1, 0.05, 14, 187, 55, 1.4, 0.5),
+                 (1.2, 0.1, 0.05, 13, 146, 34, 1.1, 0.3)]),
+}
+"""The paper's Tables 1-5 as printed (Tables 2-3 weigh f1 and f3: their w2 is 0)."""
+
+PAPER_CYCLES = {
+    # table: (map, weights, [(cycles, target, avgP, stdP)])
+    6: ("map1", FIGURE_WEIGHTS["map1"], [(0, 34, 137, 30), (1, 32, 120, 28), (2, 32, 126, 30),
+                                   (5, 32, 125, 26), (8, 24, 132, 20), (10, 24, 116, 12)]),
+    7: ("map2", FIGURE_WEIGHTS["map2"], [(0, 13, 205, 72), (1, 15, 200, 60), (2, 14, 202, 50),
+                                   (3, 17, 146, 60), (5, 19, 137, 36), (8, 14, 142, 37)]),
+}
+"""The paper's Tables 6-7. Table 6 prints its columns as avgP, stdP, target, but its values read
+as target, avgP, stdP (a target of 34 runs, so more than 20 of them; its text calls the row of 2
+cycles best "due to the shorter path"); we read them so."""
+
+TITLE = "The bees paper's Tables 1-7: cABC on maps #1 and #2"
+ABOUT = ("`cabc` is the paper's constrained ABC local planner as written (eqs. 1-10, Deb's "
+         "rules; the sizes the paper leaves open are ours: 20 sources, a window of side 2, a "
+         "tolerance of 0.5; f2 and f3 as `jaxswarm.swarm.bees.guided` defines them). "
+         "`cabc, forbid_crossing` is the same with moves through an obstacle forbidden too. "
+         "Maps #1 and #2 are ours, built in the spirit of the paper's figures "
+         "(`jaxswarm.maps.plane`). The paper's values are quoted beside ours.")
+
+RUN_COLUMNS = ["table", "map", "variant", "w1", "w2", "w3", "cycles", "seed", "reached",
+               "length", "optimum", "steps", "evaluations", "clipped", "seconds"]
+
+
+def settings(table: int) -> tuple[str, list[tuple[float, float, float, int]]]:
+    """A table's map and its rows as ``(w1, w2, w3, cycles)``."""
+    if table in PAPER:
+        name, rows = PAPER[table]
+        return name, [(w1, w2, w3, CYCLES) for w1, w2, w3, *_ in rows]
+    name, weights, rows = PAPER_CYCLES[table]
+    return name, [(*weights, cycles) for cycles, *_ in rows]
+
+
+def study(table: int, variant: str, runs: int) -> tuple[list[dict], np.ndarray]:
+    """Every run of a table's rows for one variant: all rows and seeds in one vmapped program
+    for the outcomes, then each run again alone for its wall time. Returns the rows and the
+    trajectories (f32[rows, M + 2, 2])."""
+    name, rows = settings(table)
+    chosen = paper_plane(name)
+    swarm = make("cabc", forbid_crossing=VARIANTS[variant])
+    task = make_task(chosen.plane, chosen.start, chosen.goal)
+    optimum, _ = shortest_path(chosen.plane, chosen.start, chosen.goal)
+    grid = [(row, seed) for row in rows for seed in range(runs)]
+    params = jax.tree_util.tree_map(lambda value: np.full(len(grid), value, np.float32),
+                                    swarm.default_params)._replace(**{
+        field: np.asarray([row[i] for row, _ in grid], np.float32)
+        for i, field in enumerate(("w1", "w2", "w3", "inner_iterations"))})
+    keys = jax.vmap(jax.random.key)(np.asarray([seed for _, seed in grid]))
+    batch = jax.jit(jax.vmap(lambda key, p: run(swarm, key, chosen.plane, task, p,
+                                                iterations=STEPS)))
+    states, traces = jax.device_get(batch(keys, params))
+    solutions = jax.device_get(jax.vmap(swarm.best)(states))
+    clipped = np.asarray(jax.vmap(lambda w: crossings(chosen.plane, w[:-1], w[1:]).sum())(
+        states.waypoints)) > 0
+    out = []
+    for i, (row, seed) in enumerate(grid):
+        one = jax.tree_util.tree_map(lambda leaf: leaf[i], params)
+        out.append(dict(table=table, map=name, variant=variant, w1=row[0], w2=row[1],
+                        w3=row[2], cycles=row[3], seed=seed,
+                        reached=bool(solutions.found[i]),
+                        length=float(solutions.cost[i]), optimum=optimum,
+                        steps=int(traces.moves[i].sum()),
+                        evaluations=int(traces.evaluations[i].sum()),
+                        clipped=bool(clipped[i]),
+                        seconds=time_alone(swarm, seed, chosen, task, one)))
+    return out, np.asarray(states.waypoints)
+
+
+def time_alone(swarm, seed: int, chosen, task, params) -> float:
+    """The wall time of one run on its own (compiled by the first call of the variant)."""
+    began = time.perf_counter()
+    jax.block_until_ready(run(swarm, jax.random.key(seed), chosen.plane, task, params,
+                              iterations=STEPS))
+    return time.perf_counter() - began
+
+
+def warm_up(variant: str) -> None:
+    """Compile the variant's unbatched run (one compile serves both maps: same shapes)."""
+    chosen = paper_plane("map1")
+    swarm = make("cabc", forbid_crossing=VARIANTS[variant])
+    time_alone(swarm, 0, chosen, make_task(chosen.plane, chosen.start, chosen.goal),
+               swarm.default_params)
+
+
+def summarise(runs: list[dict]) -> tuple[str, ...]:
+    """Our cells of a row: target, avgP, stdP, avgT, stdT, steps, evaluations, clipped."""
+    lengths = [r["length"] for r in runs if r["reached"]]
+    seconds = [r["seconds"] for r in runs]
+    return (f"{len(lengths)}/{len(runs)}", _mean(lengths), _std(lengths), _mean(seconds, 3),
+            _std(seconds, 3), f"{statistics.mean(r['steps'] for r in runs):.0f}",
+            f"{statistics.mean(r['evaluations'] for r in runs):.0f}",
+            f"{sum(r['clipped'] for r in runs)}")
+
+
+def table_lines(table: int, rows: list[dict]) -> list[str]:
+    """The Markdown of one table: per setting, the paper's row, then ours per variant."""
+    name, settings_ = settings(table)
+    optimum = rows[0]["optimum"]
+    best = min((r["length"] for r in rows if r["reached"]), default=float("inf"))
+    key = "w1 | w2 | w3" if table in PAPER else "cycles"
+    lines = [f"Map {name[-1]}: shortest path {optimum:.2f}; the best of our runs "
+             f"{best:.2f}.", "",
+             f"| {key} | rows | target | avgP | stdP | avgT (s) | stdT (s) | steps | "
+             "evaluations | clipped |",
+             "| " + " | ".join(["---"] * (3 if table in PAPER else 1)) + " | --- |"
+             + " ---: |" * 8]
+    for i, setting in enumerate(settings_):
+        label = (" | ".join(f"{w:g}" for w in setting[:3]) if table in PAPER
+                 else f"{setting[3]}")
+        paper = paper_cells(table, i)
+        lines.append(f"| {label} | paper | " + " | ".join(paper) + " | | | |")
+        for variant in VARIANTS:
+            mine = [r for r in rows if r["variant"] == variant
+                    and (r["w1"], r["w2"], r["w3"], r["cycles"]) == setting]
+            lines.append(f"| {label} | {variant} | " + " | ".join(summarise(mine)) + " |")
+    return lines
+
+
+def paper_cells(table: int, i: int) -> tuple[str, ...]:
+    """The paper's target, avgP, stdP, avgT, stdT of row ``i`` ("" where it gives none)."""
+    if table in PAPER:
+        *_, target, avg, std, seconds, spread = PAPER[table][1][i]
+        return f"{target}/20", f"{avg:g}", f"{std:g}", f"{seconds:g}", f"{spread:g}"
+    _, target, avg, std = PAPER_CYCLES[table][2][i]
+    return f"{target}", f"{avg:g}", f"{std:g}", "", ""
+
+
+def trajectory_figure(path: Path, name: str, rows: list[dict], waypoints: np.ndarray) -> None:
+    """The trajectories of ``rows`` (at most four) on map ``name`` with the sensor windows they
+    saw every 5th step, and the shortest path dashed."""
+    chosen = paper_plane(name)
+    first = rows[0]
+    weights = (first["w1"], first["w2"], first["w3"])
+    fig, ax = plt.subplots(figsize=(6.4, 6.4))
+    draw_plane(ax, chosen.plane, start=chosen.start, goal=chosen.goal,
+               title=f"{name}: cabc, w = {weights}, {first['cycles']} cycles a step")
+    optimum, shortest = shortest_path(chosen.plane, chosen.start, chosen.goal)
+    draw_trajectory(ax, shortest, color="k", linestyle="--", label=f"shortest path {optimum:.1f}")
+    window = float(make("cabc").default_params.window)
+    for row, points in zip(rows[:4], waypoints[:4]):
+        draw_trajectory(ax, points, window=window, every=5,
+                        label=f"seed {row['seed']}: " + (f"reached, {row['length']:.1f}"
+                                                         if row["reached"] else "stopped"))
+    ax.legend(loc="lower right", fontsize=7)
+    save_png(fig, path)
+    plt.close(fig)
+
+
+def _mean(values, digits: int = 1) -> str:
+    return f"{statistics.mean(values):.{digits}f}" if values else "-"
+
+
+def _std(values, digits: int = 1) -> str:
+    return f"{statistics.pstdev(values):.{digits}f}" if values else "-"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tables", default="1,2,3,4,5,6,7", help="comma-separated, from 1-7")
+    parser.add_argument("--runs", type=int, default=20, help="runs (seeds) per row")
+    parser.add_argument("--out", type=Path, default=Path("out/bees_tables"))
+    args = parser.parse_args(argv)
+    if args.runs < 1:
+        parser.error(f"--runs must be at least 1, got {args.runs}")
+    try:
+        chosen = sorted({int(t) for t in args.tables.split(",")})
+    except ValueError:
+        parser.error(f"--tables must be numbers from 1-7, got {args.tables!r}")
+    if not set(chosen) <= set(range(1, 8)):
+        parser.error(f"--tables must be numbers from 1-7, got {args.tables!r}")
+    record = provenance.begin(__file__, argv)
+    rows, sections, drawn = [], [], set()
+    for variant in VARIANTS:
+        warm_up(variant)
+    for table in chosen:
+        began = time.perf_counter()
+        mine = []
+        for variant in VARIANTS:
+            found, waypoints = study(table, variant, args.runs)
+            mine += found
+            name = found[0]["map"]
+            best = [i for i, r in enumerate(found) if (r["w1"], r["w2"], r["w3"], r["cycles"])
+                    == (*FIGURE_WEIGHTS[name], CYCLES)]
+            if variant == "cabc" and best and name not in drawn:
+                trajectory_figure(args.out / f"{name}.png", name, [found[i] for i in best],
+                                  waypoints[best])
+                drawn.add(name)
+        rows += mine
+        what = {1: "f1 and f2", 2: "f1 and f3", 3: "f1 and f3", 4: "f1, f2 and f3",
+                5: "f1, f2 and f3"}.get(table, "colony cycles per step")
+        sections.append((f"Table {table}: {what}, map #{settings(table)[0][-1]}",
+                         table_lines(table, mine)))
+        print(f"table {table}: {time.perf_counter() - began:.0f} s", flush=True)
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args),
+                  swarm=definition(make("cabc")))
+    write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
+    print("\n" + record.publish(args.out, provenance.join_sections(sections)))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
