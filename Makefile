@@ -51,6 +51,7 @@ IWD_FULL := --maps all --seeds 20 --drops 50 --iterations 100 --patience 30
 IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-complex 15 \
 	--iterations 50 --drops 50
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
+BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
 RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
@@ -60,6 +61,7 @@ ROBOT_QUICK := --maps pathmap10x10,maze20 --seeds 2 --iterations 10 --patience 5
 IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
 IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --runs 2 --iterations 5 --drops 20
 BEES_QUICK := --tables 1,6 --runs 2
+BEES_INVERSE_QUICK := --maps map1 --seeds 2 --grid 2x2x1 --pairs 1
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 125 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
@@ -70,6 +72,7 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 
 	$(BIN)/python sweeps/iwd_paper_maps.py $(IWD_FULL) --out $(RESULTS)/iwd_paper_maps
 	$(BIN)/python sweeps/iwd_pg_experiments.py $(IWD_PG_FULL) --out $(RESULTS)/iwd_pg_experiments
 	$(BIN)/python sweeps/bees_tables.py $(BEES_FULL) --out $(RESULTS)/bees_tables
+	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_FULL) --out $(RESULTS)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/provenance.py $(RESULTS)
 
@@ -82,6 +85,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/iwd_paper_maps.py $(IWD_QUICK) --out $(QUICK_OUT)/iwd_paper_maps
 	$(BIN)/python sweeps/iwd_pg_experiments.py $(IWD_PG_QUICK) --out $(QUICK_OUT)/iwd_pg_experiments
 	$(BIN)/python sweeps/bees_tables.py $(BEES_QUICK) --out $(QUICK_OUT)/bees_tables
+	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_QUICK) --out $(QUICK_OUT)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 

@@ -15,7 +15,7 @@ from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.bees.colony import (deb_best, deb_better, fitness, onlooker_probabilities,
                                         search)
 from jaxswarm.swarm.bees.guided import (constraint_violations, goal_distance, guided, pushback,
-                                        turn_degrees)
+                                        revisits, turn_degrees)
 
 shapely = pytest.importorskip("shapely")
 STEPS = 200
@@ -286,6 +286,7 @@ def test_bees_and_walkers_refuse_each_others_worlds():
     ("limit", 0, "limit must be a whole number >= 1"),
     ("window", 0, "window must be positive"),
     ("tolerance", np.nan, "tolerance must be finite"),
+    ("w4", -1, "w4 must be non-negative"),
 ])
 def test_bad_params_are_named(field, value, message):
     swarm = make("cabc")
@@ -298,3 +299,25 @@ def test_bad_sizes_are_named():
         make("cabc", num_agents=1)
     with pytest.raises(ValueError, match="cabc needs max_steps"):
         make("cabc", max_steps=None)
+
+
+def test_f4_counts_the_earlier_windows_that_hold_a_point():
+    waypoints = f32([[0, 0], [1, 0], [2, 0], [np.nan, np.nan]])
+    points = f32([[0.5, 0.5], [1.8, 0], [2.5, 0], [-2, 0]])
+    # (0.5, 0.5) lies in the windows round (0, 0) and (1, 0); (1.8, 0) in (1, 0)'s; (2.5, 0)
+    # only in the current position's, which does not count.
+    assert revisits(points, waypoints, jnp.int32(3), jnp.float32(1)).tolist() == [2, 1, 0, 0]
+    assert revisits(points, waypoints, jnp.int32(1), jnp.float32(1)).tolist() == [0, 0, 0, 0]
+
+
+def test_a_vehicle_that_remembers_pays_for_going_back():
+    chosen = paper_plane("map2")
+    plain, remembering = make("cabc"), make("cabc", remember=True)
+    task = make_task(chosen.plane, chosen.start, chosen.goal)
+    params = plain.default_params._replace(w4=np.float32(0))
+    a, _ = run(plain, jax.random.key(0), chosen.plane, task, params, iterations=STEPS)
+    b, _ = run(remembering, jax.random.key(0), chosen.plane, task, params, iterations=STEPS)
+    assert np.array_equal(a.waypoints, b.waypoints, equal_nan=True)  # w4 = 0: no memory
+    c, _ = run(remembering, jax.random.key(0), chosen.plane, task, remembering.default_params,
+               iterations=STEPS)
+    assert not np.array_equal(a.waypoints, c.waypoints, equal_nan=True)

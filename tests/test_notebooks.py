@@ -187,3 +187,15 @@ def test_water_drops(notebook_env):
     assert result["smoothed_not_longer"] and result["scores_in_range"]
     assert set(result["finals"]) == {"IWD_PG", "smoothing alone"}
     assert count_images(nb) >= 4
+
+
+@pytest.mark.slow  # compiles the vehicle's run and the inverse problem's scorer: about a minute
+def test_bees(notebook_env):
+    nb = execute("bees.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+    assert result["inside"] == 0 and math.isfinite(result["optimum"])
+    assert result["search_runs"] <= result["grid_runs"]  # optax within the grid's budget
+    assert result["grid_best"] > 0 and result["search_best"] > 0
+    assert count_images(nb) >= 2

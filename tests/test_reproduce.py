@@ -48,6 +48,8 @@ TINY = {
                            ["--experiments", "1", "--runs-smooth", "1", "--iterations", "2",
                             "--drops", "8"]),
     "bees_tables": ("sweeps/bees_tables.py", ["--tables", "6", "--runs", "1"]),
+    "bees_inverse": ("sweeps/bees_inverse.py",
+                     ["--maps", "map1", "--seeds", "1", "--grid", "2x1x1", "--pairs", "1"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
 
@@ -236,6 +238,26 @@ def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
     table = (folder / "bees_tables" / "table.md").read_text()
     assert "| 0 | paper | 34 | 137 | 30 |" in table and "| 10 | cabc, forbid_crossing |" in table
     assert (folder / "bees_tables" / "map1.png").is_file()
+
+
+def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(quick):
+    folder, _ = quick
+    landscape = read_csv(folder / "bees_inverse" / "landscape.csv")
+    search = read_csv(folder / "bees_inverse" / "search.csv")
+    fresh = read_csv(folder / "bees_inverse" / "fresh.csv")
+    assert len(landscape) == len(search) == 2  # one seed each: equal budgets of runs
+    for r in landscape + search + fresh:
+        target, objective = int(r["target"]), float(r["objective"])
+        if target:
+            assert objective == pytest.approx(float(r["avg_length"]) / (1 + target), rel=1e-5)
+        else:
+            assert objective == pytest.approx(201 * 2 / math.sqrt(2), rel=1e-5)
+    assert [(r["setting"], r["remember"], r["seeds"]) for r in fresh] == [
+        (setting, remember, "1") for remember in ("False", "True")
+        for setting in ("grid best", "optax best", "paper")]
+    table = (folder / "bees_inverse" / "table.md").read_text()
+    assert "w = (1.05, 0.2, 0.03), target 30/30, avgP 108" in table
+    assert (folder / "bees_inverse" / "map1.png").is_file()
 
 
 def test_path_map_table_has_the_papers_values_beside_ours(quick):

@@ -27,7 +27,7 @@ import numpy as np
 from jaxswarm.maps.plane import Plane, crossings, trajectory_length
 from jaxswarm.paths import Solution
 from jaxswarm.swarm.bees.colony import search
-from jaxswarm.swarm.bees.guided import constraint_violations, guided
+from jaxswarm.swarm.bees.guided import constraint_violations, guided, revisits
 from jaxswarm.swarm.core import StepInfo, Swarm, SwarmConfig, Task, check_positive, default_params
 
 
@@ -40,11 +40,14 @@ class CABCConfig(SwarmConfig):
       max_steps: M, the most moves of the vehicle (its trajectory holds M + 2 points).
       forbid_crossing: a move that passes through a rectangle violates it too (off in the paper,
         whose vehicle only checks where it lands: a move may then clip an obstacle's corner).
+      remember: the vehicle remembers the windows it has seen and adds ``w4 f4`` to Phi
+        (:func:`~jaxswarm.swarm.bees.guided.revisits`; the paper's future work, off).
     """
 
     num_agents: int = 20
     max_steps: int = 200
     forbid_crossing: bool = False
+    remember: bool = False
 
     def __post_init__(self):
         super().__post_init__()
@@ -66,6 +69,8 @@ class CABCParams(NamedTuple):
       window: the side of the sensor window (2).
       limit: trials before a source goes to a scout (40, the paper's 2N for N = 20).
       tolerance: the distance to the goal that counts as arrived (0.5).
+      w4: the weight of the revisit penalty, with ``remember`` (0.2: after about seven visits a
+        window costs what one step towards the goal gains).
     """
 
     w1: jax.Array
@@ -75,6 +80,7 @@ class CABCParams(NamedTuple):
     window: jax.Array
     limit: jax.Array
     tolerance: jax.Array
+    w4: jax.Array
 
 
 @dataclasses.dataclass(frozen=True)
@@ -103,7 +109,7 @@ WAYPOINTS_LABEL = "trajectory (x, y)"
 def cabc_defaults(num_agents: int = 20) -> CABCParams:
     """The default :class:`CABCParams` for a colony of ``num_agents`` sources (limit 2N)."""
     return default_params(CABCParams, w1=1.0, w2=0.2, w3=0.03, inner_iterations=8, window=2.0,
-                          limit=2 * num_agents, tolerance=0.5)
+                          limit=2 * num_agents, tolerance=0.5, w4=0.2)
 
 
 def check_cabc(params: CABCParams) -> None:
@@ -113,7 +119,7 @@ def check_cabc(params: CABCParams) -> None:
     Raises:
       ValueError: naming the param.
     """
-    for name in ("w1", "w2", "w3"):
+    for name in ("w1", "w2", "w3", "w4"):
         check_positive(name, getattr(params, name), allow_zero=True)
     for name in ("window", "tolerance"):
         check_positive(name, getattr(params, name))
@@ -153,6 +159,8 @@ def build_cabc(config: CABCConfig) -> Swarm:
         def evaluate(candidates):
             phi = guided(candidates, weights, plane, task.goal, here, previous,
                          state.count >= 2, lower, upper, half)
+            if config.remember:
+                phi = phi + params.w4 * revisits(candidates, state.waypoints, state.count, half)
             return phi, constraint_violations(candidates, plane, here,
                                               forbid_crossing=config.forbid_crossing)
 

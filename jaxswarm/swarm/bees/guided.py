@@ -16,6 +16,10 @@ which stands at ``here`` and came from ``previous``:
   weights (``w3`` = 0.03 to 0.2 beside ``w1`` near 1) would make a turn in radians worth less
   than a fifth of a unit of distance, and its tables show ``w3`` changing the outcome.
 
+The paper's future work, a vehicle that remembers the regions where it has been, adds
+``w4 f4`` (:func:`revisits`): ``f4`` counts the sensor windows of the vehicle's earlier positions
+that contain the candidate, so a vehicle going round in a trap pays more the longer it stays.
+
 A candidate violates eq. 6 for every rectangle it lies strictly inside
 (:func:`jaxswarm.maps.plane.violations`); with ``forbid_crossing`` the move from ``here`` to it
 also violates for every rectangle it passes through (off in the paper's variant, whose vehicle
@@ -83,6 +87,16 @@ def turn_degrees(points: jax.Array, here: jax.Array, previous: jax.Array,
     dot = last[0] * moves[:, 0] + last[1] * moves[:, 1]
     degenerate = jnp.all(last == 0) | jnp.all(moves == 0, axis=-1) | ~has_turn
     return jnp.where(degenerate, 0.0, jnp.degrees(jnp.arctan2(jnp.abs(cross), dot)))
+
+
+def revisits(points: jax.Array, waypoints: jax.Array, count: jax.Array,
+             reach: jax.Array) -> jax.Array:
+    """f4: f32[N], for each point (f32[N, 2]), how many windows of half-side ``reach`` round the
+    vehicle's earlier positions contain it: ``waypoints[:count - 1]`` (f32[L, 2]; the current
+    position, ``waypoints[count - 1]``, and the NaN padding do not count)."""
+    earlier = jnp.arange(waypoints.shape[0]) < count - 1
+    inside = jnp.all(jnp.abs(points[:, None, :] - waypoints[None]) <= reach, axis=-1)
+    return jnp.sum(inside & earlier, axis=-1).astype(jnp.float32)
 
 
 def guided(points: jax.Array, weights: jax.Array, plane: Plane, goal: jax.Array,
