@@ -162,14 +162,29 @@ def markdown(fresh: list[dict], landscape: list[dict], tried: list[dict], args) 
                   f"(objective {paper[2] / (1 + paper[1]):.2f}).", "",
                   "| setting | remember | w1 | w2 | w3 | target | avgP | objective |",
                   "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
-        for r in fresh:
-            if r["map"] == name:
-                avg = "-" if np.isnan(r["avg_length"]) else f"{r['avg_length']:.1f}"
-                lines.append(f"| {r['setting']} | {'yes' if r['remember'] else 'no'} | "
-                             f"{r['w1']:.3f} | {r['w2']:.3f} | {r['w3']:.3f} | "
-                             f"{r['target']}/{r['seeds']} | {avg} | {r['objective']:.2f} |")
-        lines.append("")
+        mine = [r for r in fresh if r["map"] == name]
+        for r in mine:
+            avg = "-" if np.isnan(r["avg_length"]) else f"{r['avg_length']:.1f}"
+            lines.append(f"| {r['setting']} | {'yes' if r['remember'] else 'no'} | "
+                         f"{r['w1']:.3f} | {r['w2']:.3f} | {r['w3']:.3f} | "
+                         f"{r['target']}/{r['seeds']} | {avg} | {r['objective']:.2f} |")
+        lines += ["", verdict(mine), ""]
     return "\n".join(lines)
+
+
+def verdict(rows: list[dict]) -> str:
+    """Plain words on a map's fresh seeds: is optax's best at least as good as the grid's, and
+    does the memory raise the target rate?"""
+    score = {(r["setting"], r["remember"]): r for r in rows}
+    grid, optax = score["grid best", False], score["optax best", False]
+    words = ("at least as good as" if optax["objective"] <= grid["objective"]
+             else "worse than")
+    memory = ", ".join(f"{setting} {score[setting, False]['target']} -> "
+                       f"{score[setting, True]['target']}"
+                       for setting in ("grid best", "optax best", "paper"))
+    return (f"On fresh seeds the optax search's best ({optax['objective']:.2f}) is {words} "
+            f"the grid's best ({grid['objective']:.2f}). Arrivals without and with the "
+            f"memory of visited windows: {memory}.")
 
 
 def main(argv: list[str] | None = None) -> int:
