@@ -182,8 +182,8 @@ def verdict(rows: list[dict]) -> str:
     memory = ", ".join(f"{setting} {score[setting, False]['target']} -> "
                        f"{score[setting, True]['target']}"
                        for setting in ("grid best", "optax best", "paper"))
-    return (f"On fresh seeds the optax search's best ({optax['objective']:.2f}) is {words} "
-            f"the grid's best ({grid['objective']:.2f}). Arrivals without and with the "
+    return (f"On fresh seeds the optax search's best ({optax['objective']:.3f}) is {words} "
+            f"the grid's best ({grid['objective']:.3f}). Arrivals without and with the "
             f"memory of visited windows: {memory}.")
 
 
