@@ -37,8 +37,8 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size
 # 10..100. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with other work, load
 # 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables 63 min, robot study
-# 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, A* study about 5 min alone: about
-# 125 minutes in all.
+# 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables 7 min and inverse
+# problem 10 min, A* study about 5 min alone: about 145 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -63,7 +63,7 @@ IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --runs 2 --iterations 5 --drop
 BEES_QUICK := --tables 1,6 --runs 2
 BEES_INVERSE_QUICK := --maps map1 --seeds 2 --grid 2x2x1 --pairs 1
 
-reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 125 min on 2 cores)
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 145 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps

@@ -1,2 +1,3 @@
 """Where maps come from: ``paper`` (the RFD paper's maze/mosaic/alley maps), ``random`` (seeded
-random grids and thin-wall path maps) and ``movingai`` (Moving AI ``.map``/``.scen`` files)."""
+random grids and thin-wall path maps), ``movingai`` (Moving AI ``.map``/``.scen`` files),
+``iwd_pg`` (the IWD_PG experiments' maps) and ``plane`` (planes of rectangles for the bees)."""
