@@ -179,6 +179,7 @@ def map2_runs():
     return chosen, task, runs
 
 
+@pytest.mark.slow  # the fixture compiles two variants' batched runs: about 25 s
 def test_the_vehicle_never_stands_inside_an_obstacle(map2_runs):
     chosen, _, runs = map2_runs
     for swarm, (state, trace) in runs.values():
@@ -189,6 +190,7 @@ def test_the_vehicle_never_stands_inside_an_obstacle(map2_runs):
         assert (np.asarray(trace.moves).sum(axis=1) <= 200).all()
 
 
+@pytest.mark.slow
 def test_with_forbid_crossing_every_trajectory_is_collision_free(map2_runs):
     chosen, task, runs = map2_runs
     swarm, (state, _) = runs[True]
@@ -199,6 +201,7 @@ def test_with_forbid_crossing_every_trajectory_is_collision_free(map2_runs):
                for w in np.asarray(paper_state.waypoints)) > 0
 
 
+@pytest.mark.slow
 def test_an_arrived_trajectory_ends_at_the_goal_and_is_never_shorter_than_the_optimum(map2_runs):
     chosen, task, runs = map2_runs
     optimum, _ = shortest_path(chosen.plane, chosen.start, chosen.goal)

@@ -49,7 +49,8 @@ def shapely_shortest(plane, start, goal) -> float:
 def test_a_point_violates_the_rectangles_it_lies_strictly_inside():
     plane = make_plane([(1, 1, 4, 4), (3, 3, 6, 6)], (10, 10), capacity=4)
     points = jnp.asarray([[2, 2], [3.5, 3.5], [1, 2], [4, 4], [8, 8], [6, 5]], jnp.float32)
-    assert violations(plane, points).tolist() == [1, 2, 0, 1, 0, 0]  # (4, 4): a corner of one, in the other
+    # (4, 4) is a corner of the first and inside the second; (6, 5) on the second's side.
+    assert violations(plane, points).tolist() == [1, 2, 0, 1, 0, 0]
     assert in_plane(plane, jnp.asarray([[0, 10], [10.5, 1], [-1, 3]], jnp.float32)).tolist() == [
         True, False, False]
 

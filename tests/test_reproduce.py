@@ -52,6 +52,9 @@ TINY = {
                      ["--maps", "map1", "--seeds", "1", "--grid", "2x1x1", "--pairs", "1"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
 }
+SLOW_TINY = ("bees_tables", "bees_inverse")
+"""Scripts whose tiny run compiles the bees' programs (about 45 s): run with the slow checks."""
+QUICK = {name: run for name, run in TINY.items() if name not in SLOW_TINY}
 
 
 def git_head() -> str | None:
@@ -63,18 +66,30 @@ def git_head() -> str | None:
         return None
 
 
-@pytest.fixture(scope="module")
-def quick(tmp_path_factory):
-    """A results folder written by every table script at a tiny size, then indexed; with each
-    script's wall time as measured here."""
-    folder = tmp_path_factory.mktemp("results")
+def tiny_results(folder, scripts: dict) -> dict:
+    """Run each of ``scripts`` (as :data:`TINY`) at its tiny size into ``folder``, then index
+    it; each script's wall time as measured here."""
     seconds = {}
-    for name, (script, argv) in TINY.items():
+    for name, (script, argv) in scripts.items():
         began = time.perf_counter()
         assert load_script(script).main([*argv, "--out", str(folder / name)]) == 0
         seconds[name] = time.perf_counter() - began
     assert provenance.main([str(folder)]) == 0
-    return folder, seconds
+    return seconds
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    """A results folder written by the table scripts of :data:`QUICK`, then indexed."""
+    folder = tmp_path_factory.mktemp("results")
+    return folder, tiny_results(folder, QUICK)
+
+
+@pytest.fixture(scope="module")
+def bees_quick(tmp_path_factory):
+    """The same for the bees' scripts (:data:`SLOW_TINY`)."""
+    folder = tmp_path_factory.mktemp("bees_results")
+    return folder, tiny_results(folder, {name: TINY[name] for name in SLOW_TINY})
 
 
 def read_csv(path) -> list[dict]:
@@ -126,7 +141,7 @@ def test_git_state_names_the_checkout_commit():
 def test_every_table_starts_with_its_provenance(quick):
     folder, seconds = quick
     commit = git_head()
-    for name, (script, argv) in TINY.items():
+    for name, (script, argv) in QUICK.items():
         text = (folder / name / "table.md").read_text(encoding="utf-8")
         record = json.loads((folder / name / "provenance.json").read_text(encoding="utf-8"))
         command = shlex.join(["python", script, *argv, "--out", str(folder / name)])
@@ -146,8 +161,8 @@ def test_index_lists_every_table_in_the_order_they_ran(quick):
     folder, _ = quick
     text = (folder / "README.md").read_text(encoding="utf-8")
     sections = [line for line in text.splitlines() if line.startswith("## ")]
-    assert [line.split("`")[1] for line in sections] == [f"{name}/" for name in TINY]
-    records = [provenance.load(folder / name) for name in TINY]
+    assert [line.split("`")[1] for line in sections] == [f"{name}/" for name in QUICK]
+    records = [provenance.load(folder / name) for name in QUICK]
     for record in records:
         assert f"* command: `{record['command']}`" in text
     total = sum(record["seconds"] for record in records)
@@ -222,8 +237,9 @@ def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
     assert "## 1. Smoothing" in table and "| + smoothing | 1 |" in table
 
 
-def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
-    folder, _ = quick
+@pytest.mark.slow
+def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(bees_quick):
+    folder, _ = bees_quick
     rows = read_csv(folder / "bees_tables" / "runs.csv")
     assert [(r["variant"], r["cycles"]) for r in rows] == [
         (variant, cycles) for variant in ("cabc", "cabc, forbid_crossing")
@@ -240,8 +256,9 @@ def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
     assert (folder / "bees_tables" / "map1.png").is_file()
 
 
-def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(quick):
-    folder, _ = quick
+@pytest.mark.slow
+def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(bees_quick):
+    folder, _ = bees_quick
     landscape = read_csv(folder / "bees_inverse" / "landscape.csv")
     search = read_csv(folder / "bees_inverse" / "search.csv")
     fresh = read_csv(folder / "bees_inverse" / "fresh.csv")

@@ -252,8 +252,13 @@ def paper_plane(name: str) -> PlaneMap:
     return PlaneMap(name, plane, spec["start"], spec["goal"])
 
 
-def random_plane(key: jax.Array, *, num_rectangles: int = 40, extent: float = 50.0,
-                 sides: tuple[float, float] = (2.0, 8.0), start=(2.5, 2.5), goal=(47.5, 47.5),
+RANDOM_RECTANGLES = 40
+"""Rectangles of a random plane unless told otherwise."""
+
+
+def random_plane(key: jax.Array, *, num_rectangles: int = RANDOM_RECTANGLES,
+                 extent: float = 50.0, sides: tuple[float, float] = (2.0, 8.0),
+                 start=(2.5, 2.5), goal=(47.5, 47.5),
                  capacity: int | None = None) -> PlaneMap:
     """A seeded random plane: ``num_rectangles`` axis-aligned rectangles with sides uniform in
     ``sides``, placed uniformly in an ``extent`` x ``extent`` plane; rectangles that would contain

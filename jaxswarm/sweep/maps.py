@@ -23,7 +23,8 @@ from jaxswarm.exact import optimal_length
 from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.maps import movingai
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.plane import PAPER_PLANES, Plane, paper_plane, random_plane, shortest_path
+from jaxswarm.maps.plane import (PAPER_PLANES, RANDOM_RECTANGLES, Plane, paper_plane,
+                                 random_plane, shortest_path)
 from jaxswarm.maps.random import random_grid
 from jaxswarm.swarm import make_task
 
@@ -41,7 +42,7 @@ class SweepMap:
 
     Attributes:
       label: the name written in every results row (e.g. ``mosaic50``, ``random50-s3``,
-        ``maze-32-32-2#5``, ``map1``, ``plane-s3``).
+        ``maze-32-32-2#5``, ``map1``, ``plane-s3-r40``).
       world: the map's Graph, or a Plane.
       start, goal: (x, y) cells of a graph, (x, y) points of a plane.
     """
@@ -87,7 +88,7 @@ def check_map_entry(entry) -> str | None:
             if not _int_at_least(entry.get("seed"), 0):
                 return (f"seed = {entry.get('seed')!r}: a random plane needs a non-negative "
                         "integer seed")
-            if not _int_at_least(entry.get("rectangles", 40), 0):
+            if not _int_at_least(entry.get("rectangles", RANDOM_RECTANGLES), 0):
                 return (f"rectangles = {entry['rectangles']!r}: must be a non-negative "
                         "integer")
             return None
@@ -147,7 +148,7 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
         return SweepMap(entry, chosen.graph(), tuple(chosen.start), tuple(chosen.goal))
     if "plane" in entry:
         if entry["plane"] == "random":
-            count = entry.get("rectangles", 40)
+            count = entry.get("rectangles", RANDOM_RECTANGLES)
             chosen = random_plane(jax.random.key(entry["seed"]), num_rectangles=count)
             label = f"plane-s{entry['seed']}-r{count}"
         else:
