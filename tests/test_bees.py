@@ -235,6 +235,7 @@ def test_a_vehicle_with_no_feasible_candidate_stays():
     assert int(trace.iterations) == STEPS and not bool(swarm.best(state).found)
 
 
+@pytest.mark.slow  # a config of its own: one more compile
 def test_the_vehicle_moves_at_most_max_steps_times():
     chosen = paper_plane("map1")
     swarm = make("cabc", max_steps=5)
@@ -313,6 +314,7 @@ def test_f4_counts_the_earlier_windows_that_hold_a_point():
     assert revisits(points, waypoints, jnp.int32(1), jnp.float32(1)).tolist() == [0, 0, 0, 0]
 
 
+@pytest.mark.slow  # a config of its own: one more compile
 def test_a_vehicle_that_remembers_pays_for_going_back():
     chosen = paper_plane("map2")
     plain, remembering = make("cabc"), make("cabc", remember=True)

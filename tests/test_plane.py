@@ -32,13 +32,15 @@ def shapely_shortest(plane, start, goal) -> float:
     boxes = plane.obstacles()
     corners = [(x, y) for x0, y0, x1, y1 in boxes for x, y in ((x0, y0), (x1, y0), (x1, y1),
                                                                   (x0, y1))]
-    blocked = interiors(plane)
+    blocked = np.asarray(interiors(plane))
     points = [tuple(start), tuple(goal)] + [
         c for c in set(corners) if not any(b.contains(shapely.Point(c)) for b in blocked)]
+    pairs = list(itertools.combinations(points, 2))
+    segments = shapely.linestrings(np.asarray(pairs, np.float64))
+    free = ~shapely.intersects(segments[:, None], blocked[None, :]).any(axis=1)
     graph = nx.Graph()
-    for p, q in itertools.combinations(points, 2):
-        segment = shapely.LineString([p, q])
-        if not any(b.intersects(segment) for b in blocked):
+    for (p, q), clear in zip(pairs, free):
+        if clear:
             graph.add_edge(p, q, weight=math.dist(p, q))
     try:
         return nx.dijkstra_path_length(graph, tuple(start), tuple(goal))
