@@ -49,9 +49,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.cpu import configure
+from jaxswarm.cpu import configure, cpu_model
 from jaxswarm.maps.plane import PAPER_PLANES, paper_plane
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.bees.inverse import weight_grid
 
 MiB = 2 ** 20
 ITERATIONS = 200
@@ -61,14 +62,7 @@ WEIGHT_RANGES = {"w1": (0.7, 1.2), "w2": (0.0, 0.3), "w3": (0.0, 0.1)}
 
 def machine() -> str:
     """Where the figures come from: platform, CPU model, cores, python, jax and its devices."""
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f
-                       if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return (f"{platform.platform()} | {cpu} | {os.cpu_count()} CPUs | python "
+    return (f"{platform.platform()} | {cpu_model()} | {os.cpu_count()} CPUs | python "
             f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()}: "
             f"{', '.join(str(device) for device in jax.devices())})")
 
@@ -94,16 +88,13 @@ def timed(call, repeats: int) -> tuple[float, object]:
     return statistics.median(times), result
 
 
-def weight_grid(default_params, counts: tuple[int, int, int]):
+def weight_params(default_params, counts: tuple[int, int, int]):
     """The default params with (w1, w2, w3) over the grid of ``counts`` values (w1 slowest)
     and every other param repeated: f32[runs] leaves."""
-    axes = [np.linspace(*WEIGHT_RANGES[name], count, dtype=np.float32)
-            for name, count in zip(WEIGHT_RANGES, counts)]
-    mesh = np.meshgrid(*axes, indexing="ij")
-    runs = mesh[0].size
-    params = default_params._replace(**{name: np.full(runs, value, np.float32)
+    grid = weight_grid(WEIGHT_RANGES.values(), counts)
+    params = default_params._replace(**{name: np.full(len(grid), value, np.float32)
                                         for name, value in default_params._asdict().items()})
-    return params._replace(**{name: m.reshape(-1) for name, m in zip(WEIGHT_RANGES, mesh)})
+    return params._replace(**{name: grid[:, i] for i, name in enumerate(WEIGHT_RANGES)})
 
 
 def make_sweep(swarm, batch: int | None):
@@ -140,7 +131,7 @@ def measure(swarm, sweep, map_name: str, counts, batch: int | None, repeats: int
                       evaluations=int(trace.evaluations.sum()),
                       reached=float(state.reached), busy=1.0, rss=peak_rss())
 
-    params = weight_grid(swarm.default_params, counts)
+    params = weight_params(swarm.default_params, counts)
     swarm.check_params(params)
     runs = params.w1.shape[0]
     arguments = (jax.vmap(jax.random.key)(jnp.arange(runs)), params, plane, task)

@@ -92,6 +92,7 @@ import numba
 import numpy as np
 import pyastar2d
 
+from jaxswarm.cpu import cpu_model
 from jaxswarm.edits import block_cells
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
                             replanner, shortest_lengths, warm_up)
@@ -118,13 +119,7 @@ Result = tuple[float | None, int | None]
 
 def machine_line() -> str:
     """Where the figures come from: platform, CPU, core count, library versions."""
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo", encoding="ascii", errors="replace") as f:
-            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return (f"machine: {platform.platform()} | {cpu} | {os.cpu_count()} CPUs | "
+    return (f"machine: {platform.platform()} | {cpu_model()} | {os.cpu_count()} CPUs | "
             f"python {platform.python_version()} | jax {jax.__version__} "
             f"({jax.default_backend()}) | numba {numba.__version__} | "
             f"pyastar2d {importlib.metadata.version('pyastar2d')} | networkx {nx.__version__} | "

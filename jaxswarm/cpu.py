@@ -18,6 +18,8 @@ The pool size is read once, when JAX creates its CPU client, from the environmen
 from __future__ import annotations
 
 import os
+import platform
+from pathlib import Path
 
 import jax
 
@@ -60,3 +62,16 @@ def _backends_started() -> bool:
     from jax._src import xla_bridge
 
     return xla_bridge.backends_are_initialized()
+
+
+def cpu_model(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
+    """The CPU model, for the provenance of measured figures: the first ``model name`` of
+    ``cpuinfo`` (Linux), else the platform's processor string, else "unknown"."""
+    try:
+        for line in cpuinfo.read_text(encoding="utf-8", errors="replace").splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "model name":
+                return value.strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"

@@ -42,7 +42,8 @@ from jaxswarm.atomic import write_csv  # noqa: E402
 from jaxswarm.maps.plane import PAPER_PLANES, paper_plane, shortest_path  # noqa: E402
 from jaxswarm.plot import save_png  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task  # noqa: E402
-from jaxswarm.swarm.bees.inverse import es_search, grid_search, make_scorer  # noqa: E402
+from jaxswarm.swarm.bees.inverse import (es_search, grid_search, make_scorer,  # noqa: E402
+                                         weight_grid)
 
 HERE = str(Path(__file__).resolve().parent)
 if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
@@ -73,13 +74,6 @@ FRESH_COLUMNS = ["map", "setting", "remember", "w1", "w2", "w3", "seeds", "targe
                  "avg_length", "objective"]
 
 
-def weight_grid(counts: tuple[int, int, int]) -> np.ndarray:
-    """f32[G, 3]: the grid of ``counts`` values over :data:`RANGES` (w1 slowest)."""
-    axes = [np.linspace(low, high, count, dtype=np.float32)
-            for (low, high), count in zip(RANGES, counts)]
-    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-
-
 def study(name: str, args) -> tuple[list[dict], list[dict], list[dict], dict]:
     """One map: the grid, the optax search and the fresh-seed scores; the rows of the three
     CSV files and what the figure needs."""
@@ -90,7 +84,7 @@ def study(name: str, args) -> tuple[list[dict], list[dict], list[dict], dict]:
     swarms = {False: make("cabc"), True: make("cabc", remember=True)}
     params = swarms[False].default_params._replace(inner_iterations=np.float32(CYCLES))
     score = make_scorer(swarms[False], chosen.plane, task, params, seeds)
-    grid = grid_search(score, weight_grid(args.grid), args.seeds)
+    grid = grid_search(score, weight_grid(RANGES, args.grid), args.seeds)
     steps = grid.runs // (2 * args.pairs * args.seeds)
     middle = np.asarray([(low + high) / 2 for low, high in RANGES], np.float32)
     search = es_search(jax.random.key(args.search_seed), score, middle, args.seeds,

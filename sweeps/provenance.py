@@ -43,6 +43,7 @@ except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
 from jaxswarm.atomic import write_atomically
+from jaxswarm.cpu import cpu_model
 
 ROOT = Path(__file__).resolve().parents[1]
 """The repository root: commands are written relative to it."""
@@ -200,19 +201,6 @@ def machine() -> dict[str, object]:
     """The platform, CPU model, core count, 1-minute load average and JAX devices."""
     return dict(platform=platform.platform(), cpu=cpu_model(), cores=os.cpu_count(),
                 load=round(os.getloadavg()[0], 2), devices=[str(d) for d in jax.devices()])
-
-
-def cpu_model(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:
-    """The CPU model: the first ``model name`` of ``cpuinfo`` (Linux), else the platform's
-    processor string, else "unknown"."""
-    try:
-        for line in cpuinfo.read_text(encoding="utf-8", errors="replace").splitlines():
-            key, _, value = line.partition(":")
-            if key.strip() == "model name":
-                return value.strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
 
 
 def format_seconds(seconds: float | None) -> str:

@@ -34,6 +34,14 @@ WEIGHTS = ("w1", "w2", "w3")
 """The weights the inverse problem searches, in the order of a weight vector."""
 
 
+def weight_grid(ranges, counts) -> np.ndarray:
+    """f32[G, 3]: every combination of ``counts[i]`` values evenly spaced over ``ranges[i]`` (a
+    ``(low, high)`` pair, both ends included) of w1, w2 and w3; w1 varies slowest."""
+    axes = [np.linspace(low, high, count, dtype=np.float32)
+            for (low, high), count in zip(ranges, counts, strict=True)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(WEIGHTS))
+
+
 class Score(NamedTuple):
     """Eq. 11 per weight setting: ``avg_length`` f32[W] (NaN where no run arrived), ``target``
     i32[W] and ``objective`` f32[W]."""
