@@ -205,6 +205,7 @@ def test_a_bees_spec_checks_its_params():
         spec_from_dict(document, source="bees.toml")
 
 
+@pytest.mark.slow  # compiles the bees' chunk and a run: about 12 s
 def test_a_bees_sweep_over_planes_carries_the_visibility_graph_optimum(tmp_path):
     document = {"sweep": {"name": "bees", "algorithm": "cabc", "maps": [{"plane": "map2"}],
                           "seeds": 2, "iterations": 200, "chunk_size": 4},
