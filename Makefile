@@ -35,10 +35,12 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # nine paper maps with 20 seeds (100 iterations, 256 drops or ants, 50 water drops); the path maps
 # 10x10, 20x20 and 40x25 with 10 runs of populations of 50 ants; the robot study on the three
 # path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size
-# 10..100. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with other work, load
-# 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables 63 min, robot study
-# 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables 7 min and inverse
-# problem 10 min, A* study about 5 min alone: about 145 minutes in all.
+# 10..100; the MAPF study on five Moving AI maps with 5 to 100 agents, 5 random orders and CBS
+# limited to 30 s an instance. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with
+# other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
+# 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables
+# 7 min and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
+# 155 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -52,6 +54,7 @@ IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-com
 	--iterations 50 --drops 50
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
+MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
 TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
 RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
@@ -62,8 +65,9 @@ IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
 IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --runs 2 --iterations 5 --drops 20
 BEES_QUICK := --tables 1,6 --runs 2
 BEES_INVERSE_QUICK := --maps map1 --seeds 2 --grid 2x2x1 --pairs 1
+MAPF_QUICK := --maps random-32-32-10,room-32-32-4 --agents 5,10 --seeds 1 --cbs-time-limit 2
 
-reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 145 min on 2 cores)
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 155 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
@@ -74,6 +78,7 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 
 	$(BIN)/python sweeps/bees_tables.py $(BEES_FULL) --out $(RESULTS)/bees_tables
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_FULL) --out $(RESULTS)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
+	$(BIN)/python sweeps/mapf_study.py $(MAPF_FULL) --out $(RESULTS)/mapf_study
 	$(BIN)/python sweeps/provenance.py $(RESULTS)
 
 reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
@@ -87,6 +92,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/bees_tables.py $(BEES_QUICK) --out $(QUICK_OUT)/bees_tables
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_QUICK) --out $(QUICK_OUT)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
+	$(BIN)/python sweeps/mapf_study.py $(MAPF_QUICK) --out $(QUICK_OUT)/mapf_study
 	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
 
 clean:

@@ -7,6 +7,12 @@ time) and writes figures of the paths and of the swarms' memory and convergence.
 ``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.robot`): a swarm
 and D* Lite re-plan whenever it finds one; it prints what each did and writes a GIF of the walk.
 
+``jaxswarm mapf MAP SCEN`` plans for the first ``--agents`` agents of a Moving AI MAPF scenario
+(:mod:`jaxswarm.multiagent`) with one planner (the A* report's scheme, prioritised planning or
+CBS), validates the solution, prints its sum of costs against the lower bound and writes a GIF of
+the agents moving; it exits with status 1 when the planner finds no solution (naming the agent)
+or its solution breaks a rule.
+
 ``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
 map.
@@ -28,6 +34,8 @@ from jaxswarm.graph import Graph, path_map_graph
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.maps.random import random_path_map
+from jaxswarm.multiagent import (ORDERS, PLANNERS, UNREACHABLE, load_instance, lower_bound,
+                                 validate)
 from jaxswarm.paths import as_node, path_length
 from jaxswarm.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
 from jaxswarm.swarm import make, make_task, registry, run
@@ -83,6 +91,24 @@ def main(argv: list[str] | None = None) -> int:
     robot.add_argument("--out", type=Path,
                        help="GIF of the swarm's walk (default out/robot_MAP.gif); a PNG of the "
                             "whole walk is written beside it")
+    mapf = commands.add_parser("mapf", help="plan for many agents on a Moving AI MAPF map")
+    mapf.add_argument("map", type=Path, help="a Moving AI .map file (loaded 4-connected)")
+    mapf.add_argument("scen", type=Path, help="a .scen file of the map: its first rows are the "
+                                              "agents")
+    mapf.add_argument("--agents", type=int, default=10, help="how many agents (default 10)")
+    mapf.add_argument("--planner", choices=PLANNERS, default="prioritized",
+                      help="report: the A* report's two-robot scheme, pairwise; prioritized "
+                           "(default): space-time A* in priority order; cbs: Conflict-Based "
+                           "Search (optimal, few agents)")
+    mapf.add_argument("--order", choices=ORDERS,
+                      help="prioritized only: the priority order (default given)")
+    mapf.add_argument("--seed", type=int, help="prioritized only: seed of --order random")
+    mapf.add_argument("--time-limit", type=float,
+                      help="cbs only: give up after this many seconds (default 60)")
+    gif = mapf.add_mutually_exclusive_group()
+    gif.add_argument("--gif", type=Path,
+                     help="GIF of the agents moving (default out/mapf_MAP_PLANNER.gif)")
+    gif.add_argument("--no-gif", action="store_true", help="write no GIF")
     sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
     sweep.add_argument("file", type=Path, help="the sweep spec (TOML)")
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
@@ -95,7 +121,8 @@ def main(argv: list[str] | None = None) -> int:
         except (ValueError, RuntimeError) as error:
             parser.error(f"--threads: {error}")
     try:
-        command = {"demo": run_demo, "robot": run_robot, "sweep": run_sweep_command}
+        command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
+                   "sweep": run_sweep_command}
         return command[args.command](args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
@@ -227,6 +254,67 @@ def run_robot(args: argparse.Namespace) -> int:
                          title=f"{name}, {swarm.name}: {float(walk.travelled):.2f}"))
     print(f"figures written to {figure} and {still}")
     return 0
+
+
+def run_mapf(args: argparse.Namespace) -> int:
+    """Load the instance, plan, validate, print the table, write the GIF; 1 when not solved."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from jaxswarm.plot_agents import animate_plan
+
+    options = _planner_options(args)
+    if args.agents < 1:
+        raise ValueError(f"--agents must be at least 1, got {args.agents}")
+    for kind, path in (("MAP", args.map), ("SCEN", args.scen)):
+        if not path.is_file():
+            raise ValueError(f"{kind} {path}: no such file")
+    instance = load_instance(args.map, args.scen, args.agents)
+    graph = instance.graph
+    height, width = graph.shape
+    print(f"map {args.map.stem}: {width}x{height}, {int(graph.free.sum())} free cells, "
+          f"{args.agents} agents from {args.scen.name}, planner {args.planner}")
+    planner = PLANNERS[args.planner]
+    bound = lower_bound(graph, instance.starts, instance.goals)  # also compiles the hop fields
+    planner(graph, instance.starts[:1], instance.goals[:1], **options)  # load the kernels
+    began = time.perf_counter()
+    plan = planner(graph, instance.starts, instance.goals, **options)
+    seconds = time.perf_counter() - began
+    violations = (validate(graph, plan.paths, instance.starts, instance.goals, plan.lengths)
+                  if plan.solved else [])
+    solved = plan.solved and not violations
+    cost = plan.sum_of_costs if plan.solved else "-"
+    ratio = (f"{plan.sum_of_costs / bound:.3f}" if plan.solved and 0 < bound < UNREACHABLE
+             else "-")
+    print(_table(("planner", "solved", "sum of costs", "lower bound", "ratio", "makespan",
+                  "time [ms]", "violations"),
+                 [(plan.planner, plan.solved, cost, bound if bound < UNREACHABLE else "-", ratio,
+                   plan.makespan if plan.solved else "-", f"{1e3 * seconds:.1f}",
+                   len(violations) if plan.solved else "-")]))
+    for violation in violations[:10]:
+        print(f"violation: {violation}")
+    if not plan.solved:
+        print(f"not solved: {plan.reason}")
+        return 1
+    if not args.no_gif:
+        gif = args.gif or Path("out") / f"mapf_{args.map.stem}_{args.planner}.gif"
+        frames = animate_plan(graph, plan.paths, gif, title=f"{instance.name}, {plan.planner}: "
+                                                            "step {step} of {steps}")
+        print(f"GIF written to {gif} ({frames} frames)")
+    return 0 if solved else 1
+
+
+def _planner_options(args: argparse.Namespace) -> dict:
+    """The keyword arguments of the chosen planner; ValueError for an option of another."""
+    given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit}
+    owner = {"order": "prioritized", "seed": "prioritized", "time_limit": "cbs"}
+    for option, value in given.items():
+        if value is not None and owner[option] != args.planner:
+            raise ValueError(f"--{option.replace('_', '-')} applies to --planner "
+                             f"{owner[option]}, not {args.planner}")
+    if args.time_limit is not None and not args.time_limit > 0:
+        raise ValueError(f"--time-limit must be positive, got {args.time_limit}")
+    return {option: value for option, value in given.items() if value is not None}
 
 
 def _run_swarm(swarm, graph, start, goal, args):

@@ -115,3 +115,91 @@ def test_threads_option_names_a_bad_count_or_a_late_call(capsys):
         assert stop.value.code == 2
         error = capsys.readouterr().err
         assert "error: --threads:" in error and message in error
+
+
+def _mapf_files(movingai_dir, map_name="empty-32-32", scen="even-1"):
+    mapf = movingai_dir / "mapf"
+    return str(mapf / f"{map_name}.map"), str(mapf / f"{map_name}-{scen}.scen")
+
+
+def _mapf_row(text: str, planner: str) -> dict:
+    header = ("planner", "solved", "sum of costs", "lower bound", "ratio", "makespan", "time [ms]",
+              "violations")
+    row = re.search(rf"^{planner}\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)$",
+                    text, re.MULTILINE)
+    assert row, f"no row for {planner} in:\n{text}"
+    return dict(zip(header[1:], row.groups()))
+
+
+@pytest.mark.parametrize("planner, options", [("report", []),
+                                              ("prioritized", ["--order", "distance"]),
+                                              ("cbs", ["--time-limit", "30"])])
+def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner, options):
+    assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "5", "--planner", planner,
+                 *options, "--no-gif"]) == 0
+    text = capsys.readouterr().out
+    assert text.startswith("map empty-32-32: 32x32, 1024 free cells, 5 agents from "
+                           f"empty-32-32-even-1.scen, planner {planner}")
+    row = _mapf_row(text, planner)
+    assert row["solved"] == "True" and row["violations"] == "0"
+    cost, bound = int(row["sum of costs"]), int(row["lower bound"])
+    assert bound == 114 and cost >= bound  # the sum of the scenario's optimal lengths
+    assert float(row["ratio"]) == pytest.approx(cost / bound, abs=1e-3)
+    if planner == "cbs":
+        assert cost == bound  # optimal, and here no agent has to give way
+    assert int(row["makespan"]) >= 1 and float(row["time [ms]"]) >= 0
+    assert "GIF" not in text
+
+
+def test_mapf_writes_a_gif_with_one_frame_per_step(movingai_dir, capsys, tmp_path,
+                                                    monkeypatch):
+    from PIL import Image
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["mapf", *_mapf_files(movingai_dir, scen="random-1"), "--agents", "5",
+                 "--planner", "prioritized", "--order", "random", "--seed", "3"]) == 0
+    text = capsys.readouterr().out
+    gif = tmp_path / "out" / "mapf_empty-32-32_prioritized.gif"  # the default place
+    frames = int(re.search(r"GIF written to (\S+) \((\d+) frames\)", text).group(2))
+    assert frames == int(_mapf_row(text, "prioritized")["makespan"]) + 1
+    with Image.open(gif) as image:
+        assert image.format == "GIF" and image.n_frames == frames
+    out = tmp_path / "elsewhere" / "cbs.gif"
+    assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "2", "--planner", "cbs",
+                 "--gif", str(out)]) == 0
+    assert out.read_bytes()[:6] == b"GIF89a"
+
+
+def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
+    (tmp_path / "corridor.map").write_text("type octile\nheight 1\nwidth 5\nmap\n.....\n")
+    (tmp_path / "swap.scen").write_text("version 1\n"  # two agents swapping ends: impossible
+                                        "0\tcorridor.map\t5\t1\t0\t0\t4\t0\t4\n"
+                                        "0\tcorridor.map\t5\t1\t4\t0\t0\t0\t4\n")
+    assert main(["mapf", str(tmp_path / "corridor.map"), str(tmp_path / "swap.scen"),
+                 "--agents", "2", "--planner", "prioritized"]) == 1
+    text = capsys.readouterr().out
+    assert _mapf_row(text, "prioritized")["solved"] == "False"
+    assert re.search(r"^not solved: agent 1 could not be planned", text, re.MULTILINE), text
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["nosuch.map", "{scen}"], "MAP nosuch.map: no such file"),
+    (["{map}", "nosuch.scen"], "SCEN nosuch.scen: no such file"),
+    (["{map}", "{scen}", "--agents", "5000"], "5000 agents asked for, the file has"),
+    (["{map}", "{scen}", "--agents", "0"], "--agents must be at least 1, got 0"),
+    (["{map}", "{scen}", "--planner", "astar"], "argument --planner: invalid choice: 'astar'"),
+    (["{map}", "{scen}", "--planner", "cbs", "--order", "random"],
+     "--order applies to --planner prioritized, not cbs"),
+    (["{map}", "{scen}", "--planner", "cbs", "--time-limit", "0"],
+     "--time-limit must be positive, got 0.0"),
+    (["{map}", "{scen}", "--gif", "a.gif", "--no-gif"], "--no-gif: not allowed with argument"),
+])
+def test_mapf_rejects_bad_input_in_a_line_with_exit_status_2(movingai_dir, capsys, arguments,
+                                                              message):
+    map_path, scen = _mapf_files(movingai_dir)
+    with pytest.raises(SystemExit) as stop:
+        main(["mapf", *(a.format(map=map_path, scen=scen) for a in arguments)])
+    assert stop.value.code == 2
+    error = capsys.readouterr().err
+    assert message in error.splitlines()[-1] and "Traceback" not in error

@@ -11,6 +11,9 @@ The notebooks also check their own results with ``assert``. After a run, the tes
   shown inline.
 * dynamic: the JSON line of its ``checks`` cell (three swarms continued after the goal moved, none
   beating the new optimum) and the GIF it wrote under ``tmp_path``.
+* many_agents: the JSON line of its ``checks`` cell (the three multi-agent planners solve, their
+  solutions validate, none beats the lower bound or CBS), the GIF it wrote under ``tmp_path`` and
+  the logs of the A* report's two examples.
 * sweep_analysis: the Parquet store under ``tmp_path``. Read back with pandas, it holds
   maps x combinations x seeds rows, one per run, taken from the spec in ``metadata.json``. No gap
   is below -1e-6. The PNGs of ``plot_sweep`` exist. The figures were shown inline, which
@@ -198,4 +201,34 @@ def test_bees(notebook_env):
     assert result["inside"] == 0 and math.isfinite(result["optimum"])
     assert result["search_runs"] <= result["grid_runs"]  # optax within the grid's budget
     assert result["grid_best"] > 0 and result["search_best"] > 0
+    assert count_images(nb) >= 2
+
+
+def test_many_agents(notebook_env):
+    from PIL import Image
+
+    nb = execute("many_agents.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+    assert result["agents"] == 20, "JAXSWARM_NOTEBOOK_SMALL ignored"
+    planners = result["planners"]
+    assert set(planners) == {"report", "prioritized", "cbs"}
+    bound = result["lower_bound"]
+    for name, plan in planners.items():
+        assert plan["solved"], f"{name}: {plan['reason']}"
+        assert plan["violations"] == 0 and plan["sum_of_costs"] >= bound, name
+        assert planners["cbs"]["sum_of_costs"] <= plan["sum_of_costs"], f"{name} beats CBS"
+    gif = Path(result["gif"])
+    assert gif.parent == notebook_env
+    with Image.open(gif) as image:
+        assert image.format == "GIF" and image.n_frames == result["frames"]
+    animated = planners[result["animated"]]  # the plan of least sum of costs, a frame a step
+    assert animated["sum_of_costs"] == planners["cbs"]["sum_of_costs"]
+    assert result["frames"] >= animated["makespan"] + 1
+    examples = result["examples"]
+    assert "no collision found" in examples["map1"]["log"]
+    assert "can not synchronize, robot 2 move first" in examples["map2"]["log"]
+    for example in examples.values():
+        assert example["cbs"] <= example["report"]
     assert count_images(nb) >= 2

@@ -51,6 +51,9 @@ TINY = {
     "bees_inverse": ("sweeps/bees_inverse.py",
                      ["--maps", "map1", "--seeds", "1", "--grid", "2x1x1", "--pairs", "1"]),
     "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
+    "mapf_study": ("sweeps/mapf_study.py",
+                   ["--maps", "random-32-32-10", "--agents", "5", "--seeds", "1",
+                    "--cbs-time-limit", "1"]),
 }
 SLOW_TINY = ("bees_tables", "bees_inverse")
 """Scripts whose tiny run compiles the bees' programs (about 45 s): run with the slow checks."""

@@ -1,0 +1,31 @@
+"""Many agents on one map: the A* report's two-robot scheme, prioritised space-time A* and
+Conflict-Based Search, with one solution format and one validator.
+
+* :func:`report_scheme` (:mod:`~jaxswarm.multiagent.report`): A* per robot, then at a collision
+  one robot side-steps while the other waits, or one moves first (the report's section 5).
+* :func:`prioritized` (:mod:`~jaxswarm.multiagent.prioritized`): space-time A* per agent around a
+  reservation table, in a given, distance or seeded random order.
+* :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs.
+* :func:`validate` (:mod:`~jaxswarm.multiagent.validate`) checks any solution;
+  :func:`find_conflicts` (:mod:`~jaxswarm.multiagent.conflicts`) is its batched JAX conflict
+  check; :class:`Plan` (:mod:`~jaxswarm.multiagent.plan`) is the one result format.
+
+Time is in steps: every agent moves along one edge or waits per step, and an agent's cost is the
+step from which it stays at its goal. On the MAPF benchmark maps (:func:`load_instance`, loaded
+4-connected) that is the benchmark's sum of costs.
+"""
+from jaxswarm.multiagent.agents import (UNREACHABLE, Instance, agent_nodes, hop_fields,
+                                        load_instance, lower_bound)
+from jaxswarm.multiagent.cbs import cbs
+from jaxswarm.multiagent.conflicts import Conflicts, find_conflicts
+from jaxswarm.multiagent.plan import Plan, arrival_steps, pack
+from jaxswarm.multiagent.prioritized import ORDERS, prioritized
+from jaxswarm.multiagent.report import report_scheme
+from jaxswarm.multiagent.validate import Violation, validate
+
+PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs}
+"""The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
+
+__all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",
+           "agent_nodes", "arrival_steps", "cbs", "find_conflicts", "hop_fields", "load_instance",
+           "lower_bound", "pack", "prioritized", "report_scheme", "validate"]

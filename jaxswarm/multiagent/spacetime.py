@@ -1,0 +1,249 @@
+"""Space-time A*: one agent's fewest-steps path among reserved nodes and moves (compiled).
+
+A state is ``(node, step)``; each step the agent waits or moves along a valid edge, at a cost of
+one. What the other agents hold is a :class:`Reservations` table:
+
+* ``holder`` i32[H, N]: the agent on each node at each step ``t < H`` (-1 free, -2 a forbidden
+  node with no agent, CBS's vertex constraint). Moving u -> v from step t is a swap, and
+  forbidden, when the agent on v at t is on u at t + 1: the table doubles as the edge
+  reservations.
+* ``parked_from`` i32[N]: the step from which an agent stays on the node for good.
+* ``banned`` i32[M, 3]: single moves ``(t, u, v)`` forbidden from step t (CBS's edge
+  constraints).
+
+From step ``H`` on nothing moves any more, so the world is static: a state reaching step H is
+finished by the static shortest path that avoids the parked nodes (a breadth-first field from the
+goal), pushed with its exact cost. The search therefore stores at most (H + 1) * N states, ends
+on every instance, and finds the fewest steps to a goal that the agent can keep: its goal is
+accepted at step t only if no reservation touches it at t or later.
+
+The search is numba-compiled (as :mod:`jaxswarm.exact.kernels`): a heap of packed int64 keys
+``(f, -t, node)`` pops the lowest f, then the latest step, then the lowest node, so a solution is
+a pure function of its input.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from jaxswarm.exact._host import edge_arrays
+from jaxswarm.exact.kernels import inline, jit
+from jaxswarm.graph import Graph
+from jaxswarm.multiagent.agents import UNREACHABLE
+
+FREE, FORBIDDEN = -1, -2
+"""``holder`` entries that are not agents."""
+FOUND, EXHAUSTED, LIMIT = 0, 1, 2
+"""Search outcomes."""
+
+
+@dataclasses.dataclass
+class Reservations:
+    """What other agents hold, for :func:`search` (see the module docstring).
+
+    Attributes:
+      holder: i32[H, N] agent (or FREE, FORBIDDEN) per step and node.
+      parked_from: i32[N] the step from which a node is held for good (UNREACHABLE: never).
+      banned: i32[M, 3] forbidden moves ``(t, u, v)``, each with t < H.
+    """
+
+    holder: np.ndarray
+    parked_from: np.ndarray
+    banned: np.ndarray
+
+    @classmethod
+    def empty(cls, num_nodes: int, steps: int = 0) -> "Reservations":
+        """Nothing held, over a table of ``steps`` rows."""
+        return cls(np.full((steps, num_nodes), FREE, np.int32),
+                   np.full(num_nodes, UNREACHABLE, np.int32), np.zeros((0, 3), np.int32))
+
+    def reserve(self, agent: int, path: np.ndarray) -> None:
+        """Hold ``path`` (i32[L], ending at the agent's goal) for ``agent``: its nodes at steps
+        0..L-1 (the table grows to at least L rows, so a swap into its last move is seen) and
+        its goal from step L - 1 on."""
+        steps = len(path)
+        if steps > self.holder.shape[0]:
+            grown = np.full((steps, self.holder.shape[1]), FREE, np.int32)
+            grown[:self.holder.shape[0]] = self.holder
+            self.holder = grown
+        self.holder[np.arange(steps), path] = agent
+        self.parked_from[path[-1]] = steps - 1
+
+    def last_use(self, node: int) -> int:
+        """The last step < H at which ``node`` is held or forbidden (-1 if none)."""
+        held = np.nonzero(self.holder[:, node] != FREE)[0]
+        return int(held[-1]) if held.size else -1
+
+
+def static_field(graph: Graph, goal: int, blocked: np.ndarray) -> np.ndarray:
+    """i32[N]: steps from every node to ``goal`` avoiding the ``blocked`` nodes (bool[N]),
+    UNREACHABLE where there is no way."""
+    arrays = edge_arrays(graph)
+    return _breadth_first(arrays.rev_indptr, arrays.rev_tails, goal, blocked)
+
+
+def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservations: Reservations,
+           *, max_expansions: int = 10_000_000) -> tuple[np.ndarray | None, int, int]:
+    """Fewest-steps path of one agent from ``start`` to ``goal`` around the reservations.
+
+    Args:
+      graph: the map (its valid edges are the moves).
+      start, goal: node indices.
+      heuristic: i32[N] steps to ``goal`` ignoring the other agents (``hop_fields``).
+      reservations: what the other agents hold.
+      max_expansions: stop after expanding this many states.
+
+    Returns:
+      ``(path i32[L] or None, expanded states, outcome)``, outcome FOUND, EXHAUSTED (no path
+      exists) or LIMIT.
+    """
+    arrays = edge_arrays(graph)
+    parked = reservations.parked_from
+    finish = static_field(graph, goal, (parked < UNREACHABLE) & (np.arange(len(parked)) != goal))
+    keep_from = reservations.last_use(goal) + 1
+    path, expanded, outcome = _search(
+        arrays.indptr, arrays.heads, np.ascontiguousarray(heuristic, np.int32), finish, start,
+        goal, reservations.holder, parked, reservations.banned, keep_from, max_expansions)
+    return (path if outcome == FOUND else None), int(expanded), int(outcome)
+
+
+@jit
+def _breadth_first(rev_indptr, rev_tails, goal, blocked):
+    n = rev_indptr.shape[0] - 1
+    dist = np.full(n, UNREACHABLE, np.int32)
+    queue = np.empty(n, np.int64)
+    dist[goal] = 0
+    queue[0] = goal
+    head, tail = 0, 1
+    while head < tail:
+        v = queue[head]
+        head += 1
+        for e in range(rev_indptr[v], rev_indptr[v + 1]):
+            u = rev_tails[e]
+            if not blocked[u] and dist[u] == UNREACHABLE:
+                dist[u] = dist[v] + 1
+                queue[tail] = u
+                tail += 1
+    return dist
+
+
+@inline
+def _push(heap, size, key):
+    if size == heap.shape[0]:
+        grown = np.empty(2 * size, np.int64)
+        grown[:size] = heap[:size]
+        heap = grown
+    i = size
+    while i > 0:
+        up = (i - 1) >> 1
+        if heap[up] <= key:
+            break
+        heap[i] = heap[up]
+        i = up
+    heap[i] = key
+    return heap, size + 1
+
+
+@inline
+def _pop(heap, size):
+    top = heap[0]
+    size -= 1
+    last = heap[size]
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= size:
+            break
+        if child + 1 < size and heap[child + 1] < heap[child]:
+            child += 1
+        if heap[child] >= last:
+            break
+        heap[i] = heap[child]
+        i = child
+    heap[i] = last
+    return top, size
+
+
+@inline
+def _open(holder, parked, horizon, v, t):
+    """Whether node v is free at step t."""
+    return t < parked[v] and (t >= horizon or holder[t, v] == -1)
+
+
+@inline
+def _allowed(holder, banned, horizon, u, v, t):
+    """Whether the move u -> v from step t is no swap and not banned."""
+    if t + 1 < horizon:
+        other = holder[t, v]
+        if other >= 0 and holder[t + 1, u] == other:
+            return False
+    for i in range(banned.shape[0]):
+        if banned[i, 0] == t and banned[i, 1] == u and banned[i, 2] == v:
+            return False
+    return True
+
+
+@jit
+def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banned, keep_from,
+            max_expansions):
+    horizon, n = holder.shape
+    layers = horizon + 1
+    seen = np.zeros(layers * n, np.bool_)
+    parent = np.empty(layers * n, np.int32)
+    heap = np.empty(1024, np.int64)
+    size = 0
+    empty = np.empty(0, np.int32)
+    if not _open(holder, parked, horizon, start, 0):
+        return empty, 0, EXHAUSTED
+    f0 = heuristic[start] if horizon > 0 else finish[start]
+    if f0 >= UNREACHABLE:
+        return empty, 0, EXHAUSTED
+    seen[start] = True
+    heap, size = _push(heap, size, (np.int64(f0) * layers + horizon) * n + start)
+    expanded = 0
+    while size > 0:
+        key, size = _pop(heap, size)
+        v = key % n
+        t = horizon - (key // n) % layers
+        if t == horizon or (v == goal and t >= keep_from):
+            return _unwind(indptr, heads, finish, parent, n, v, t, horizon), expanded, FOUND
+        if expanded == max_expansions:
+            return empty, expanded, LIMIT
+        expanded += 1
+        nt = t + 1
+        for e in range(indptr[v] - 1, indptr[v + 1]):
+            w = v if e < indptr[v] else heads[e]  # a wait first, then the moves
+            state = nt * n + w
+            if seen[state] or not _open(holder, parked, horizon, w, nt):
+                continue
+            if w != v and not _allowed(holder, banned, horizon, v, w, t):
+                continue
+            remaining = finish[w] if nt == horizon else heuristic[w]
+            if remaining >= UNREACHABLE:
+                continue
+            seen[state] = True
+            parent[state] = v
+            heap, size = _push(heap, size, (np.int64(nt + remaining) * layers + horizon - nt)
+                               * n + w)
+    return empty, expanded, EXHAUSTED
+
+
+@jit
+def _unwind(indptr, heads, finish, parent, n, v, t, horizon):
+    """The path to state (v, t), then (at the horizon) down the static field to the goal."""
+    tail = finish[v] if t == horizon else 0
+    path = np.empty(t + tail + 1, np.int32)
+    node = v
+    for step in range(t, -1, -1):
+        path[step] = node
+        if step > 0:
+            node = parent[step * n + node]
+    node = v
+    for step in range(t + 1, t + tail + 1):
+        for e in range(indptr[node], indptr[node + 1]):
+            if finish[heads[e]] == finish[node] - 1:
+                node = heads[e]
+                break
+        path[step] = node
+    return path
