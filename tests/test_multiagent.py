@@ -333,3 +333,28 @@ def test_agents_given_as_node_indices(planner):
     assert not plan.solved and "agent 0" in plan.reason
     with pytest.raises(ValueError, match=r"agents 0 and 1 have one goal \(2, 0\)"):
         PLANNERS[planner](graph, [0, 1], [2, 2])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["empty-32-32", "random-32-32-10", "room-32-32-4",
+                                  "maze-32-32-2", "den312d"])
+def test_every_solution_on_the_study_maps_is_valid(movingai_dir, name):
+    """50 agents of each study map: every planner's solution validates and none beats the lower
+    bound or a solved CBS."""
+    mapf = movingai_dir / "mapf"
+    instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-random-1.scen", 50)
+    graph, starts, goals = instance.graph, instance.starts, instance.goals
+    bound = lower_bound(graph, starts, goals)
+    plans = [report_scheme(graph, starts, goals), cbs(graph, starts, goals, time_limit=5)]
+    plans += [prioritized(graph, starts, goals, order=order, seed=seed)
+              for order, seed in (("given", 0), ("distance", 0), ("random", 1), ("random", 2))]
+    solved = [plan for plan in plans if plan.solved]
+    assert any(plan.planner == "prioritized" for plan in solved), name
+    for plan in solved:
+        assert validate(graph, plan.paths, starts, goals, plan.lengths) == [], plan.planner
+        assert plan.sum_of_costs >= bound
+        if plans[1].solved:
+            assert plans[1].sum_of_costs <= plan.sum_of_costs
+    for plan in plans:
+        if not plan.solved:
+            assert plan.reason and "agent" in plan.reason, plan.planner
