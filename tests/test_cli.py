@@ -10,6 +10,23 @@ matplotlib.use("Agg")
 from jaxswarm.cli import main  # noqa: E402
 
 
+def test_demo_of_one_swarm_prints_it_beside_the_exact_planners(tmp_path, capsys):
+    out = tmp_path / "demo.png"
+    assert main(["demo", "--map", "maze20", "--repeats", "1", "--drops", "16", "--iterations", "5",
+                 "--swarms", "rfd_graded", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    rows = {planner: re.search(rf"^{re.escape(planner)}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
+            for planner in ("Dijkstra", "A*", "bidirectional A*", "RFD graded (ours)")}
+    assert all(rows.values()), text
+    assert {row.group(2) for name, row in rows.items() if name != "RFD graded (ours)"} == {
+        "+0.00%"}
+    assert not rows["RFD graded (ours)"].group(2).startswith("-")
+    assert "RFD (paper)" not in text
+    for png in (out, tmp_path / "demo_rfd_graded.png"):
+        assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.slow  # every swarm's compile, about 100 s
 def test_demo_prints_every_planner_and_writes_figures(tmp_path, capsys):
     out = tmp_path / "demo.png"
     assert main(["demo", "--map", "maze20", "--repeats", "1", "--drops", "16", "--iterations", "5",

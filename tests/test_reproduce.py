@@ -57,7 +57,9 @@ TINY = {
 }
 SLOW_TINY = ("bees_tables", "bees_inverse")
 """Scripts whose tiny run compiles the bees' programs (about 45 s): run with the slow checks."""
-QUICK = {name: run for name, run in TINY.items() if name not in SLOW_TINY}
+OWN_TESTS = ("mapf_study",)
+"""Scripts whose tiny run has its own test file (tests/test_mapf_study.py), not run here again."""
+QUICK = {name: run for name, run in TINY.items() if name not in SLOW_TINY + OWN_TESTS}
 
 
 def git_head() -> str | None:
