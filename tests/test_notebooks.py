@@ -30,8 +30,9 @@ variable only lives for the test (monkeypatch). Nothing is installed, and no use
 change. Before a notebook's own cells, the test runs one extra cell, added to the in-memory copy
 only. It prints the kernel's ``sys.prefix``, and the test checks that this equals pytest's.
 
-Run time on 2 CPU cores: about 2 minutes for the three notebooks, mostly JAX compiling. Each cell
-may take up to ``CELL_TIMEOUT`` seconds.
+Run time on 2 CPU cores, mostly JAX compiling: about 15 s for ``many_agents`` in the default
+suite; the others (from 25 s to two minutes each) are slow checks. Each cell may take up to
+``CELL_TIMEOUT`` seconds.
 """
 from __future__ import annotations
 
@@ -116,6 +117,7 @@ def test_notebooks_are_stored_without_outputs():
                     f"{path.name}: clear the outputs before committing")
 
 
+@pytest.mark.slow  # about 50 s of compiles; the default suite keeps under ten minutes
 def test_quickstart(notebook_env):
     nb = execute("quickstart.ipynb")
     checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
@@ -135,6 +137,7 @@ def test_quickstart(notebook_env):
     assert count_images(nb) >= 6
 
 
+@pytest.mark.slow  # a sweep's compile, about 25 s
 def test_sweep_analysis(notebook_env):
     nb = execute("sweep_analysis.ipynb")
     store = notebook_env / "sweep_analysis"

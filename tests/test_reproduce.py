@@ -85,7 +85,8 @@ def tiny_results(folder, scripts: dict) -> dict:
 
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    """A results folder written by the table scripts of :data:`QUICK`, then indexed."""
+    """A results folder written by the table scripts of :data:`QUICK`, then indexed (about two
+    minutes: the tests that read it are slow checks)."""
     folder = tmp_path_factory.mktemp("results")
     return folder, tiny_results(folder, QUICK)
 
@@ -143,6 +144,7 @@ def test_git_state_names_the_checkout_commit():
     assert "2 paths differ" in provenance.describe_tree(["a.py", "b.py"])
 
 
+@pytest.mark.slow  # the quick fixture runs eight table scripts: about two minutes
 def test_every_table_starts_with_its_provenance(quick):
     folder, seconds = quick
     commit = git_head()
@@ -162,6 +164,7 @@ def test_every_table_starts_with_its_provenance(quick):
         assert record["about"] and record["about"] in text
 
 
+@pytest.mark.slow
 def test_index_lists_every_table_in_the_order_they_ran(quick):
     folder, _ = quick
     text = (folder / "README.md").read_text(encoding="utf-8")
@@ -183,6 +186,7 @@ def test_index_of_a_folder_without_tables_is_an_error(tmp_path, capsys):
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.slow
 def test_path_map_ratios_are_to_ant_system(quick):
     folder, _ = quick
     rows = read_csv(folder / "aco_pathmaps" / "results.csv")
@@ -200,6 +204,7 @@ def test_path_map_ratios_are_to_ant_system(quick):
                 float(r[ours]) / float(baseline[ours]))
 
 
+@pytest.mark.slow
 def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
     folder, _ = quick
     rows = read_csv(folder / "robot_study" / "runs.csv")
@@ -217,6 +222,7 @@ def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
     assert (folder / "robot_study" / "walks.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
     folder, _ = quick
     rows = read_csv(folder / "iwd_paper_maps" / "runs.csv")
@@ -229,6 +235,7 @@ def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
     assert "| maze20 | 78.00 |" in (folder / "iwd_paper_maps" / "table.md").read_text()
 
 
+@pytest.mark.slow
 def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
     folder, _ = quick
     rows = read_csv(folder / "iwd_pg_experiments" / "runs.csv")
@@ -282,6 +289,7 @@ def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(be
     assert (folder / "bees_inverse" / "map1.png").is_file()
 
 
+@pytest.mark.slow
 def test_path_map_table_has_the_papers_values_beside_ours(quick):
     folder, _ = quick
     rows = {(r["map"], r["algorithm"]): r for r in read_csv(folder / "aco_pathmaps" /
