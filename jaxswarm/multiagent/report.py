@@ -31,6 +31,7 @@ import numpy as np
 
 from jaxswarm.edits import block_cells
 from jaxswarm.exact import astar
+from jaxswarm.exact._host import edge_arrays
 from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.multiagent.agents import agent_nodes, distance_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
@@ -164,8 +165,9 @@ def _repair(graph, first, second, step, to_goal, log, cells, names):
 
 
 def _neighbours(graph: Graph, node: int) -> list[int]:
-    valid = np.asarray(graph.valid_edges()[node])
-    return [int(v) for v in np.asarray(graph.nbr[node])[valid]]
+    """The heads of ``node``'s valid edges, from the map's cached CSR arrays."""
+    arrays = edge_arrays(graph)
+    return arrays.heads[arrays.indptr[node]:arrays.indptr[node + 1]].tolist()
 
 
 def _astar(graph: Graph, start, goal) -> list[int] | None:
