@@ -1,0 +1,70 @@
+"""Golden records of every registered swarm: small runs replayed bit for bit by
+``tests/test_golden.py``, so that "behaviour unchanged" means the same bits for every swarm.
+
+Each record names its swarm, world, config, iterations, patience and seed, and holds the
+SHA-256 of every leaf of what the run returned (state and trace, PRNG keys as their data)
+beside a few readable figures (best cost, iterations run) that say what changed when a digest
+does. Write them again, from the repository root, only after a change that is meant to change
+results (and say why in the CHANGELOG)::
+
+    python tests/golden/swarms.py
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import jax
+import numpy as np
+
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.plane import make_plane
+from jaxswarm.swarm import make, make_task, registered, run
+from jaxswarm.swarm.testing import key_data
+
+GOLDEN = Path(__file__).parent / "swarms.json"
+GRAPH_CASES = [dict(world=world, config=dict(num_agents=16), iterations=6, patience=3)
+               for world in ("maze20", "alley20")]
+"""Two 20 x 20 maps with one run length: one compiled program per swarm."""
+PLANE_CASES = [dict(world="plane6", config=dict(), iterations=12, patience=3)]
+SEEDS = (0, 3)
+
+
+def world(name: str):
+    """``(world, task)`` of a record: a paper map by name, or ``plane6``, a 6 x 6 plane with
+    one rectangle beside the straight way from start to goal."""
+    if name == "plane6":
+        plane = make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0))
+        return plane, make_task(plane, (0.5, 2.5), (5.5, 2.5))
+    chosen = paper_map(name)
+    graph = chosen.graph()
+    return graph, make_task(graph, chosen.start, chosen.goal)
+
+
+def replay(record: dict) -> dict:
+    """The run a record describes, as the record's ``digests``, ``best_cost`` and ``ran``."""
+    graph, task = world(record["world"])
+    swarm = make(record["swarm"], **record["config"])
+    state, trace = run(swarm, jax.random.key(record["seed"]), graph, task, swarm.default_params,
+                       iterations=record["iterations"], patience=record["patience"])
+    leaves = jax.tree_util.tree_leaves_with_path(key_data((state, trace)))
+    digests = {jax.tree_util.keystr(where): hashlib.sha256(
+        np.ascontiguousarray(np.asarray(leaf)).tobytes()).hexdigest()[:16] for where, leaf in leaves}
+    return dict(digests=digests, best_cost=float(swarm.best(state).cost),
+                ran=int(trace.iterations))
+
+
+def cases() -> list[dict]:
+    """Every record's description: each registered swarm on its kind of world, two seeds."""
+    out = []
+    for name in registered():
+        on_plane = make(name).world.__name__ == "Plane"
+        for case in PLANE_CASES if on_plane else GRAPH_CASES:
+            out += [dict(swarm=name, seed=seed, **case) for seed in SEEDS]
+    return out
+
+
+if __name__ == "__main__":
+    GOLDEN.write_text(json.dumps([dict(case, **replay(case)) for case in cases()], indent=1) + "\n")
+    print(f"wrote {GOLDEN}")
