@@ -30,7 +30,7 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 
 # The generated tables of results/ (see results/README.md), one script each; every script writes
 # its Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and
-# sweeps/provenance.py then indexes them in results/README.md. The full run is the scripts'
+# sweeps/index_results.py then indexes them in results/README.md. The full run is the scripts'
 # paper-size defaults, spelled out: Table 1, the RFD table, the dynamic Tables 2-5 and IWD on all
 # nine paper maps with 20 seeds (100 iterations, 256 drops or ants, 50 water drops); the path maps
 # 10x10, 20x20 and 40x25 with 10 runs of populations of 50 ants; the robot study on the three
@@ -79,7 +79,7 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_FULL) --out $(RESULTS)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/mapf_study.py $(MAPF_FULL) --out $(RESULTS)/mapf_study
-	$(BIN)/python sweeps/provenance.py $(RESULTS)
+	$(BIN)/python sweeps/index_results.py $(RESULTS)
 
 reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_QUICK) --out $(QUICK_OUT)/rfd_paper_table1
@@ -93,7 +93,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_QUICK) --out $(QUICK_OUT)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/mapf_study.py $(MAPF_QUICK) --out $(QUICK_OUT)/mapf_study
-	$(BIN)/python sweeps/provenance.py $(QUICK_OUT)
+	$(BIN)/python sweeps/index_results.py $(QUICK_OUT)
 
 clean:
 	rm -rf $(VENV) out *.egg-info

@@ -28,7 +28,7 @@ of their group's slowest run). ``ratio`` is the sweep's evaluations/s over the s
 memory (``ru_maxrss``) after each part.
 
 XLA:CPU runs on ``--threads`` intra-op threads (default 1, as in ``benchmarks/rfd.py``; see
-:mod:`jaxswarm.cpu`: on 2 cores one thread was faster for both parts).
+:mod:`jaxswarm.runtime.cpu`: on 2 cores one thread was faster for both parts).
 
 Run from the repository root::
 
@@ -49,8 +49,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.cpu import configure, cpu_model
-from jaxswarm.maps.plane import PAPER_PLANES, paper_plane
+from jaxswarm.maps.planes import PAPER_PLANES, paper_plane
+from jaxswarm.runtime.cpu import configure, cpu_model
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.bees.inverse import weight_grid
 
@@ -160,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=5, help="timed calls of the single run")
     parser.add_argument("--sweep-repeats", type=int, default=3, help="timed calls of the sweep")
     parser.add_argument("--threads", type=int, default=1,
-                        help="XLA:CPU intra-op threads (jaxswarm.cpu.configure)")
+                        help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
     parser.add_argument("--quick", action="store_true",
                         help="a smoke test: a 5x5x4 grid (100 runs), 2 repeats of each part")
     args = parser.parse_args(argv)

@@ -2,13 +2,13 @@
 beside A* from scratch and D* Lite's repair.
 
 For each map of ``--maps`` (default: the three 100 x 100 paper maps) and each of the paper's
-dynamic tables 2-5 (:func:`jaxswarm.maps.paper_dynamic.paper_scenario`: the goal moves, obstacles
+dynamic tables 2-5 (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: the goal moves, obstacles
 are added, removed, or a major change), and for each swarm of ``--swarms`` (default ``rfd_star``,
 ``rfd_graded``, ``aco_star``; ``--agents`` agents, default params) and each of ``--seeds`` seeds:
 
 1. the swarm solves the static map from fresh memory (``run`` with ``jax.random.key(seed)``,
    100 iterations at most, patience 30): its Table 1 state;
-2. the change is applied to that state (:func:`jaxswarm.dynamic.change`: the swarm's memory
+2. the change is applied to that state (:func:`jaxswarm.dynamic.events.change`: the swarm's memory
    rule, an invalidated best path forgotten) and the run continues from it
    (``run(..., state=...)``, key ``seed + 1000``, 100 iterations at most, patience 30). Timed
    from the change to the run's own stop: **time to stop**;
@@ -41,14 +41,14 @@ import time
 
 import jax
 
-from jaxswarm.cpu import configure
-from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
+from jaxswarm.dynamic.events import apply_event, check_events, first_iteration_at, replan
+from jaxswarm.dynamic.scenarios import TABLES, paper_scenario
 from jaxswarm.exact import astar, dijkstra, replanner
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map, paper_map_names
-from jaxswarm.maps.paper_dynamic import TABLES, paper_scenario
+from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep.runner import SUCCESS_GAP
+from jaxswarm.world.graph import grid_graph
 
 ITERATIONS = 100
 PATIENCE = 30

@@ -49,7 +49,7 @@ that map's shape); their seconds are printed per map and excluded from the timin
 
 3. D* Lite repair after a single-cell change. For each of the N rows whose path has at least 5
    nodes, in each pass: ``planner = replanner(graph, start, goal)``, ``sol = planner.solve()``,
-   the middle node of ``sol.nodes()`` blocked by ``jaxswarm.edits.block_cells`` (not timed);
+   the middle node of ``sol.nodes()`` blocked by ``jaxswarm.world.edits.block_cells`` (not timed);
    then ``planner.update(edited)`` (the repair), ``astar(edited, start, goal)`` a first time (A*
    from scratch: it builds the edited map's host arrays, as every new Graph needs) and a second
    time (the search alone). Printed per map: the median over rows of each row's median over the
@@ -92,11 +92,11 @@ import numba
 import numpy as np
 import pyastar2d
 
-from jaxswarm.cpu import cpu_model
-from jaxswarm.edits import block_cells
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
                             replanner, shortest_lengths, warm_up)
 from jaxswarm.maps.movingai import Scenario, load_map, load_scenarios, read_map
+from jaxswarm.runtime.cpu import cpu_model
+from jaxswarm.world.edits import block_cells
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -58,7 +58,7 @@ What is measured
    where Berlin's 65,536 nodes give 8 steps per chunk (``--check-map Berlin_1_256``).
 
 XLA:CPU runs on ``--threads`` intra-op threads (default 1, as in ``benchmarks/rfd.py``: the
-Python check runs on one core too; see :mod:`jaxswarm.cpu`).
+Python check runs on one core too; see :mod:`jaxswarm.runtime.cpu`).
 
 How to run
 ----------
@@ -85,11 +85,11 @@ import jax
 import numba
 import numpy as np
 
-from jaxswarm.cpu import configure, cpu_model
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.movingai import read_map
 from jaxswarm.multiagent import (ORDERS, find_conflicts, load_instance, lower_bound, prioritized,
                                  validate)
+from jaxswarm.runtime.cpu import configure, cpu_model
+from jaxswarm.world.graph import grid_graph
 
 REPO = Path(__file__).resolve().parents[1]
 MAPF_DIR = Path("benchdata", "movingai", "mapf")
@@ -292,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="timed calls of each check per solution")
     parser.add_argument("--seed", type=int, default=0, help="seed of part 2's walks")
     parser.add_argument("--threads", type=int, default=1,
-                        help="XLA:CPU intra-op threads (jaxswarm.cpu.configure)")
+                        help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
     parser.add_argument("--data", type=Path, default=REPO.parent / "shared",
                         help="the shared directory holding benchdata/movingai/mapf "
                              "(default: ../shared next to the repository)")

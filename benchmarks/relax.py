@@ -1,6 +1,6 @@
 """Time of the two relaxations to a fixpoint: the batched distance field and rfd_graded's settling.
 
-Both run Jacobi sweeps over each node's cheapest neighbour (:func:`jaxswarm.relax.relax`):
+Both run Jacobi sweeps over each node's cheapest neighbour (:func:`jaxswarm.world.relax.relax`):
 
 * ``distance_field``: the distance from every node to the goal of each paper map (``--maps``),
   the optimum each sweep row carries;
@@ -28,9 +28,9 @@ import jax.numpy as jnp
 
 from jaxswarm.exact import distance_field
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
-from jaxswarm.paths import node_index
 from jaxswarm.swarm import make, make_task, rfd, run
 from jaxswarm.swarm.walking import step_budget, visited_nodes, walk
+from jaxswarm.world.paths import node_index
 
 
 def median_ms(function, *args, repeats: int) -> float:

@@ -11,23 +11,15 @@ Run from the repository root (about 15 minutes on 2 cores; ``make performance`` 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import subprocess
 import sys
 import time
 from pathlib import Path
 
-from jaxswarm.atomic import write_atomically
+from jaxswarm.runtime.atomic import write_atomically
+from jaxswarm.studies import provenance
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def _provenance():
-    path = ROOT / "sweeps" / "provenance.py"
-    spec = importlib.util.spec_from_file_location("provenance", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 BENCHMARKS = [
@@ -94,7 +86,6 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default=None,
                         help="comma-separated scripts to run (default: all)")
     args = parser.parse_args(argv)
-    provenance = _provenance()
     record = provenance.begin(__file__, argv)
     chosen = [entry for entry in BENCHMARKS
               if args.only is None or entry[1] in args.only.split(",")]

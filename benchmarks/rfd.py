@@ -12,7 +12,7 @@ Shared machines are noisy: with ``--repeats R`` the seeds of each map are timed 
 the script prints the median of the R medians and their range. The runs themselves are
 deterministic, so a repeat whose paths differ from the first stops the script.
 
-XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see :mod:`jaxswarm.cpu`: a
+XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see :mod:`jaxswarm.runtime.cpu`: a
 run is thousands of tiny kernels in a row, and a second thread mostly adds hand-offs between the
 cores).
 
@@ -33,8 +33,8 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.cpu import configure
 from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
+from jaxswarm.runtime.cpu import configure
 
 
 def _rfd_static():
@@ -52,7 +52,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--patience", type=int, default=30)
     parser.add_argument("--agents", type=int, default=256)
     parser.add_argument("--threads", type=int, default=1,
-                        help="XLA:CPU intra-op threads (jaxswarm.cpu.configure)")
+                        help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
     parser.add_argument("--repeats", type=int, default=1,
                         help="time each map's seeds this many times (median and range)")
     args = parser.parse_args(argv)

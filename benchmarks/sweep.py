@@ -7,7 +7,7 @@ geometric from 2 to 200, ``alpha`` linear from 1 to 20) x ``--seeds`` seeds on `
 :func:`jaxswarm.sweep.run_sweep` into a fresh temporary store, then the same runs are done one at
 a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The CPU is split into
 ``--devices`` JAX devices (default: one per core, each with one XLA thread; see
-:mod:`jaxswarm.cpu`), so the sweep runs one shard of each chunk per core. Printed per agent count:
+:mod:`jaxswarm.runtime.cpu`), so the sweep runs one shard of each chunk per core. Printed per agent count:
 
 * ``sweep``: one timed call of ``run_sweep`` (not repeated: it takes a while). Its compile time
   is the runner's own ``compiled ... in X s`` log line; the wall time and runs/s exclude it (they
@@ -43,8 +43,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.cpu import configure
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep import run_sweep, spec_from_dict
 from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE

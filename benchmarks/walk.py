@@ -51,11 +51,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.lattice import slot_offsets
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, rfd, run
 from jaxswarm.swarm.iwd.soil import SOIL, goal_log_desirability
 from jaxswarm.swarm.walking import edge_table, step_budget, walk
+from jaxswarm.world.lattice import slot_offsets
 
 SCALAR_SOURCE = Path(__file__).parent / "scalar" / "walk.c"
 

@@ -4,7 +4,7 @@
 exact planners and the swarm planners, prints a comparison table (length, optimality gap, work,
 time) and writes figures of the paths and of the swarms' memory and convergence.
 
-``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.robot`): a swarm
+``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.dynamic.robot`): a swarm
 and D* Lite re-plan whenever it finds one; it prints what each did and writes a GIF of the walk.
 
 ``jaxswarm mapf MAP SCEN`` plans for the first ``--agents`` agents of a Moving AI MAPF scenario
@@ -28,17 +28,17 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.cpu import configure
+from jaxswarm.dynamic.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
-from jaxswarm.graph import Graph, path_map_graph
 from jaxswarm.maps.movingai import load_map
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.multiagent import (ORDERS, PLANNERS, UNREACHABLE, load_instance, lower_bound,
                                  validate)
-from jaxswarm.paths import as_node, path_length
-from jaxswarm.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
+from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, registry, run
+from jaxswarm.world.graph import Graph, path_map_graph
+from jaxswarm.world.paths import as_node, path_length
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
 def swarm_label(name: str) -> str:
@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="jaxswarm", description=__doc__.splitlines()[0])
     parser.add_argument("--threads", type=int,
                         help="XLA:CPU intra-op threads (default: one per core); 1 is fastest for "
-                             "single runs on a few cores, see jaxswarm.cpu")
+                             "single runs on a few cores, see jaxswarm.runtime.cpu")
     commands = parser.add_subparsers(dest="command", required=True)
     demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
     demo.add_argument("--map", default="mosaic50",
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
 def run_sweep_command(args: argparse.Namespace) -> int:
     """Check the spec (before any compute), run or resume the sweep, plot, print a summary."""
     from jaxswarm.sweep import default_out, load_spec, run_sweep
-    from jaxswarm.sweep.plots import plot_sweep, summary
+    from jaxswarm.plot.sweep import plot_sweep, summary
 
     spec = load_spec(args.file)
     out = args.out if args.out is not None else default_out(spec)
@@ -162,7 +162,7 @@ def run_demo(args: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     from matplotlib import pyplot as plt
 
-    from jaxswarm.plot import plot_solutions, plot_swarm_run
+    from jaxswarm.plot.graph import plot_solutions, plot_swarm_run
 
     name, graph, start, goal = _load(args)
     if args.repeats < 1:
@@ -216,7 +216,7 @@ def run_robot(args: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     from matplotlib import pyplot as plt
 
-    from jaxswarm.plot_robot import animate_robot, plot_robot
+    from jaxswarm.plot.robot import animate_robot, plot_robot
 
     name, graph, start, goal = _load(args)
     for option in ("blocks", "iterations", "max_plans"):
@@ -261,7 +261,7 @@ def run_mapf(args: argparse.Namespace) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from jaxswarm.plot_agents import animate_plan
+    from jaxswarm.plot.agents import animate_plan
 
     options = _planner_options(args)
     if args.agents < 1:

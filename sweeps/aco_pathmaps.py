@@ -36,16 +36,13 @@ from pathlib import Path
 import jax
 import numpy as np
 
-from jaxswarm.atomic import write_csv
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import path_map_graph
 from jaxswarm.maps.random import random_path_map
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.world.graph import path_map_graph
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 ALGORITHMS = {"Ant System": "ant_system", "Max-Min ACO": "max_min_aco",
               "Improved Max-Min ACO": "improved_max_min_aco"}

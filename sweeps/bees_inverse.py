@@ -38,17 +38,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from jaxswarm.atomic import write_csv  # noqa: E402
-from jaxswarm.maps.plane import PAPER_PLANES, paper_plane, shortest_path  # noqa: E402
-from jaxswarm.plot import save_png  # noqa: E402
+from jaxswarm.exact.visibility import shortest_path  # noqa: E402
+from jaxswarm.maps.planes import paper_plane, PAPER_PLANES  # noqa: E402
+from jaxswarm.plot.graph import save_png  # noqa: E402
+from jaxswarm.runtime.atomic import write_csv  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task  # noqa: E402
 from jaxswarm.swarm.bees.inverse import (es_search, grid_search, make_scorer,  # noqa: E402
                                          weight_grid)
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 CYCLES = 3
 """The paper's colony cycles a step for the inverse problem."""

@@ -12,7 +12,7 @@ Columns: target (runs that reached the goal), the mean and standard deviation of
 of those runs (avgP, stdP) and of one run's wall time (avgT, stdT: each run timed alone after a
 warm-up compile), then ours only: the vehicle's steps and the bee evaluations per run (means),
 the runs whose trajectory passes through an obstacle (the paper's vehicle checks only where it
-lands, so it may clip a corner; shapely-free check: :func:`jaxswarm.maps.plane.crossings`) and
+lands, so it may clip a corner; shapely-free check: :func:`jaxswarm.world.plane.crossings`) and
 the best length found against the visibility-graph optimum. Each table has the paper's variant
 (``cabc``) and the one that also forbids moves through obstacles (``forbid_crossing``).
 
@@ -42,16 +42,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from jaxswarm.atomic import write_csv  # noqa: E402
-from jaxswarm.maps.plane import crossings, paper_plane, shortest_path  # noqa: E402
-from jaxswarm.plot import save_png  # noqa: E402
-from jaxswarm.plot_plane import draw_plane, draw_trajectory  # noqa: E402
+from jaxswarm.exact.visibility import shortest_path  # noqa: E402
+from jaxswarm.maps.planes import paper_plane  # noqa: E402
+from jaxswarm.plot.graph import save_png  # noqa: E402
+from jaxswarm.plot.plane import draw_plane, draw_trajectory  # noqa: E402
+from jaxswarm.runtime.atomic import write_csv  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task, run  # noqa: E402
+from jaxswarm.world.plane import crossings  # noqa: E402
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 STEPS = 200
 """The paper's M: the most vehicle steps of a run."""
@@ -105,7 +104,7 @@ ABOUT = ("`cabc` is the paper's constrained ABC local planner as written (eqs. 1
          "tolerance of 0.5; f2 and f3 as `jaxswarm.swarm.bees.guided` defines them). "
          "`cabc, forbid_crossing` is the same with moves through an obstacle forbidden too. "
          "Maps #1 and #2 are ours, built in the spirit of the paper's figures "
-         "(`jaxswarm.maps.plane`). The paper's values are quoted beside ours.")
+         "(`jaxswarm.world.plane`). The paper's values are quoted beside ours.")
 
 RUN_COLUMNS = ["table", "map", "variant", "w1", "w2", "w3", "cycles", "seed", "reached",
                "length", "optimum", "steps", "evaluations", "clipped", "seconds"]

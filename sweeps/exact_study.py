@@ -7,7 +7,7 @@ Dijkstra, A* and bidirectional A* against the grid size (mean and spread).
 
 Here each grid is :func:`jaxswarm.maps.random.random_grid` (obstacles with probability
 ``--density``, then a random monotone staircase from (0, 0) to (size-1, size-1) is cleared) turned
-into a :func:`jaxswarm.graph.grid_graph` (8-connected, diagonal sqrt 2, no corner cutting). The
+into a :func:`jaxswarm.world.graph.grid_graph` (8-connected, diagonal sqrt 2, no corner cutting). The
 seed of grid ``index`` of a given ``size`` is derived from ``(--seed, size, index)`` by numpy's
 ``SeedSequence``, so any row can be regenerated on its own. For every grid the report's three
 planners of :mod:`jaxswarm.exact`, and balanced bidirectional A* in its own row, record, from
@@ -52,15 +52,12 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import atomic_path, write_csv
 from jaxswarm.exact import astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
+from jaxswarm.runtime.atomic import atomic_path, write_csv
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 PLANNERS: dict[str, Callable] = {
     "dijkstra": dijkstra,

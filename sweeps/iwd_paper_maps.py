@@ -27,15 +27,12 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import write_csv
 from jaxswarm.exact import astar
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 COLUMNS = ("map", "seed", "optimum", "cost", "gap", "found", "optimal", "iterations",
            "evaluations", "seconds")

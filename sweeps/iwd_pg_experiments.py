@@ -52,18 +52,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from jaxswarm.atomic import write_csv  # noqa: E402
 from jaxswarm.exact import dijkstra  # noqa: E402
 from jaxswarm.maps.iwd_pg import iwd_pg_map  # noqa: E402
 from jaxswarm.maps.paper import paper_map  # noqa: E402
-from jaxswarm.plot import draw_map, draw_paths, save_png  # noqa: E402
+from jaxswarm.plot.graph import draw_map, draw_paths, save_png  # noqa: E402
+from jaxswarm.runtime.atomic import write_csv  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task, run  # noqa: E402
 from jaxswarm.swarm.iwd import fuzzy  # noqa: E402
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 OFF = dict(smooth=False, first_intersection=False, second_intersection=False,
            local_search=False)

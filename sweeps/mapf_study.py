@@ -72,14 +72,11 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import atomic_path, write_csv
 from jaxswarm.multiagent import (Instance, cbs, load_instance, lower_bound, prioritized,
                                  report_scheme, validate)
+from jaxswarm.runtime.atomic import atomic_path, write_csv
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 MAPS = ("empty-32-32", "random-32-32-10", "room-32-32-4", "maze-32-32-2", "den312d")
 """The default maps (all: ``--maps all``)."""

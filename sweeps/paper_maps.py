@@ -22,7 +22,7 @@ from matplotlib import pyplot as plt
 
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra
 from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, paper_map
-from jaxswarm.plot import draw_map, draw_paths, save_png
+from jaxswarm.plot.graph import draw_map, draw_paths, save_png
 
 
 def ascii_map(chosen) -> str:

@@ -3,9 +3,9 @@
 The rows of Table 1 (:mod:`rfd_paper_static`, the same labels, swarms and params) plus "D* Lite
 (repair)", a row the paper lacks. Per map, each swarm first solves the static map once per seed
 (keys split from key 0, ``--iterations`` iterations, like Table 1): its Table 1 state. Then for
-each of the paper's changes (:func:`jaxswarm.maps.paper_dynamic.paper_scenario`: Table 2 the goal
+each of the paper's changes (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: Table 2 the goal
 moves, 3 obstacles added, 4 removed, 5 a major change) the swarm continues from that state:
-:func:`jaxswarm.dynamic.change` applies the change and the swarm's memory rule, then ``run``
+:func:`jaxswarm.dynamic.events.change` applies the change and the swarm's memory rule, then ``run``
 continues (``--iterations`` at most, patience ``--patience``; key ``fold_in(seed key, table)``).
 
 Timed per run, compile excluded (each program runs once first):
@@ -46,20 +46,17 @@ import matplotlib
 matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 
-from jaxswarm.atomic import write_csv
-from jaxswarm.dynamic import apply_event, check_events, first_iteration_at, replan
-from jaxswarm.exact import astar, replanner
-from jaxswarm.graph import grid_graph
-from jaxswarm.maps.paper import paper_map, paper_maps_argument
-from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
+from jaxswarm.dynamic.events import apply_event, check_events, first_iteration_at, replan
+from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
                                          paper_scenario)
-from jaxswarm.plot import draw_map, draw_paths, save_png
+from jaxswarm.exact import astar, replanner
+from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.plot.graph import draw_map, draw_paths, save_png
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import make_task, run
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find the modules beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 import rfd_paper_static as static  # noqa: E402
 
 DSTAR = "D* Lite (repair)"
@@ -72,7 +69,7 @@ TITLE = "RFD paper, Tables 2-5 (dynamic environment): ours beside the paper's"
 ABOUT = static.ABOUT + (
     " \"D* Lite (repair)\" is not in the paper: D* Lite (`jaxswarm.exact.replanner`) repairing "
     "its search of the static map. Each swarm continues from its own Table 1 state, its memory "
-    "adapted by its rule (`jaxswarm.dynamic`).")
+    "adapted by its rule (`jaxswarm.dynamic.events`).")
 PAPER_ROW = {**{row.label: row.paper for row in static.ROWS}, DSTAR: None}
 
 

@@ -62,19 +62,16 @@ matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
-from jaxswarm.atomic import write_csv
 from jaxswarm.exact import astar, dijkstra
-from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import (
     PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, PaperMap, paper_map, paper_maps_argument)
-from jaxswarm.paths import Solution
-from jaxswarm.plot import draw_map, draw_paths, save_png
+from jaxswarm.plot.graph import draw_map, draw_paths, save_png
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import Swarm, definition, make, make_task, run
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 
 class Row(NamedTuple):

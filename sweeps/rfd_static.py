@@ -28,15 +28,12 @@ from pathlib import Path
 
 import jax
 
-from jaxswarm.atomic import write_csv
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 SOURCES = {"rfd": "RFD paper", "rfd_star": "RFD paper", "rfd_graded": "ours"}
 """Registered swarm -> where its algorithm comes from, in table order."""

@@ -2,7 +2,7 @@
 compared on seeded random path maps and on the RFD paper's nine maps.
 
 Per map and seed, a world: the map the robot knows and ``--blocks`` hidden blocks it does not
-(:func:`jaxswarm.robot.hidden_blocks`: each on the shortest path of the world so far, so the
+(:func:`jaxswarm.dynamic.robot.hidden_blocks`: each on the shortest path of the world so far, so the
 robot meets them; passages with a thin wall on path maps, cells on the paper maps; fewer where
 no more keep the goal reachable, as on a perfect maze's single way, counted in ``blocks``).
 Path maps are the Max-Min ACO paper's sizes (10x10, 20x20, 40x25), one random map per seed
@@ -14,7 +14,7 @@ first ant walking again from where the robot stands), the same with its memory w
 re-plan (what keeping the pheromone buys: the paper's claim), ``rfd_star`` (the RFD paper's
 RFD*, altitudes kept), ``rfd_graded`` (ours) and D* Lite repairing its search. Each plan of a
 swarm is a run of at most ``--iterations`` iterations with patience ``--patience``, continuing
-its memory (:func:`jaxswarm.robot.swarm_robot`); the robot stops at the goal or after
+its memory (:func:`jaxswarm.dynamic.robot.swarm_robot`); the robot stops at the goal or after
 ``--max-plans`` plans.
 
 Measured per run: whether the robot reached the goal, the length it travelled against the
@@ -49,20 +49,17 @@ import matplotlib
 matplotlib.use("Agg")
 from matplotlib import pyplot as plt
 
-from jaxswarm.atomic import write_csv
-from jaxswarm.dynamic import Event
-from jaxswarm.graph import Graph, path_map_graph
+from jaxswarm.dynamic.events import Event
+from jaxswarm.dynamic.robot import check_world, dstar_robot, hidden_blocks, swarm_robot
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
 from jaxswarm.maps.random import random_path_map
-from jaxswarm.plot_robot import animate_robot, draw_robot
-from jaxswarm.plot import save_png
-from jaxswarm.robot import check_world, dstar_robot, hidden_blocks, swarm_robot
+from jaxswarm.plot.graph import save_png
+from jaxswarm.plot.robot import animate_robot, draw_robot
+from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.swarm import definition, make, make_task
+from jaxswarm.world.graph import Graph, path_map_graph
+from jaxswarm.studies import provenance
 
-HERE = str(Path(__file__).resolve().parent)
-if HERE not in sys.path:  # loaded by path (the tests): find provenance.py beside this script
-    sys.path.insert(0, HERE)
-import provenance  # noqa: E402
 
 
 class Row(NamedTuple):

@@ -4,9 +4,9 @@ from typing import NamedTuple
 import jax
 import numpy as np
 
-from jaxswarm.graph import dense_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.world.graph import dense_graph
 
 
 def geometric_graph(rng, n: int, *, radius: float, density: float, stretch: tuple[float, float]):

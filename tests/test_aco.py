@@ -4,10 +4,10 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.paths import is_valid_path, path_length, step_slots
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.world.paths import is_valid_path, path_length, step_slots
 
 
 def corridor():

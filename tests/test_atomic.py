@@ -3,7 +3,7 @@ import csv
 
 import pytest
 
-from jaxswarm.atomic import atomic_path, write_atomically, write_csv
+from jaxswarm.runtime.atomic import atomic_path, write_atomically, write_csv
 
 
 def test_a_write_replaces_the_file_and_leaves_nothing_behind(tmp_path):

@@ -3,7 +3,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.batching import one_at_a_time
+from jaxswarm.runtime.batching import one_at_a_time
 
 
 def halvings(x, floor):

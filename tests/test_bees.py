@@ -8,14 +8,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import grid_graph
-from jaxswarm.maps.plane import (PLANE_CAPACITY, make_plane, paper_plane, shortest_path,
-                                 violations)
+from jaxswarm.exact.visibility import shortest_path
+from jaxswarm.maps.planes import PLANE_CAPACITY, paper_plane
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.bees.colony import (deb_best, deb_better, fitness, onlooker_probabilities,
                                         search)
 from jaxswarm.swarm.bees.guided import (constraint_violations, goal_distance, guided, pushback,
                                         revisits, turn_degrees)
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.world.plane import make_plane, violations
 
 shapely = pytest.importorskip("shapely")
 STEPS = 200

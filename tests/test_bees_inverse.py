@@ -5,7 +5,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.maps.plane import paper_plane
+from jaxswarm.maps.planes import paper_plane
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.bees.inverse import (Score, es_search, grid_search, make_scorer, objective,
                                          worst_objective)

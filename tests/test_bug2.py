@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.random import random_grid, random_path_map
-from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.aco.bug2 import bug2_path
+from jaxswarm.world.graph import grid_graph, path_map_graph
+from jaxswarm.world.paths import is_valid_path, path_length
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -1,4 +1,4 @@
-"""jaxswarm.cpu: devices and XLA's thread pool, set before JAX starts."""
+"""jaxswarm.runtime.cpu: devices and XLA's thread pool, set before JAX starts."""
 import json
 import subprocess
 import sys
@@ -6,7 +6,7 @@ import sys
 import jax.numpy as jnp
 import pytest
 
-from jaxswarm.cpu import configure
+from jaxswarm.runtime.cpu import configure
 
 PROBE = """
 import importlib, json, os, pkgutil
@@ -14,7 +14,7 @@ import jax
 import jaxswarm
 for module in pkgutil.walk_packages(jaxswarm.__path__, "jaxswarm."):
     importlib.import_module(module.name)
-from jaxswarm.cpu import configure
+from jaxswarm.runtime.cpu import configure
 configure(devices={devices}, threads={threads})  # after every import: none may start JAX
 import jax.numpy as jnp
 jnp.ones(3).block_until_ready()

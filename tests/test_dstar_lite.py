@@ -5,10 +5,10 @@ import pytest
 
 from conftest import MOVINGAI
 from graphs import geometric_graph
-from jaxswarm.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.exact import astar, dijkstra, replanner
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.movingai import load_map
+from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
+from jaxswarm.world.graph import grid_graph
 
 
 def check(solution, graph, start, goal):

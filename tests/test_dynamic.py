@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from graphs import solved_paper_map
-from jaxswarm.dynamic import (apply_event, change, check_events, first_iteration_at, make_event,
+from jaxswarm.dynamic.events import (apply_event, change, check_events, first_iteration_at, make_event,
                               memory_frames, replan)
-from jaxswarm.graph import grid_graph
-from jaxswarm.plot import animate_field
+from jaxswarm.plot.graph import animate_field
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import _run
+from jaxswarm.world.graph import grid_graph
 
 H0 = 1e4
 

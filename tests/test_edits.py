@@ -1,10 +1,10 @@
 import jax
 import numpy as np
 
-from jaxswarm import edits
+from jaxswarm.world import edits
 from jaxswarm.exact import distance_field
-from jaxswarm.graph import grid_graph, path_map_graph
-from jaxswarm.paths import node_index
+from jaxswarm.world.graph import grid_graph, path_map_graph
+from jaxswarm.world.paths import node_index
 
 
 def test_block_and_unblock_cells_change_contents_not_shapes():

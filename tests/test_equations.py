@@ -20,9 +20,7 @@ import pytest
 
 from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_walk, moves,
                   probabilities, slot, step_length, xy)
-from jaxswarm.edits import close_edges
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.swarm import aco, make, make_task
 from jaxswarm.swarm.aco.bug2 import first_ant_path
@@ -31,6 +29,8 @@ from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDSta
                                 rfd_star_transition, rfd_transition, settle)
 from jaxswarm.swarm.rfd.river import deposit_where_stuck
 from jaxswarm.swarm.walking import FORCED
+from jaxswarm.world.edits import close_edges
+from jaxswarm.world.graph import grid_graph, path_map_graph
 
 REL = 1e-5
 NONE = -math.inf

@@ -9,9 +9,9 @@ import scipy.sparse.csgraph as csgraph
 import oracle
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
                             distance_field, optimum)
-from jaxswarm.graph import dense_graph, grid_graph, path_map_graph
 from jaxswarm.maps.random import random_path_map
-from jaxswarm.paths import is_valid_path, path_length
+from jaxswarm.world.graph import dense_graph, grid_graph, path_map_graph
+from jaxswarm.world.paths import is_valid_path, path_length
 
 PLANNERS = [dijkstra, astar, bidirectional_astar, balanced_bidirectional_astar]
 

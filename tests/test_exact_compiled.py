@@ -4,11 +4,11 @@ import pytest
 
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
                             reference, shortest_lengths, warm_up)
-from jaxswarm.exact.search import workspace
 from jaxswarm.exact._host import edge_arrays
+from jaxswarm.exact.search import workspace
 from graphs import geometric_graph
-from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.random import random_path_map
+from jaxswarm.world.graph import grid_graph, path_map_graph
 
 PAIRS = [(dijkstra, reference.dijkstra), (astar, reference.astar),
          (bidirectional_astar, reference.bidirectional_astar),

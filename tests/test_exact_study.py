@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from scipy.sparse.csgraph import shortest_path
 
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.random import random_grid
+from jaxswarm.world.graph import grid_graph
 from repo_scripts import load_script
 
 SIZES = (10, 15)

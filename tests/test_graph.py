@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 import scipy.sparse.csgraph as csgraph
 
-from jaxswarm.graph import dense_graph, grid_graph, path_map_graph
-from jaxswarm.lattice import (DIRECTIONS, OPPOSITE, move_lengths, slot_lengths, slot_offsets,
+from jaxswarm.world.graph import dense_graph, grid_graph, path_map_graph
+from jaxswarm.world.lattice import (DIRECTIONS, OPPOSITE, move_lengths, slot_lengths, slot_offsets,
                               total_length)
-from jaxswarm.relax import lowest_neighbour, relax
+from jaxswarm.world.relax import lowest_neighbour, relax
 from oracle import grid_adjacency
 
 

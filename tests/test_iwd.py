@@ -5,13 +5,13 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import grid_graph
-from jaxswarm.paths import step_slots
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
 from jaxswarm.swarm.iwd.soil import SOIL, choice_log_weights, goal_log_desirability
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, edge_groups
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.world.paths import step_slots
 
 P = DEFAULT_IWD
 EAST = 0  # slot of the move (x, y) -> (x + 1, y)

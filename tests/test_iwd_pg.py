@@ -7,14 +7,14 @@ import numpy as np
 import pytest
 
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import grid_graph
-from jaxswarm.paths import is_valid_path, pad, path_length, trim
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import fuzzy
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
                                           second_intersection)
 from jaxswarm.swarm.iwd.memory import empty_memory, join, remember, reverse, splice
 from jaxswarm.swarm.iwd.smooth import smooth_path
+from jaxswarm.world.graph import grid_graph
+from jaxswarm.world.paths import is_valid_path, pad, path_length, trim
 
 L = 40
 

@@ -13,7 +13,7 @@ import pytest
 
 from jaxswarm.maps.movingai import read_map
 from jaxswarm.multiagent import Plan, load_instance, pack, prioritized
-from jaxswarm.paths import as_node
+from jaxswarm.world.paths import as_node
 from repo_scripts import load_script
 
 study = load_script("sweeps/mapf_study.py")

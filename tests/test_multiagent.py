@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 import oracle
-from jaxswarm.graph import grid_graph
 from jaxswarm.maps.movingai import MovingAIFormatError
 from jaxswarm.multiagent import (UNREACHABLE, cbs, find_conflicts, hop_fields, load_instance,
                                  lower_bound, pack, prioritized, report_scheme, validate)
@@ -15,6 +14,7 @@ from jaxswarm.multiagent import conflicts as conflicts_module
 from jaxswarm.multiagent.plan import arrival_steps
 from jaxswarm.multiagent.prioritized import priority_order
 from jaxswarm.multiagent.report import report_example
+from jaxswarm.world.graph import grid_graph
 
 PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs}
 

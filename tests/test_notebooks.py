@@ -17,7 +17,7 @@ The notebooks also check their own results with ``assert``. After a run, the tes
 * sweep_analysis: the Parquet store under ``tmp_path``. Read back with pandas, it holds
   maps x combinations x seeds rows, one per run, taken from the spec in ``metadata.json``. No gap
   is below -1e-6. The PNGs of ``plot_sweep`` exist. The figures were shown inline, which
-  confirms the notebook's ``%matplotlib inline`` after the import of ``jaxswarm.sweep.plots``;
+  confirms the notebook's ``%matplotlib inline`` after the import of ``jaxswarm.plot.sweep``;
   that module selects Agg at import.
 
 Which Python runs the kernel: the notebooks must run in the interpreter that runs pytest (the

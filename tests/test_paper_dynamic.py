@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 
 from graphs import solved_paper_map
-from jaxswarm.dynamic import apply_event, change, check_events
-from jaxswarm.exact import dijkstra
-from jaxswarm.graph import grid_graph
-from jaxswarm.maps.paper import PAPER_OPTIMA, paper_map
-from jaxswarm.maps.paper_dynamic import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
+from jaxswarm.dynamic.events import apply_event, change, check_events
+from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
                                          paper_scenario)
+from jaxswarm.exact import dijkstra
+from jaxswarm.maps.paper import PAPER_OPTIMA, paper_map
 from jaxswarm.swarm import make_task, run
+from jaxswarm.world.graph import grid_graph
 
 
 @pytest.mark.parametrize("name", [

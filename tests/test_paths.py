@@ -5,9 +5,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm import edits
-from jaxswarm.graph import dense_graph, grid_graph
-from jaxswarm.paths import as_node, is_valid_path, node_index, node_xy, pad, path_length, trim
+from jaxswarm.world import edits
+from jaxswarm.world.graph import dense_graph, grid_graph
+from jaxswarm.world.paths import as_node, is_valid_path, node_index, node_xy, pad, path_length, trim
 
 
 @pytest.fixture

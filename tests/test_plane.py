@@ -8,9 +8,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.maps.plane import (PAPER_PLANES, check_point, crossings, in_plane, make_plane,
-                                 paper_plane, random_plane, shortest_path, trajectory_length,
-                                 violations)
+from jaxswarm.exact.visibility import shortest_path
+from jaxswarm.maps.planes import PAPER_PLANES, paper_plane, random_plane
+from jaxswarm.world.plane import check_point, crossings, in_plane, make_plane, trajectory_length, violations
 
 shapely = pytest.importorskip("shapely")
 nx = pytest.importorskip("networkx")

@@ -11,12 +11,12 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from jaxswarm import plot  # noqa: E402
+from jaxswarm.plot import graph as plot  # noqa: E402
 from jaxswarm.exact import astar, dijkstra, distance_field  # noqa: E402
-from jaxswarm.graph import dense_graph, grid_graph, path_map_graph  # noqa: E402
-from jaxswarm.lattice import DIRECTIONS  # noqa: E402
 from jaxswarm.maps.random import random_path_map  # noqa: E402
-from jaxswarm.paths import pad  # noqa: E402
+from jaxswarm.world.graph import dense_graph, grid_graph, path_map_graph  # noqa: E402
+from jaxswarm.world.lattice import DIRECTIONS  # noqa: E402
+from jaxswarm.world.paths import pad  # noqa: E402
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -275,7 +275,7 @@ def test_save_png_interrupted_leaves_old_file_and_no_temporary(tmp_path, monkeyp
 def test_draw_trace_plots_the_run_and_the_optimum():
     import jax.numpy as jnp
 
-    from jaxswarm.plot import draw_trace
+    from jaxswarm.plot.graph import draw_trace
     from jaxswarm.swarm import Trace
 
     nan = float("nan")
@@ -296,7 +296,7 @@ def test_draw_trace_plots_the_run_and_the_optimum():
 def test_plot_swarm_run_writes_two_panels(tmp_path):
     import jax
 
-    from jaxswarm.plot import plot_swarm_run
+    from jaxswarm.plot.graph import plot_swarm_run
     from jaxswarm.swarm import make, make_task, run
 
     graph = grid_graph(np.zeros((6, 6), bool))

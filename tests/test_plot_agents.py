@@ -1,4 +1,4 @@
-"""Figures of many agents (jaxswarm.plot_agents): paths drawn where the map says, GIFs with one
+"""Figures of many agents (jaxswarm.plot.agents): paths drawn where the map says, GIFs with one
 frame per step, written whole or not at all."""
 import re
 
@@ -11,9 +11,9 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from PIL import Image  # noqa: E402
 
-from jaxswarm.atomic import TEMPORARY_GLOB  # noqa: E402
-from jaxswarm.graph import grid_graph  # noqa: E402
-from jaxswarm.plot_agents import agent_colors, animate_plan, draw_plan  # noqa: E402
+from jaxswarm.plot.agents import agent_colors, animate_plan, draw_plan  # noqa: E402
+from jaxswarm.runtime.atomic import TEMPORARY_GLOB  # noqa: E402
+from jaxswarm.world.graph import grid_graph  # noqa: E402
 
 BLOCKED = np.array([[0, 0, 0, 0, 0],
                     [0, 1, 0, 1, 0],

@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 
 from jaxswarm.exact import dijkstra
-from jaxswarm.graph import grid_graph, path_map_graph
-from jaxswarm.lattice import OPPOSITE
 from jaxswarm.maps.random import random_grid, random_path_map
+from jaxswarm.world.graph import grid_graph, path_map_graph
+from jaxswarm.world.lattice import OPPOSITE
 
 
 @pytest.mark.parametrize("size", [2, 10, 37])

@@ -7,11 +7,11 @@ import jax
 import numpy as np
 import pytest
 
-from jaxswarm.graph import Graph
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.maps.plane import Plane
 from jaxswarm.swarm import config_options, definition, make, make_task, registered, run
 from jaxswarm.swarm.registry import REGISTRY
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.plane import Plane
 
 GOLDEN = Path(__file__).parent / "golden" / "rfd_graded_0.3.0.json"
 """Runs of ``make("rfd_graded", num_agents=...)`` with its defaults, written by

@@ -1,4 +1,4 @@
-"""The reproduction of results/: the shared provenance helper (sweeps/provenance.py), every table
+"""The reproduction of results/: the shared provenance helper (jaxswarm.studies.provenance), every table
 script's provenance header at a tiny size, the path-map table beside the Max-Min ACO paper's
 (sweeps/aco_pathmaps.py), the results index, and the Makefile's reproduce targets."""
 from __future__ import annotations
@@ -21,7 +21,7 @@ import pytest
 
 from repo_scripts import ROOT, load_script
 
-provenance = load_script("sweeps/provenance.py")
+from jaxswarm.studies import provenance
 pathmaps = load_script("sweeps/aco_pathmaps.py")
 robot_study = load_script("sweeps/robot_study.py")
 
@@ -363,14 +363,14 @@ def make_commands(target: str, *variables: str) -> list[list[str]]:
 def out_folders(commands: list[list[str]]) -> list[str]:
     """The --out of each table command and the folder the last one (the index) is given."""
     *tables, index = commands
-    assert index[0] == "sweeps/provenance.py"
+    assert index[0] == "sweeps/index_results.py"
     return [words[words.index("--out") + 1] for words in tables] + [index[1]]
 
 
 def test_reproduce_writes_results_and_the_quick_target_never_does():
     full, quick = make_commands("reproduce"), make_commands("reproduce-quick")
     assert [words[0] for words in full] == [words[0] for words in quick] == [
-        *(script for script, _ in TINY.values()), "sweeps/provenance.py"]
+        *(script for script, _ in TINY.values()), "sweeps/index_results.py"]
     assert out_folders(full) == [*(f"results/{name}" for name in TINY), "results"]
     assert out_folders(quick) == [*(f"out/reproduce-quick/{name}" for name in TINY),
                                   "out/reproduce-quick"]

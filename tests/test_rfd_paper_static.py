@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from jaxswarm.maps.paper import PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, paper_map
-from jaxswarm.paths import as_node, is_valid_path, path_length
+from jaxswarm.world.paths import as_node, is_valid_path, path_length
 from repo_scripts import load_script
 
 MAP, SEEDS, ITERATIONS, AGENTS = "mosaic20", 2, 3, 16

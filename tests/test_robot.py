@@ -6,15 +6,15 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.dynamic import apply_event, change, check_events, make_event
+from jaxswarm.dynamic.events import apply_event, change, check_events, make_event
+from jaxswarm.dynamic.robot import (check_world, dstar_robot, hidden_blocks, swarm_robot, walk_plan)
 from jaxswarm.exact import astar
-from jaxswarm.graph import grid_graph, path_map_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.maps.random import random_path_map
-from jaxswarm.paths import is_valid_path, path_length, trim
-from jaxswarm.robot import (check_world, dstar_robot, hidden_blocks, swarm_robot, walk_plan)
 from jaxswarm.swarm import make, make_task
 from jaxswarm.swarm.core import Task
+from jaxswarm.world.graph import grid_graph, path_map_graph
+from jaxswarm.world.paths import is_valid_path, path_length, trim
 
 SQRT2 = float(np.sqrt(2))
 

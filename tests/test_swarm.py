@@ -9,15 +9,16 @@ import pytest
 
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra, optimal_length
-from jaxswarm.graph import Graph, grid_graph
+from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.maps.plane import Plane, make_plane, shortest_path
-from jaxswarm.paths import Solution
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
 from jaxswarm.swarm.testing import (check_compiles_once, check_reproducible,
                                     check_valid_results)
 from jaxswarm.swarm.walking import Walk
+from jaxswarm.world.graph import Graph, grid_graph
+from jaxswarm.world.paths import Solution
+from jaxswarm.world.plane import Plane, make_plane
 
 ITERATIONS = 8
 SMALL = dict(num_agents=32)

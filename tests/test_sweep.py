@@ -19,12 +19,13 @@ import pandas as pd
 import pytest
 
 from jaxswarm.exact import dijkstra, optimal_length
+from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.maps.plane import paper_plane, shortest_path
+from jaxswarm.maps.planes import paper_plane
+from jaxswarm.plot.sweep import heatmap_figure, line_figure, plot_sweep, summary
 from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
-from jaxswarm.sweep.plots import heatmap_figure, line_figure, plot_sweep, summary
 from jaxswarm.sweep.runner import group_size
 
 REPO = Path(__file__).resolve().parents[1]

@@ -3,11 +3,11 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.graph import dense_graph, grid_graph
-from jaxswarm.lattice import straight_line
-from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.walking import (FORCED, STEPS_PER_REFILL, edge_table, sample_masked,
                                     visited_nodes, walk)
+from jaxswarm.world.graph import dense_graph, grid_graph
+from jaxswarm.world.lattice import straight_line
+from jaxswarm.world.paths import is_valid_path, path_length
 
 
 def _uniform(seed, mask):

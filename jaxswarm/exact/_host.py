@@ -14,7 +14,7 @@ import weakref
 import numpy as np
 
 from jaxswarm.exact import kernels
-from jaxswarm.graph import Graph
+from jaxswarm.world.graph import Graph
 
 SQRT2 = math.sqrt(2.0)
 

@@ -6,8 +6,8 @@ algorithms in readable Python, with the same paths and statistics.
 from __future__ import annotations
 
 from jaxswarm.exact.search import best_first_search, bidirectional_search
-from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution
 
 
 def astar(graph: Graph, start, goal, *, heuristic: str | None = None,

@@ -20,7 +20,7 @@ from jaxswarm.exact import kernels
 from jaxswarm.exact._host import EdgeArrays, default_heuristic, edge_arrays, heuristic_code
 from jaxswarm.exact.search import workspace
 from jaxswarm.exact.stats import SearchStats
-from jaxswarm.graph import Graph
+from jaxswarm.world.graph import Graph
 
 
 class Lengths(NamedTuple):

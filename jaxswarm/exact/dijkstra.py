@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 from jaxswarm.exact.search import best_first_search
-from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution, path_length
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution, path_length
 
 
 def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Solution:
@@ -27,7 +27,7 @@ def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Soluti
 
 def optimal_length(graph: Graph, start, goal) -> float:
     """The optimum as the swarms measure their paths: Dijkstra's shortest path, its length
-    summed in float32 by :func:`jaxswarm.paths.path_length` (moves counted by kind on grids and
+    summed in float32 by :func:`jaxswarm.world.paths.path_length` (moves counted by kind on grids and
     path maps). A swarm path is never shorter, so a gap to it is never negative; inf where the
     goal cannot be reached.
 

@@ -29,8 +29,8 @@ import numpy as np
 from jaxswarm.exact import kernels
 from jaxswarm.exact._host import EdgeArrays, default_heuristic, heuristic_code, lattice_arrays
 from jaxswarm.exact.stats import SearchStats, make_solution
-from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution, as_node
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution, as_node
 
 jit, inline = kernels.jit, kernels.inline
 
@@ -226,7 +226,7 @@ class _Lattice:
         self.cost = structure.cost.copy()
 
     def check_same_map(self, graph: Graph) -> None:
-        if graph.nbr is self.source.nbr:  # an edit (jaxswarm.edits) keeps the lattice's array
+        if graph.nbr is self.source.nbr:  # an edit (jaxswarm.world.edits) keeps the lattice's array
             return
         nbr = np.asarray(graph.nbr)
         if nbr.shape != self.structure.nbr.shape or not np.array_equal(nbr, self.structure.nbr):

@@ -10,8 +10,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.relax import relax
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.relax import relax
 
 SWEEPS_PER_CHECK = 4
 """Relaxation sweeps between two convergence tests (amortises the loop's overhead)."""
@@ -23,7 +23,7 @@ def distance_field(graph: Graph, goal) -> jax.Array:
 
     Args:
       graph: the map (a batch of maps under vmap).
-      goal: i32[] goal node index (traced; see :func:`jaxswarm.paths.node_index`). A blocked goal
+      goal: i32[] goal node index (traced; see :func:`jaxswarm.world.paths.node_index`). A blocked goal
         gives 0 at the goal and inf everywhere else.
 
     Returns:

@@ -21,8 +21,8 @@ from typing import Callable
 from jaxswarm.exact._host import HostGraph, default_heuristic, host_graph
 from jaxswarm.exact._host import heuristic as make_heuristic
 from jaxswarm.exact.stats import SearchStats, make_solution
-from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution, as_node
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution, as_node
 
 
 def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Solution:

@@ -17,8 +17,8 @@ import numpy as np
 from jaxswarm.exact import kernels
 from jaxswarm.exact._host import EdgeArrays, default_heuristic, edge_arrays, heuristic_code
 from jaxswarm.exact.stats import SearchStats, make_solution
-from jaxswarm.graph import Graph
-from jaxswarm.paths import Solution, as_node
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution, as_node
 
 
 def side_buffers(arrays: EdgeArrays) -> tuple:
@@ -76,7 +76,7 @@ def endpoints(graph: Graph, arrays: EdgeArrays, start, goal) -> tuple[int, int]:
 
 
 def _node(graph: Graph, arrays: EdgeArrays, point, name: str) -> int:
-    """:func:`~jaxswarm.paths.as_node`, with a shortcut for the common case (a free grid cell
+    """:func:`~jaxswarm.world.paths.as_node`, with a shortcut for the common case (a free grid cell
     given as a pair of ints) that reads the cached host arrays instead of the graph's."""
     if graph.is_grid and isinstance(point, tuple) and len(point) == 2 and all(
             isinstance(v, (int, np.integer)) for v in point):

@@ -6,7 +6,7 @@ import dataclasses
 import jax
 import numpy as np
 
-from jaxswarm.paths import Solution, pad
+from jaxswarm.world.paths import Solution, pad
 
 
 @dataclasses.dataclass(frozen=True)

@@ -8,7 +8,7 @@ import numpy as np
 from jaxswarm.exact.astar import astar, bidirectional_astar
 from jaxswarm.exact.batch import shortest_lengths
 from jaxswarm.exact.dstar_lite import replanner
-from jaxswarm.graph import grid_graph
+from jaxswarm.world.graph import grid_graph
 
 
 def warm_up() -> float:

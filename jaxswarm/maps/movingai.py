@@ -16,7 +16,7 @@ import os
 
 import numpy as np
 
-from jaxswarm.graph import Graph, grid_graph
+from jaxswarm.world.graph import Graph, grid_graph
 
 PASSABLE = frozenset(".GS")
 BLOCKED = frozenset("@OTW")
@@ -99,7 +99,7 @@ def load_map(path, **grid_options) -> Graph:
 
     Args:
       path: the ``.map`` file.
-      **grid_options: passed to :func:`jaxswarm.graph.grid_graph` (connectivity, corner_cutting).
+      **grid_options: passed to :func:`jaxswarm.world.graph.grid_graph` (connectivity, corner_cutting).
     """
     return grid_graph(read_map(path), **grid_options)
 

@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from jaxswarm.graph import Graph, grid_graph
+from jaxswarm.world.graph import Graph, grid_graph
 
 PAPER_MAPS: tuple[str, ...] = (
     "mosaic20", "alley20", "maze20",
@@ -43,13 +43,13 @@ PAPER_MAPS: tuple[str, ...] = (
 """The nine maps in the column order of the paper's Table 1."""
 
 
-def _by_map(rows: dict[str, tuple]) -> dict[str, dict[str, float | None]]:
+def by_map(rows: dict[str, tuple]) -> dict[str, dict[str, float | None]]:
     """algorithm -> map -> value, from one tuple per algorithm in the order of PAPER_MAPS."""
     return {algorithm: dict(zip(PAPER_MAPS, values, strict=True))
             for algorithm, values in rows.items()}
 
 
-PAPER_TABLE1_LENGTH: dict[str, dict[str, float | None]] = _by_map({
+PAPER_TABLE1_LENGTH: dict[str, dict[str, float | None]] = by_map({
     "Dijkstra": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
     "A*": (18.65, 33.48, 78.62, 50.62, 81.97, 228.52, 116.94, 170.42, 510.56),
     "ACO": (51.68, 138.98, None, 450.65, 1158.61, None, 2749.60, 5435.08, None),
@@ -60,7 +60,7 @@ PAPER_TABLE1_LENGTH: dict[str, dict[str, float | None]] = _by_map({
 """The paper's Table 1 (static environment), mean path length per algorithm and map; None where
 the paper says n/a (no path found)."""
 
-PAPER_TABLE1_MS: dict[str, dict[str, float | None]] = _by_map({
+PAPER_TABLE1_MS: dict[str, dict[str, float | None]] = by_map({
     "Dijkstra": (6.051, 5.787, 6.534, 57.876, 59.333, 46.316, 542.385, 753.503, 445.556),
     "A*": (1.601, 4.453, 6.265, 24.173, 56.662, 48.895, 335.751, 661.118, 448.542),
     "ACO": (650.16, 681.82, None, 10118.72, 10086.02, None, 131071.05, 132445.70, None),

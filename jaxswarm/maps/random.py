@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from jaxswarm.lattice import DIRECTIONS, OPPOSITE
+from jaxswarm.world.lattice import DIRECTIONS, OPPOSITE
 
 
 @dataclasses.dataclass(frozen=True)
@@ -69,7 +69,7 @@ def random_path_map(width: int, height: int, seed: int, *, extra: float = 0.3) -
     Returns:
       ``conn[y, x, k] == 1`` where the move in direction slot k (``graph.DIRECTIONS``) is open;
       ``conn`` is symmetric (a move is open iff its reverse is) and connects every cell. Feed it
-      to :func:`jaxswarm.graph.path_map_graph`.
+      to :func:`jaxswarm.world.graph.path_map_graph`.
     """
     if width < 1 or height < 1 or width * height < 2:
         raise ValueError(f"a path map needs at least 2 cells, got {width}x{height}")

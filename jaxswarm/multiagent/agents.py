@@ -15,9 +15,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.exact import distance_field
-from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.maps.movingai import MovingAIFormatError, load_scenarios, read_map
-from jaxswarm.paths import as_node
+from jaxswarm.world.graph import Graph, grid_graph
+from jaxswarm.world.paths import as_node
 
 UNREACHABLE = np.iinfo(np.int32).max
 """Hop distance of a node that cannot reach the goal (i32)."""

@@ -19,11 +19,11 @@ import time
 
 import numpy as np
 
-from jaxswarm.graph import Graph
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations, search
+from jaxswarm.world.graph import Graph
 
 
 def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,

@@ -12,10 +12,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jaxswarm.graph import Graph
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import LIMIT, Reservations, search
+from jaxswarm.world.graph import Graph
 
 ORDERS = ("given", "distance", "random")
 """Priority orders by name: as given, by distance (the farthest from its goal first, ties by

@@ -29,13 +29,13 @@ import time
 
 import numpy as np
 
-from jaxswarm.edits import block_cells
 from jaxswarm.exact import astar
 from jaxswarm.exact._host import edge_arrays
-from jaxswarm.graph import Graph, grid_graph
 from jaxswarm.multiagent.agents import agent_nodes, distance_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
+from jaxswarm.world.edits import block_cells
+from jaxswarm.world.graph import Graph, grid_graph
 
 REPORT_EXAMPLES = {
     # map 1: the diagonal crosses a cluster of obstacles around (5, 5), leaving robot 2 the

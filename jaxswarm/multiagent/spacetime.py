@@ -29,8 +29,8 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import inline, jit
-from jaxswarm.graph import Graph
 from jaxswarm.multiagent.agents import UNREACHABLE
+from jaxswarm.world.graph import Graph
 
 FREE, FORBIDDEN = -1, -2
 """``holder`` entries that are not agents."""

@@ -12,9 +12,9 @@ import dataclasses
 
 import numpy as np
 
-from jaxswarm.graph import Graph
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.multiagent.conflicts import find_conflicts
+from jaxswarm.world.graph import Graph
 
 
 @dataclasses.dataclass(frozen=True)

@@ -23,9 +23,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph
-from jaxswarm.maps.plane import Plane, check_point
-from jaxswarm.paths import Solution, as_node
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import Solution, as_node
+from jaxswarm.world.plane import check_point, Plane
 
 World = Graph | Plane
 """What a swarm plans in: a graph (the walkers) or a plane of rectangles (the bees)."""
@@ -113,9 +113,9 @@ class Swarm:
       memory_label: what ``memory`` shows, for colorbars.
       adapt: ``(state, before, after, old_task, new_task, params) -> State``: the memory rule of
         a change of the map (``before`` to ``after``) or the task (see
-        :func:`jaxswarm.dynamic.change`); each family documents its own.
-      world: the kind of world it plans in, :class:`~jaxswarm.graph.Graph` or
-        :class:`~jaxswarm.maps.plane.Plane`.
+        :func:`jaxswarm.dynamic.events.change`); each family documents its own.
+      world: the kind of world it plans in, :class:`~jaxswarm.world.graph.Graph` or
+        :class:`~jaxswarm.world.plane.Plane`.
     """
 
     name: str
@@ -181,7 +181,7 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
       patience: stop after this many iterations without improvement of a path found
         (static; None = never).
       state: a State to continue from (the memory of an earlier run, after
-        :func:`jaxswarm.dynamic.change` when the map or the task changed); its key is replaced
+        :func:`jaxswarm.dynamic.events.change` when the map or the task changed); its key is replaced
         by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
         iteration count and the patience count start again either way.
       budget: i32[] stop after at most this many iterations (traced, so runs of different
@@ -268,7 +268,7 @@ class SwarmConfig:
 
 def default_params(params_type, **values):
     """A Params tuple of NumPy float32 scalars, not JAX arrays: importing a swarm must not start
-    JAX's backend (see :func:`jaxswarm.cpu.configure`); jit and vmap take them as f32 arrays."""
+    JAX's backend (see :func:`jaxswarm.runtime.cpu.configure`); jit and vmap take them as f32 arrays."""
     return params_type(**{name: np.float32(value) for name, value in values.items()})
 
 

@@ -87,8 +87,8 @@ def config_options(name: str) -> tuple[str, ...]:
 
 
 def registered(world: type | None = None) -> tuple[str, ...]:
-    """Names of the registered swarms, sorted; with ``world`` (:class:`~jaxswarm.graph.Graph` or
-    :class:`~jaxswarm.maps.plane.Plane`) only those that plan in that kind of world."""
+    """Names of the registered swarms, sorted; with ``world`` (:class:`~jaxswarm.world.graph.Graph` or
+    :class:`~jaxswarm.world.plane.Plane`) only those that plan in that kind of world."""
     return tuple(name for name in sorted(REGISTRY)
                  if world is None or make(name).world is world)
 

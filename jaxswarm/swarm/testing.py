@@ -6,10 +6,10 @@ Each check raises ``AssertionError`` naming what failed:
 * :func:`check_reproducible`: the same key gives bit-identical results, ``vmap`` over keys
   equals a loop over them, and another key gives another run.
 * :func:`check_valid_results`: the best path is a valid path from start to goal, its cost is
-  its length measured as :func:`jaxswarm.paths.path_length` measures it, never below the
+  its length measured as :func:`jaxswarm.world.paths.path_length` measures it, never below the
   optimum; the trace's best cost never rises; the memory stays finite. On a plane the path is a
   trajectory of waypoints: it starts at the start, ends at the goal, no waypoint lies inside a
-  rectangle, and its cost is :func:`jaxswarm.maps.plane.trajectory_length`.
+  rectangle, and its cost is :func:`jaxswarm.world.plane.trajectory_length`.
 * :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
   and new values of the same shapes do not compile again.
 
@@ -24,9 +24,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.maps.plane import Plane, in_plane, trajectory_length, violations
-from jaxswarm.paths import is_valid_path, path_length
 from jaxswarm.swarm.core import Swarm, Task, World, run
+from jaxswarm.world.paths import is_valid_path, path_length
+from jaxswarm.world.plane import in_plane, Plane, trajectory_length, violations
 
 
 def leaves_equal(a, b) -> bool:

@@ -4,7 +4,7 @@ An entry is a paper map name (``"mosaic50"``), a seeded random grid
 (``{ random = 50, seed = 3, density = 0.3 }``, corner to corner), a plane of rectangles for the
 bees (``{ plane = "map1" }``, the bees paper's map #1 or #2, or
 ``{ plane = "random", seed = 3, rectangles = 40 }``, see
-:func:`jaxswarm.maps.plane.random_plane`) or one row of a Moving AI
+:func:`jaxswarm.world.plane.random_plane`) or one row of a Moving AI
 scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 counted from 0;
 ``scenario_file = "random"`` takes the MAPF set's ``<map>-random-1.scen`` instead of the default
 ``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map).
@@ -20,13 +20,14 @@ from pathlib import Path
 import jax
 
 from jaxswarm.exact import optimal_length
-from jaxswarm.graph import Graph, grid_graph
+from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps import movingai
 from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.plane import (PAPER_PLANES, RANDOM_RECTANGLES, Plane, paper_plane,
-                                 random_plane, shortest_path)
+from jaxswarm.maps.planes import paper_plane, PAPER_PLANES, random_plane, RANDOM_RECTANGLES
 from jaxswarm.maps.random import random_grid
 from jaxswarm.swarm import make_task
+from jaxswarm.world.graph import Graph, grid_graph
+from jaxswarm.world.plane import Plane
 
 RANDOM_KEYS = {"random", "seed", "density"}
 PLANE_KEYS = {"plane", "seed", "rectangles"}
@@ -62,7 +63,7 @@ class SweepMap:
     def optimum(self) -> float:
         """The optimal path length, measured as the swarms measure theirs: Dijkstra's path on a
         graph (:func:`jaxswarm.exact.optimal_length`), the visibility-graph shortest path on a
-        plane (:func:`jaxswarm.maps.plane.shortest_path`); inf when the goal is unreachable."""
+        plane (:func:`jaxswarm.exact.visibility.shortest_path`); inf when the goal is unreachable."""
         if isinstance(self.world, Plane):
             return shortest_path(self.world, self.start, self.goal)[0]
         return optimal_length(self.world, self.start, self.goal)

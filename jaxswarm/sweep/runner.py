@@ -19,7 +19,7 @@ none at the default group sizes).
 
 Each map's optimum is measured as the swarms measure their paths (Dijkstra's path on a graph,
 :func:`jaxswarm.exact.optimal_length`; the visibility-graph shortest path on a plane,
-:func:`jaxswarm.maps.plane.shortest_path`), so every row carries its optimality gap, never
+:func:`jaxswarm.exact.visibility.shortest_path`), so every row carries its optimality gap, never
 negative.
 Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec again
 skips them.

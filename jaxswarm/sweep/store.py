@@ -22,7 +22,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from jaxswarm.atomic import TEMPORARY_GLOB, atomic_path, write_atomically
+from jaxswarm.runtime.atomic import TEMPORARY_GLOB, atomic_path, write_atomically
 
 
 class StoreMismatchError(ValueError):

@@ -19,9 +19,9 @@ import jax
 import numpy as np
 
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.maps.plane import make_plane
 from jaxswarm.swarm import make, make_task, registered, run
 from jaxswarm.swarm.testing import key_data
+from jaxswarm.world.plane import make_plane
 
 GOLDEN = Path(__file__).parent / "swarms.json"
 GRAPH_CASES = [dict(world=world, config=dict(num_agents=16), iterations=6, patience=3)

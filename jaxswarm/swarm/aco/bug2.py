@@ -16,9 +16,9 @@ import functools
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import NO_NODE, Graph
-from jaxswarm.paths import path_length
 from jaxswarm.swarm.walking import heads, sample_masked
+from jaxswarm.world.graph import NO_NODE, Graph
+from jaxswarm.world.paths import path_length
 
 
 def direction_cosine(graph: Graph, goal) -> jax.Array:

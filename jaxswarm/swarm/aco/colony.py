@@ -19,12 +19,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph
-from jaxswarm.paths import step_slots
 from jaxswarm.swarm.aco.bug2 import direction_cosine
 from jaxswarm.swarm.core import Swarm, Task, best_solution, check_positive, keep_best
 from jaxswarm.swarm.walking import (FORCED, edge_table, goal_log_distance, heads, step_budget,
                                      walk)
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import step_slots
 
 DIRECTION_FLOOR = 1e-3
 """Added to the direction desirability so that a move straight away from the goal stays possible."""

@@ -8,7 +8,7 @@ window (the square of side ``window`` centred on the vehicle, clipped to the pla
 Deb's rules. A feasible best point is the vehicle's next position; when no candidate is feasible
 the vehicle stays. The vehicle has arrived when it is within ``tolerance`` of the goal; the goal
 is then appended to its trajectory, so the path length is the length of a trajectory from start
-to goal (never below the optimum of :func:`jaxswarm.maps.plane.shortest_path`). It moves at most
+to goal (never below the optimum of :func:`jaxswarm.exact.visibility.shortest_path`). It moves at most
 ``max_steps`` times (the paper's M = 200). Sizes the paper leaves open are ours: N = 20 sources;
 a window of side 2, so that a move shifts each coordinate by at most 1, less than the thinnest
 wall of our maps (2): the vehicle cannot hop over an obstacle, only clip a corner (the paper's
@@ -24,11 +24,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.maps.plane import Plane, crossings, trajectory_length
-from jaxswarm.paths import Solution
 from jaxswarm.swarm.bees.colony import search
 from jaxswarm.swarm.bees.guided import constraint_violations, guided, revisits
 from jaxswarm.swarm.core import StepInfo, Swarm, SwarmConfig, Task, check_positive, default_params
+from jaxswarm.world.paths import Solution
+from jaxswarm.world.plane import crossings, Plane, trajectory_length
 
 
 @dataclasses.dataclass(frozen=True)
@@ -140,7 +140,7 @@ def trajectory(state: CABCState) -> Solution:
 
 
 def build_cabc(config: CABCConfig) -> Swarm:
-    """cABC on a :class:`~jaxswarm.maps.plane.Plane` (see the module docstring)."""
+    """cABC on a :class:`~jaxswarm.world.plane.Plane` (see the module docstring)."""
     points = config.max_steps + 2
 
     def init(key, plane: Plane, task: Task, params: CABCParams) -> CABCState:

@@ -21,7 +21,7 @@ The paper's future work, a vehicle that remembers the regions where it has been,
 that contain the candidate, so a vehicle going round in a trap pays more the longer it stays.
 
 A candidate violates eq. 6 for every rectangle it lies strictly inside
-(:func:`jaxswarm.maps.plane.violations`); with ``forbid_crossing`` the move from ``here`` to it
+(:func:`jaxswarm.world.plane.violations`); with ``forbid_crossing`` the move from ``here`` to it
 also violates for every rectangle it passes through (off in the paper's variant, whose vehicle
 only ever checks where it lands).
 """
@@ -30,7 +30,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.maps.plane import Plane, crossings, violations
+from jaxswarm.world.plane import crossings, Plane, violations
 
 
 def goal_distance(points: jax.Array, goal: jax.Array) -> jax.Array:

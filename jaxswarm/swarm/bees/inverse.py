@@ -27,8 +27,8 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
-from jaxswarm.maps.plane import Plane
 from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.world.plane import Plane
 
 WEIGHTS = ("w1", "w2", "w3")
 """The weights the inverse problem searches, in the order of a weight vector."""

@@ -29,9 +29,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import move_lengths
-from jaxswarm.paths import step_slots
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import move_lengths
+from jaxswarm.world.paths import step_slots
 
 LOW, MEDIUM, HIGH = 0, 1, 2
 

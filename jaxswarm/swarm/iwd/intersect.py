@@ -18,9 +18,9 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.paths import path_length
 from jaxswarm.swarm.iwd.memory import join, last_position, prefix_lengths, reverse
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import path_length
 
 
 class Children(NamedTuple):

@@ -17,11 +17,11 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
                                  default_params, keep_best)
 from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
 from jaxswarm.swarm.walking import Walk, edge_table, step_budget, walk
+from jaxswarm.world.graph import Graph
 
 
 @dataclasses.dataclass(frozen=True)

@@ -26,7 +26,7 @@ Local searches are small IWD runs (``local_agents`` drops, ``local_iterations`` 
 fresh soil: :mod:`.local`) of one batch each stage, all through the shared walker. Every
 complete path measured counts as a fitness call: the drops that arrived, the local searches'
 drops that arrived, each child and each spliced path. After a change of the map (see
-:func:`jaxswarm.dynamic.change`) the soil is kept as IWD keeps it and the memory is emptied: its
+:func:`jaxswarm.dynamic.events.change`) the soil is kept as IWD keeps it and the memory is emptied: its
 paths may cross the change.
 """
 from __future__ import annotations
@@ -36,8 +36,6 @@ import dataclasses
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.paths import path_length
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, best_solution, keep_best
 from jaxswarm.swarm.iwd import fuzzy
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
@@ -49,6 +47,8 @@ from jaxswarm.swarm.iwd.local import connect, improve_between, splice_if_shorter
 from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
 from jaxswarm.swarm.iwd.smooth import smooth_path
 from jaxswarm.swarm.walking import step_budget
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import path_length
 
 
 @dataclasses.dataclass(frozen=True)

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.paths import path_length
 from jaxswarm.swarm.core import Swarm, Task, run
 from jaxswarm.swarm.iwd.memory import prefix_lengths, splice
 from jaxswarm.swarm.iwd.smooth import IMPROVEMENT
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import path_length
 
 
 def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations: int):

@@ -12,9 +12,9 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import NO_NODE, Graph
-from jaxswarm.lattice import move_lengths
-from jaxswarm.paths import step_slots
+from jaxswarm.world.graph import NO_NODE, Graph
+from jaxswarm.world.lattice import move_lengths
+from jaxswarm.world.paths import step_slots
 
 
 class Memory(NamedTuple):

@@ -16,7 +16,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import NO_NODE, Graph
+from jaxswarm.world.graph import NO_NODE, Graph
 
 IMPROVEMENT = 1e-4
 """How much shorter (in length units) a replacement must be: float rounding is no improvement."""

@@ -27,11 +27,11 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import move_lengths
-from jaxswarm.paths import step_slots
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
 from jaxswarm.swarm.walking.hooks import Move, StepHook
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import move_lengths
+from jaxswarm.world.paths import step_slots
 
 VELOCITY, CARRIED = 0, 1
 """Columns of a drop's state ``f32[2]``: its velocity and the soil it carries."""

@@ -4,8 +4,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
 from jaxswarm.swarm.walking import Walk
+from jaxswarm.world.graph import Graph
 
 STEPS_PER_CHECK = 8
 """Steps back along the trails per test of whether any drop is still filling."""

@@ -43,16 +43,16 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.batching import one_at_a_time
 from jaxswarm.exact.field import distance_field
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import move_lengths
-from jaxswarm.relax import lowest_neighbour, relax
+from jaxswarm.runtime.batching import one_at_a_time
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import RFDState, check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
                                     neighbour_slots, visited_nodes)
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import move_lengths
+from jaxswarm.world.relax import lowest_neighbour, relax
 
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
@@ -154,7 +154,7 @@ def settle(graph: Graph, altitude, params: GradedParams):
     which no filled node is a pit, whatever the order of the sweeps.
 
     Under ``vmap`` (a sweep) the runs settle one at a time
-    (:func:`~jaxswarm.batching.one_at_a_time`): most need one sweep, a few dozens, and settled
+    (:func:`~jaxswarm.runtime.batching.one_at_a_time`): most need one sweep, a few dozens, and settled
     together each paid for the slowest."""
     rise = jnp.where(graph.valid_edges(), params.repose * graph.cost, jnp.inf)
 

@@ -44,13 +44,13 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import move_lengths
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, gradients,
                                       river_swarm)
 from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, neighbour_slots
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import move_lengths
 
 EROSION_LAWS = ("linear", "exponential")
 """How ``rfd_star``'s arrived drops erode their paths: eq. 4, or its exponential form."""

@@ -14,9 +14,9 @@ from typing import Callable
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.walking import Walk, heads, neighbour_slots, step_budget, walk
+from jaxswarm.world.graph import Graph
 
 
 @dataclasses.dataclass(frozen=True)

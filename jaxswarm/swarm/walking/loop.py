@@ -48,12 +48,12 @@ import jax
 import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
-from jaxswarm.graph import NO_NODE, Graph
-from jaxswarm.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.sampler import sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
+from jaxswarm.world.graph import NO_NODE, Graph
+from jaxswarm.world.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
 
 LANES = 1024
 """Lanes of one walk loop (fewer when the walk has fewer agents). Measured on maze100 on a 2-core
@@ -84,7 +84,7 @@ class Walk(NamedTuple):
       slots: i8[A, L - 1] (i16 on graphs of more than 127 slots) neighbour slot of each move
         (``path[a, t + 1] = nbr[path[a, t], slot]``), -1 after the agent stopped.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
-        counted by kind (:func:`jaxswarm.lattice.lattice_length`), so the same moves in any order
+        counted by kind (:func:`jaxswarm.world.lattice.lattice_length`), so the same moves in any order
         give the same float; on general graphs the edge costs are summed.
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).

@@ -7,7 +7,7 @@ import operator
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import NO_NODE
+from jaxswarm.world.graph import NO_NODE
 
 FORCED = 1e30
 """A log-weight that wins every draw: use it for moves that must be taken (e.g. into the goal)."""

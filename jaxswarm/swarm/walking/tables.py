@@ -5,8 +5,8 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import slot_offsets, straight_line
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import slot_offsets, straight_line
 
 
 def heads(graph: Graph) -> jax.Array:

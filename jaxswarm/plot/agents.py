@@ -4,7 +4,7 @@ moving step by step.
 Every agent has its own colour (:func:`agent_colors`). Its start is a filled square, its goal a
 hollow ring and, in the animation, the agent itself a filled dot, so an agent that has arrived is
 a dot inside its ring. Paths are ``i32[A, T]`` node indices, one row per agent and one column per
-time step, as in :class:`jaxswarm.multiagent.Plan`. Coordinates follow :mod:`jaxswarm.plot`: cell
+time step, as in :class:`jaxswarm.multiagent.Plan`. Coordinates follow :mod:`jaxswarm.plot.graph`: cell
 ``(x, y)`` is centred at ``(x, y)``, with ``y`` growing downwards on grids.
 """
 from __future__ import annotations
@@ -15,10 +15,10 @@ import numpy as np
 from matplotlib.axes import Axes
 from PIL import Image
 
-from jaxswarm.atomic import atomic_path
-from jaxswarm.graph import Graph
-from jaxswarm.paths import as_node
-from jaxswarm.plot import draw_map
+from jaxswarm.plot.graph import draw_map
+from jaxswarm.runtime.atomic import atomic_path
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import as_node
 
 MAX_LEGEND = 10
 """Agents are named in a legend up to this many."""

@@ -16,7 +16,7 @@ script puts its own folder on ``sys.path`` first).
 Run as a script, it writes the index of a results folder (``README.md``: each table's title, what
 its rows are, the command that made it, when, at which commit, and how long it took)::
 
-    python sweeps/provenance.py results
+    python sweeps/index_results.py results
 """
 # No "from __future__ import annotations": the dataclass below then needs no entry in
 # sys.modules, so the tests can load this file by its path as they load the scripts.
@@ -42,8 +42,8 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
-from jaxswarm.atomic import write_atomically
-from jaxswarm.cpu import cpu_model
+from jaxswarm.runtime.atomic import write_atomically
+from jaxswarm.runtime.cpu import cpu_model
 
 ROOT = Path(__file__).resolve().parents[1]
 """The repository root: commands are written relative to it."""

@@ -48,7 +48,7 @@ def configure(*, devices: int | None = None, threads: int | None = None) -> None
         if value is not None and (not isinstance(value, int) or value < 1):
             raise ValueError(f"{name} must be a whole number of at least 1, got {value!r}")
     if _backends_started():
-        raise RuntimeError("jaxswarm.cpu.configure must be called before JAX's first "
+        raise RuntimeError("jaxswarm.runtime.cpu.configure must be called before JAX's first "
                            "computation (JAX reads the device count and thread pool size when "
                            "it starts); call it right after `import jax`")
     if devices is not None:

@@ -1,6 +1,6 @@
 """Pure, shape-preserving map edits.
 
-Each edit returns a new :class:`~jaxswarm.graph.Graph` whose ``free`` or ``open`` array differs;
+Each edit returns a new :class:`~jaxswarm.world.graph.Graph` whose ``free`` or ``open`` array differs;
 no shape changes, so a jitted planner called on the edited map does not recompile. The node and
 slot arguments may be traced arrays (the edits are jittable and vmappable).
 """
@@ -10,7 +10,7 @@ import dataclasses
 
 import jax.numpy as jnp
 
-from jaxswarm.graph import Graph
+from jaxswarm.world.graph import Graph
 
 
 def block_cells(graph: Graph, nodes) -> Graph:
@@ -18,7 +18,7 @@ def block_cells(graph: Graph, nodes) -> Graph:
 
     Args:
       graph: the map.
-      nodes: int or i32[M] node indices (see :func:`jaxswarm.paths.node_index`).
+      nodes: int or i32[M] node indices (see :func:`jaxswarm.world.paths.node_index`).
 
     Returns:
       The map with ``free[nodes] = False``; every edge touching them (and every diagonal squeezing

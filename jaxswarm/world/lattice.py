@@ -21,7 +21,7 @@ import jax.numpy as jnp
 import numpy as np
 
 if TYPE_CHECKING:
-    from jaxswarm.graph import Graph
+    from jaxswarm.world.graph import Graph
 
 DIRECTIONS = np.array(
     [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)], dtype=np.int32

@@ -35,10 +35,10 @@ from matplotlib.figure import Figure
 from matplotlib.image import AxesImage
 from matplotlib.lines import Line2D
 
-from jaxswarm.atomic import atomic_path, write_atomically
-from jaxswarm.graph import Graph
-from jaxswarm.lattice import OPPOSITE
-from jaxswarm.paths import Solution, as_node, trim
+from jaxswarm.runtime.atomic import atomic_path, write_atomically
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import OPPOSITE
+from jaxswarm.world.paths import Solution, as_node, trim
 
 MASKED_COLOR = "0.6"
 """Neutral grey for obstacles and non-finite values in :func:`draw_field`."""

@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.lattice import DIRECTIONS
+from jaxswarm.world.lattice import DIRECTIONS
 
 if TYPE_CHECKING:
-    from jaxswarm.graph import Graph
+    from jaxswarm.world.graph import Graph
 
 
 def lowest_neighbour(graph: Graph, values: jax.Array, extra: jax.Array) -> jax.Array:

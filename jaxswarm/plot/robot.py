@@ -1,4 +1,4 @@
-"""Figures of the robot of :mod:`jaxswarm.robot`: its walk, its plans and the blocks it found.
+"""Figures of the robot of :mod:`jaxswarm.dynamic.robot`: its walk, its plans and the blocks it found.
 
 What is drawn on the map the robot knew at the start: the hidden blocks, faint until found
 (cells as squares, passages as crosses on their midpoint) and red once found, the plan it is
@@ -13,11 +13,11 @@ from matplotlib.animation import FuncAnimation
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from jaxswarm.dynamic import Event
-from jaxswarm.graph import Graph
-from jaxswarm.paths import trim
-from jaxswarm.plot import draw_map, save_gif, save_png
-from jaxswarm.robot import RobotWalk
+from jaxswarm.dynamic.events import Event
+from jaxswarm.dynamic.robot import RobotWalk
+from jaxswarm.plot.graph import draw_map, save_gif, save_png
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import trim
 
 FOUND = "tab:red"
 UNKNOWN = "#f4a6a6"

@@ -1,4 +1,4 @@
-"""Figures of planes (:mod:`jaxswarm.maps.plane`): the rectangles, the start and the goal, the
+"""Figures of planes (:mod:`jaxswarm.world.plane`): the rectangles, the start and the goal, the
 shortest path, and vehicle trajectories with the sensor windows they saw (the bees)."""
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from matplotlib.axes import Axes
 from matplotlib.collections import PatchCollection
 from matplotlib.patches import Rectangle
 
-from jaxswarm.maps.plane import Plane
+from jaxswarm.world.plane import Plane
 
 
 def draw_plane(ax: Axes, plane: Plane, *, start=None, goal=None, title=None) -> Axes:

@@ -27,10 +27,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.edits import block_cells, close_edges, open_edges, unblock_cells
-from jaxswarm.graph import Graph
-from jaxswarm.paths import as_node, is_valid_path
 from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.paths import as_node, is_valid_path
 
 NO_NODE = -1
 
@@ -189,7 +189,7 @@ def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterati
     """Step a swarm ``iterations`` times from ``state`` (static count, no stop rule) and keep its
     memory after each step: ``(state, f32[iterations + 1, N])``, the first row the memory
     given (for a figure or a GIF of it re-forming after a change, see
-    :func:`jaxswarm.plot.animate_field`)."""
+    :func:`jaxswarm.plot.graph.animate_field`)."""
     def one(state, _):
         state, _ = swarm.step(state, graph, task, params)
         return state, swarm.memory(state)

@@ -13,8 +13,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.graph import NO_NODE, Graph
-from jaxswarm.lattice import total_length
+from jaxswarm.world.graph import NO_NODE, Graph
+from jaxswarm.world.lattice import total_length
 
 
 @dataclasses.dataclass(frozen=True)
@@ -129,7 +129,7 @@ def step_slots(graph: Graph, path) -> jax.Array:
 
 @jax.jit
 def path_length(graph: Graph, path) -> jax.Array:
-    """f32[]: sum of the edge lengths along a padded path (by :func:`jaxswarm.lattice.total_length`,
+    """f32[]: sum of the edge lengths along a padded path (by :func:`jaxswarm.world.lattice.total_length`,
     as the swarms' walks are measured); inf if a step is not an edge.
 
     A path of one node (start == goal) has length 0; an all-padding path has length inf.

@@ -26,37 +26,37 @@ import functools
 
 import numpy as np
 
-from jaxswarm.dynamic import Event, make_event
-from jaxswarm.edits import block_cells, unblock_cells
+from jaxswarm.dynamic.events import Event, make_event
 from jaxswarm.exact import dijkstra, replanner
-from jaxswarm.graph import Graph
-from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, _by_map, paper_map
+from jaxswarm.maps.paper import PAPER_MAPS, PAPER_OPTIMA, by_map, paper_map
+from jaxswarm.world.edits import block_cells, unblock_cells
+from jaxswarm.world.graph import Graph
 
 TABLES = (2, 3, 4, 5)
 """The paper's dynamic tables."""
 
 _NA = None
 PAPER_DYNAMIC_LENGTH: dict[int, dict[str, dict[str, float | None]]] = {
-    2: _by_map({
+    2: by_map({
         "Dijkstra": (20.07, 34.31, 77.79, 50.79, 83.21, 227.28, 117.76, 171.66, 509.32),
         "A*": (20.07, 34.31, 77.79, 50.79, 83.21, 227.28, 117.76, 171.66, 509.32),
         "ACO": (60.45, 135.32, _NA, 471.88, 1175.75, _NA, 2651.17, 5458.90, _NA),
         "ACO*": (20.07, 64.83, _NA, 69.52, 210.56, _NA, 241.62, 380.73, _NA),
         "RFD": (28.42, 98.16, _NA, 295.24, 798.88, _NA, 2133.11, 3824.62, _NA)}),
-    3: _by_map({
+    3: by_map({
         "Dijkstra": (19.48, 34.31, 82.62, 51.45, 83.62, 232.52, 118.59, 172.91, 514.56),
         "A*": (19.48, 34.31, 82.62, 51.45, 83.62, 232.52, 118.59, 172.91, 514.56),
         "ACO": (49.54, 112.01, _NA, 438.39, 1075.32, _NA, 2690.44, 5370.58, _NA),
         "ACO*": (19.48, 124.74, _NA, 127.35, 257.26, _NA, 296.22, 331.62, _NA),
         "RFD": (53.88, 105.43, _NA, 301.66, 810.58, _NA, 1856.91, 3788.83, _NA)}),
-    4: _by_map({
+    4: by_map({
         "Dijkstra": (17.82, 32.07, 76.62, 48.97, 79.14, 224.52, 115.28, 167.59, 504.56),
         "A*": (17.82, 32.07, 76.62, 48.97, 79.14, 224.52, 115.28, 167.59, 504.56),
         "ACO": (37.72, 127.66, _NA, 429.91, 1106.74, _NA, 2717.84, 5129.76, _NA),
         "ACO*": (18.65, 169.39, _NA, 68.48, 237.54, _NA, 289.69, 295.25, _NA),
         "RFD": (30.21, 117.12, _NA, 383.1, 839.24, _NA, 2196.57, 4070.42, _NA),
         "RFD*": (17.82, 32.07, 76.62, 48.97, 79.14, 224.52, 115.28, 167.59, 504.56)}),
-    5: _by_map({
+    5: by_map({
         "Dijkstra": (21.31, 13, 58.97, 55.11, 29, 167.7, 117.5, 52, 359.11),
         "A*": (21.31, 13, 58.97, 55.11, 29, 167.7, 117.5, 52, 359.11),
         "ACO": (85.6, 238.48, _NA, 506.03, 1468.16, _NA, 2481.27, 6085.31, _NA),
@@ -68,28 +68,28 @@ PAPER_DYNAMIC_LENGTH: dict[int, dict[str, dict[str, float | None]]] = {
 the paper says n/a. Tables 2 and 3 have no RFD* length row in the paper's text."""
 
 PAPER_DYNAMIC_MS: dict[int, dict[str, dict[str, float | None]]] = {
-    2: _by_map({
+    2: by_map({
         "Dijkstra": (4.658, 4.655, 6.215, 55.931, 62.062, 45.988, 513.412, 751.669, 443.453),
         "A*": (1.953, 4.375, 6.326, 25.148, 56.548, 47.941, 320.462, 654.803, 442.611),
         "ACO": (652.73, 685.97, _NA, 11139.51, 10873.72, _NA, 130845.01, 132885.49, _NA),
         "ACO*": (557.349, 775.123, _NA, 3966.235, 6183.59, _NA, 35302.022, 28573.663, _NA),
         "RFD": (197.364, 201.56, _NA, 183.474, 355.38, _NA, 1040.421, 981.498, _NA),
         "RFD*": (4.351, 5.234, 5.102, 10.299, 14.446, 15.103, 70.356, 90.322, 121.452)}),
-    3: _by_map({
+    3: by_map({
         "Dijkstra": (5.518, 4.601, 5.654, 67.314, 85.992, 57.822, 557.943, 753.041, 440.751),
         "A*": (2.037, 4.938, 5.936, 28.153, 55.631, 47.522, 362.752, 637.612, 434.634),
         "ACO": (642.97, 669.38, _NA, 10900.92, 10048.88, _NA, 131001.71, 133701.91, _NA),
         "ACO*": (61.851, 730.941, _NA, 4928.543, 6028.818, _NA, 34866.798, 30177.845, _NA),
         "RFD": (120.677, 581.521, _NA, 804.213, 1184.2, _NA, 4772.492, 5204.32, _NA),
         "RFD*": (6.166, 6.921, 5.989, 11.319, 19.662, 15.926, 81.774, 92.482, 101.404)}),
-    4: _by_map({
+    4: by_map({
         "Dijkstra": (4.593, 4.794, 5.642, 56.846, 71.968, 58.254, 541.029, 757.242, 438.629),
         "A*": (1.092, 4.429, 5.328, 20.467, 57.568, 48.106, 338.702, 665.238, 440.981),
         "ACO": (643.59, 667.04, _NA, 10873.22, 10183.79, _NA, 130503.92, 132996.64, _NA),
         "ACO*": (62.35, 769.54, _NA, 4814.421, 5924.835, _NA, 32334.028, 21751.601, _NA),
         "RFD": (205.739, 471.739, _NA, 838.274, 747.91, _NA, 2572.473, 1942.22, _NA),
         "RFD*": (5.183, 7.511, 8.181, 9.371, 11.482, 12.669, 47.429, 50.163, 70.171)}),
-    5: _by_map({
+    5: by_map({
         "Dijkstra": (2.858, 2.296, 3.515, 30.237, 30.966, 28.663, 226.148, 305.574, 229.698),
         "A*": (0.988, 0.592, 3.359, 11.637, 3.618, 28.475, 112.069, 16.251, 226.841),
         "ACO": (460.031, 449.92, _NA, 4368.948, 4326.924, _NA, 33090.306, 33682.913, _NA),
@@ -143,7 +143,7 @@ class Scenario:
     optimum: float
 
     def event(self, graph: Graph, size: int | None = None) -> Event:
-        """The change as an :class:`~jaxswarm.dynamic.Event` on ``graph`` (the map's graph)."""
+        """The change as an :class:`~jaxswarm.dynamic.events.Event` on ``graph`` (the map's graph)."""
         return make_event(graph, goal=self.goal, block=self.block, unblock=self.unblock,
                           size=size)
 

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from matplotlib import patheffects
 
-from jaxswarm.plot import save_png
+from jaxswarm.plot.graph import save_png
 
 METRICS = {"success": "success rate", "gap": "mean gap to the optimum"}
 
