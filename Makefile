@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
 PYTEST := $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile
 
-.PHONY: demo test test-slow bench performance reproduce reproduce-quick clean
+.PHONY: demo test test-slow docs bench performance reproduce reproduce-quick clean
 
 $(INSTALLED): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,6 +21,9 @@ test: $(INSTALLED)  ## the default test suite (minutes)
 
 test-slow: $(INSTALLED)  ## the large-scale checks (every Moving AI scenario row, ...)
 	$(PYTEST) -m slow
+
+docs: $(INSTALLED)  ## the API reference from the docstrings (pdoc) into docs/api/ (open docs/api/index.html)
+	$(BIN)/python docs/build_api.py docs/api
 
 bench: $(INSTALLED)  ## benchmark scripts (print figures; not tests)
 	$(BIN)/python benchmarks/exact.py
@@ -96,4 +99,4 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/index_results.py $(QUICK_OUT)
 
 clean:
-	rm -rf $(VENV) out *.egg-info
+	rm -rf $(VENV) out *.egg-info docs/api .import_linter_cache

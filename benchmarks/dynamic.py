@@ -23,7 +23,7 @@ A* from scratch on the changed map (its host arrays built, as a new map needs, a
 alone) and D* Lite repairing the static map's search (for Table 2, a goal move, D* Lite
 restarts). Compile time is excluded: every program is run once before timing.
 
-Goal (issue 22): ``rfd_graded`` reaches the new optimum after the changes of Tables 2-4 in at
+Goal: ``rfd_graded`` reaches the new optimum after the changes of Tables 2-4 in at
 least 19 of 20 seeds, median time to target at most 20 ms (the paper's RFD*: 47-121 ms).
 
 Run from the repository root::

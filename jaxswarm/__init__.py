@@ -2,18 +2,70 @@
 JAX, beside exact planners, on maps stored as dense padded adjacency tensors or as planes of
 rectangles.
 
-Where things are:
+The names a first plan needs are here::
 
-* :mod:`jaxswarm.world.graph` (maps as tensors), :mod:`jaxswarm.world.edits` (shape-preserving map changes),
-  :mod:`jaxswarm.world.paths` (padded paths and their lengths);
-* :mod:`jaxswarm.maps` (the RFD paper's maps, seeded random maps, Moving AI files, planes of
-  rectangles for the bees);
-* :mod:`jaxswarm.exact` (Dijkstra, A*, bidirectional A* and the batched distance field);
-* :mod:`jaxswarm.swarm` (the swarm protocol, the walker and the algorithms, by name);
-* :mod:`jaxswarm.sweep` (parameter studies: specs, the sharded runner, the results store);
-* :mod:`jaxswarm.plot.graph`, :mod:`jaxswarm.plot.plane` (figures), :mod:`jaxswarm.runtime.cpu` (XLA:CPU devices and threads, set before
-  JAX starts), :mod:`jaxswarm.cli` (the ``jaxswarm`` command).
+    import jax
+    import jaxswarm
 
-Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can still
-be called after it.
+    maze = jaxswarm.paper_map("maze20")
+    graph = maze.graph()
+    task = jaxswarm.make_task(graph, maze.start, maze.goal)
+    swarm = jaxswarm.make("rfd", num_agents=64)
+    state, trace = jaxswarm.run(swarm, jax.random.key(0), graph, task, swarm.default_params,
+                                iterations=20)
+    print(swarm.best(state).cost, jaxswarm.optimal_length(graph, maze.start, maze.goal))
+
+Everything else lives in one room per concern; imports only go down this list (the import
+contract in ``pyproject.toml``, checked by the tests):
+
+* :mod:`jaxswarm.runtime`: how jaxswarm runs: XLA:CPU devices and threads
+  (:func:`jaxswarm.runtime.cpu.configure`, called before JAX starts), files written whole or not
+  at all, a vmap rule for loops of differing trip counts, the old import paths of moved names.
+* :mod:`jaxswarm.world`: what a swarm plans in: the :class:`Graph` (dense padded adjacency
+  tensors) with its lattice, shape-preserving edits, padded paths and the min-plus relaxation;
+  the :class:`Plane` of rectangles and its geometry.
+* :mod:`jaxswarm.maps`: where worlds come from: the RFD paper's maps (:func:`paper_map`), seeded
+  random grids and path maps (:func:`random_grid`), Moving AI ``.map``/``.scen`` files
+  (:func:`load_map`), the IWD_PG experiments' maps and the bees' planes (:func:`paper_plane`).
+* :mod:`jaxswarm.exact`: exact planners: :func:`dijkstra`, :func:`astar`,
+  :func:`bidirectional_astar`, D* Lite (:func:`replanner`), batched queries, the optimum as the
+  swarms measure it (:func:`optimal_length`), the JAX distance field, the plane's visibility graph.
+* :mod:`jaxswarm.swarm`: the swarm protocol and run loop (:func:`make_task`, :func:`run`), the
+  shared walker, the algorithms (RFD, ACO, IWD on graphs; the bees on planes), the registry of
+  names (:func:`make`, :func:`registered`) and the conformance suite every swarm passes.
+* :mod:`jaxswarm.dynamic`: worlds that change during a run: events and what each swarm's memory
+  does on them, the RFD paper's dynamic scenarios (Tables 2-5), a robot that re-plans.
+* :mod:`jaxswarm.multiagent`: many agents on one map: the A* report's two-robot scheme,
+  prioritised space-time A*, Conflict-Based Search, one plan format and one validator.
+* :mod:`jaxswarm.sweep`: parameter sweeps: specs as TOML data, the batched, sharded, resumable
+  runner and the Parquet results store.
+* :mod:`jaxswarm.plot`: figures and animations, one module per world or subject.
+* :mod:`jaxswarm.studies`: what the table scripts of ``sweeps/`` share (provenance records).
+* :mod:`jaxswarm.cli`: the ``jaxswarm`` command.
+
+``jaxswarm.graph``, ``jaxswarm.robot`` and ``jaxswarm.maps.plane`` are 0.4.0's module paths,
+kept until 0.6.0: they forward to the new homes with a ``DeprecationWarning``.
+
+Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can
+still be called after it.
 """
+import importlib.metadata
+
+from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, replanner
+from jaxswarm.maps.movingai import load_map
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.planes import paper_plane
+from jaxswarm.maps.random import random_grid
+from jaxswarm.swarm import Task, make, make_task, registered, run
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.plane import Plane
+
+try:
+    __version__ = importlib.metadata.version("jaxswarm")
+    """The installed distribution's version (``0+unknown`` when run from an uninstalled tree)."""
+except importlib.metadata.PackageNotFoundError:  # pragma: no cover - a source tree on sys.path
+    __version__ = "0+unknown"
+
+__all__ = ["Graph", "Plane", "Task", "__version__", "astar", "bidirectional_astar", "dijkstra",
+           "load_map", "make", "make_task", "optimal_length", "paper_map", "paper_plane",
+           "random_grid", "registered", "replanner", "run"]

@@ -4,8 +4,9 @@
 exact planners and the swarm planners, prints a comparison table (length, optimality gap, work,
 time) and writes figures of the paths and of the swarms' memory and convergence.
 
-``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.dynamic.robot`): a swarm
-and D* Lite re-plan whenever it finds one; it prints what each did and writes a GIF of the walk.
+``jaxswarm robot`` walks a robot through a map with hidden blocks (:mod:`jaxswarm.dynamic.robot`):
+a swarm and D* Lite re-plan whenever it finds one; it prints what each did and writes a GIF of the
+walk.
 
 ``jaxswarm mapf MAP SCEN`` plans for the first ``--agents`` agents of a Moving AI MAPF scenario
 (:mod:`jaxswarm.multiagent`) with one planner (the A* report's scheme, prioritised planning or
@@ -20,7 +21,6 @@ map.
 from __future__ import annotations
 
 import argparse
-import re
 import statistics
 import sys
 import time
@@ -30,14 +30,13 @@ import jax
 
 from jaxswarm.dynamic.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
-from jaxswarm.maps.movingai import load_map
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.random import random_path_map
+from jaxswarm.maps.named import NamedMap, named_map
+from jaxswarm.maps.paper import PAPER_MAPS
 from jaxswarm.multiagent import (ORDERS, PLANNERS, UNREACHABLE, load_instance, lower_bound,
                                  validate)
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, registry, run
-from jaxswarm.world.graph import Graph, path_map_graph
+from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, path_length
 
 EXACT_PLANNERS = {"Dijkstra": dijkstra, "A*": astar, "bidirectional A*": bidirectional_astar}
@@ -50,12 +49,43 @@ def swarm_label(name: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``jaxswarm`` command; returns the exit status."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.threads is not None:
+        try:
+            configure(threads=args.threads)
+        except (ValueError, RuntimeError) as error:
+            parser.error(f"--threads: {error}")
+    try:
+        command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
+                   "sweep": run_sweep_command}
+        return command[args.command](args)
+    except ValueError as error:
+        parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
+    except KeyboardInterrupt:
+        resume = ("; the finished chunks are kept: run the same command again to resume"
+                  if args.command == "sweep" else "")
+        parser.exit(130, f"jaxswarm {args.command}: interrupted{resume}\n")
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The ``jaxswarm`` command's arguments: ``--threads`` and a sub-command."""
     parser = argparse.ArgumentParser(prog="jaxswarm", description=__doc__.splitlines()[0])
     parser.add_argument("--threads", type=int,
                         help="XLA:CPU intra-op threads (default: one per core); 1 is fastest for "
                              "single runs on a few cores, see jaxswarm.runtime.cpu")
     commands = parser.add_subparsers(dest="command", required=True)
-    demo = commands.add_parser("demo", help="plan on a real map, print a table, write a figure")
+    _add_demo_parser(commands)
+    _add_robot_parser(commands)
+    _add_mapf_parser(commands)
+    _add_sweep_parser(commands)
+    return parser
+
+
+def _add_demo_parser(subparsers) -> None:
+    """The ``demo`` sub-command: plan on one map with every planner."""
+    demo = subparsers.add_parser("demo",
+                                 help="plan on a real map, print a table, write a figure")
     demo.add_argument("--map", default="mosaic50",
                       help=f"a paper map ({', '.join(PAPER_MAPS)}), a random path map "
                            "pathmapWxH (e.g. pathmap20x20) or a Moving AI .map file")
@@ -73,7 +103,12 @@ def main(argv: list[str] | None = None) -> int:
     demo.add_argument("--out", type=Path,
                       help="figure path (default out/demo_MAP.png); each swarm's figure is "
                            "written beside it with the swarm's name appended")
-    robot = commands.add_parser("robot", help="a robot that finds hidden blocks and re-plans")
+
+
+def _add_robot_parser(subparsers) -> None:
+    """The ``robot`` sub-command: a robot that finds hidden blocks and re-plans."""
+    robot = subparsers.add_parser("robot",
+                                  help="a robot that finds hidden blocks and re-plans")
     robot.add_argument("--map", default="maze20",
                        help=f"a paper map ({', '.join(PAPER_MAPS)}), a random path map "
                             "pathmapWxH (e.g. pathmap20x20, seeded by --seed) or a Moving AI "
@@ -91,7 +126,11 @@ def main(argv: list[str] | None = None) -> int:
     robot.add_argument("--out", type=Path,
                        help="GIF of the swarm's walk (default out/robot_MAP.gif); a PNG of the "
                             "whole walk is written beside it")
-    mapf = commands.add_parser("mapf", help="plan for many agents on a Moving AI MAPF map")
+
+
+def _add_mapf_parser(subparsers) -> None:
+    """The ``mapf`` sub-command: plan for many agents on a Moving AI MAPF map."""
+    mapf = subparsers.add_parser("mapf", help="plan for many agents on a Moving AI MAPF map")
     mapf.add_argument("map", type=Path, help="a Moving AI .map file (loaded 4-connected)")
     mapf.add_argument("scen", type=Path, help="a .scen file of the map: its first rows are the "
                                               "agents")
@@ -109,27 +148,16 @@ def main(argv: list[str] | None = None) -> int:
     gif.add_argument("--gif", type=Path,
                      help="GIF of the agents moving (default out/mapf_MAP_PLANNER.gif)")
     gif.add_argument("--no-gif", action="store_true", help="write no GIF")
-    sweep = commands.add_parser("sweep", help="run or resume a parameter sweep from a TOML file")
+
+
+def _add_sweep_parser(subparsers) -> None:
+    """The ``sweep`` sub-command: run or resume a sweep from a TOML file."""
+    sweep = subparsers.add_parser("sweep",
+                                  help="run or resume a parameter sweep from a TOML file")
     sweep.add_argument("file", type=Path, help="the sweep spec (TOML)")
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--no-plots", action="store_true", help="write no figures")
-    args = parser.parse_args(argv)
-    if args.threads is not None:
-        try:
-            configure(threads=args.threads)
-        except (ValueError, RuntimeError) as error:
-            parser.error(f"--threads: {error}")
-    try:
-        command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
-                   "sweep": run_sweep_command}
-        return command[args.command](args)
-    except ValueError as error:
-        parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
-    except KeyboardInterrupt:
-        resume = ("; the finished chunks are kept: run the same command again to resume"
-                  if args.command == "sweep" else "")
-        parser.exit(130, f"jaxswarm {args.command}: interrupted{resume}\n")
 
 
 def run_sweep_command(args: argparse.Namespace) -> int:
@@ -336,23 +364,8 @@ def _run_swarm(swarm, graph, start, goal, args):
     return state, trace, statistics.median(times) * 1e3
 
 
-def _load(args):
-    if args.map in PAPER_MAPS:
-        chosen = paper_map(args.map)
-        return args.map, chosen.graph(), args.start or chosen.start, args.goal or chosen.goal
-    sized = re.fullmatch(r"pathmap(\d+)x(\d+)", args.map)
-    if sized:
-        width, height = (int(v) for v in sized.groups())
-        graph = path_map_graph(random_path_map(width, height, getattr(args, "seed", 0)))
-        return args.map, graph, args.start or (0, 0), args.goal or (width - 1, height - 1)
-    if args.map.endswith(".map"):
-        if args.start is None or args.goal is None:
-            raise ValueError("--start and --goal are required with a .map file")
-        if not Path(args.map).is_file():
-            raise ValueError(f"--map {args.map}: no such file")
-        return Path(args.map).stem, load_map(args.map), args.start, args.goal
-    raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)}, pathmapWxH or a .map "
-                     f"file, got {args.map!r}")
+def _load(args) -> NamedMap:
+    return named_map(args.map, seed=args.seed, start=args.start, goal=args.goal)
 
 
 def _swarm_names(text: str) -> tuple[str, ...]:

@@ -29,20 +29,16 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
-import sys
 import time
-from pathlib import Path
 
-import jax
 import numpy as np
 
-from jaxswarm.exact import dijkstra
-from jaxswarm.maps.random import random_path_map
 from jaxswarm.runtime.atomic import write_csv
-from jaxswarm.swarm import definition, make, make_task, run
-from jaxswarm.world.graph import path_map_graph
 from jaxswarm.studies import provenance
-
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.studies.problems import Problem, named_problem
+from jaxswarm.studies.timing import seed_keys, timed_runs
+from jaxswarm.swarm import definition, make
 
 ALGORITHMS = {"Ant System": "ant_system", "Max-Min ACO": "max_min_aco",
               "Improved Max-Min ACO": "improved_max_min_aco"}
@@ -100,53 +96,33 @@ def ratio(value: float, baseline: float) -> float:
     return math.nan
 
 
-def run_algorithm(label: str, graph, task, keys, *, ants: int, max_ants: int,
-                  patience: int) -> tuple[list[float], list[int], list[float]]:
-    """Run the algorithm ``label`` once per key (after a warm-up run that compiles it).
-
-    Returns:
-      (best length of each run, inf if none found; populations run; seconds per run).
-    """
+def run_algorithm(label: str, problem: Problem, *, seed: int, runs: int, ants: int,
+                  max_ants: int, patience: int) -> dict:
+    """Run the algorithm ``label`` ``runs`` times on ``problem`` (keys split from key
+    ``seed``), compiled first, each run timed alone; its results.csv row without the ratios."""
     swarm = make(ALGORITHMS[label], num_agents=ants)
     params = swarm.default_params._replace(
         **{name: np.float32(value) for name, value in PARAMS.get(label, {}).items()})
-
-    def one_run(key):
-        return run(swarm, key, graph, task, params,
-                   iterations=max(max_ants // ants, 1), patience=patience)
-
-    jax.block_until_ready(one_run(keys[0]))  # compile
-    lengths, populations, seconds = [], [], []
-    for key in keys:
-        began = time.perf_counter()
-        state, trace = jax.block_until_ready(one_run(key))
-        seconds.append(time.perf_counter() - began)
-        lengths.append(float(swarm.best(state).cost))
-        populations.append(int(trace.iterations))
-    return lengths, populations, seconds
+    timed = timed_runs(swarm, seed_keys(runs, seed), problem.graph, problem.task, params,
+                       iterations=max(max_ants // ants, 1), patience=patience)
+    lengths = [float(swarm.best(one.state).cost) for one in timed]
+    found = [length for length in lengths if math.isfinite(length)]
+    mean = statistics.mean(found) if found else math.inf
+    optimum = problem.optimum
+    return dict(map=problem.label.removeprefix("pathmap"), algorithm=label, optimum=optimum,
+                min_length=min(lengths), mean_length=mean, min_ratio=min(lengths) / optimum,
+                mean_ratio=mean / optimum, found=len(found), runs=runs,
+                mean_populations=statistics.mean(int(one.trace.iterations) for one in timed),
+                mean_seconds=statistics.mean(one.seconds for one in timed))
 
 
-def compare(width: int, height: int, *, seed: int, runs: int, ants: int, max_ants: int,
-            patience: int) -> list[dict]:
-    """One row per algorithm on one random path map, with the ratios to Ant System and the
-    paper's values."""
-    graph = path_map_graph(random_path_map(width, height, seed))
-    start, goal = 0, graph.num_nodes - 1
-    task = make_task(graph, start, goal)
-    optimum = float(dijkstra(graph, start, goal).cost)
-    keys = jax.random.split(jax.random.key(seed), runs)
-    rows = []
-    for label in ALGORITHMS:
-        lengths, populations, seconds = run_algorithm(label, graph, task, keys, ants=ants,
-                                                      max_ants=max_ants, patience=patience)
-        found = [length for length in lengths if math.isfinite(length)]
-        mean = statistics.mean(found) if found else math.inf
-        rows.append(dict(
-            map=f"{width}x{height}", algorithm=label, optimum=optimum, min_length=min(lengths),
-            mean_length=mean, min_ratio=min(lengths) / optimum, mean_ratio=mean / optimum,
-            found=len(found), runs=runs, mean_populations=statistics.mean(populations),
-            mean_seconds=statistics.mean(seconds)))
-    return add_ratios(rows)
+def compare(width: int, height: int, *, seed: int, **options) -> list[dict]:
+    """One row per algorithm on the random path map of ``width`` x ``height`` cells drawn by
+    ``seed``, with the ratios to Ant System and the paper's values (``options``: those of
+    :func:`run_algorithm`)."""
+    problem = named_problem(f"pathmap{width}x{height}", seed=seed)
+    return add_ratios([run_algorithm(label, problem, seed=seed, **options)
+                       for label in ALGORITHMS])
 
 
 def add_ratios(rows: list[dict]) -> list[dict]:
@@ -218,13 +194,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-ants", type=int, default=5000, help="ants per run at most")
     parser.add_argument("--patience", type=int, default=20, help="populations without gain")
     parser.add_argument("--seed", type=int, default=0, help="seed of the maps and the runs")
-    parser.add_argument("--out", type=Path, default=Path("out/aco_pathmaps"),
-                        help="output folder (make reproduce: results/aco_pathmaps)")
+    add_out_argument(parser, "aco_pathmaps")
     args = parser.parse_args(argv)
-    for option in ("runs", "ants", "max_ants", "patience"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option.replace('_', '-')} must be at least 1, "
-                         f"got {getattr(args, option)}")
+    check_counts(parser, args, "runs", "ants", "max_ants", "patience")
     record = provenance.begin(__file__, argv)
     rows = []
     for width, height in args.sizes:

@@ -27,7 +27,6 @@ Run from the repository root (about 15 minutes on 2 cores)::
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -39,13 +38,14 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from jaxswarm.exact.visibility import shortest_path  # noqa: E402
-from jaxswarm.maps.planes import paper_plane, PAPER_PLANES  # noqa: E402
-from jaxswarm.plot.graph import save_png  # noqa: E402
+from jaxswarm.maps.planes import PAPER_PLANES, paper_plane  # noqa: E402
 from jaxswarm.runtime.atomic import write_csv  # noqa: E402
+from jaxswarm.studies import provenance  # noqa: E402
+from jaxswarm.studies.arguments import add_out_argument, check_counts, names_argument  # noqa: E402
+from jaxswarm.studies.figures import write_png  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task  # noqa: E402
 from jaxswarm.swarm.bees.inverse import (es_search, grid_search, make_scorer,  # noqa: E402
                                          weight_grid)
-from jaxswarm.studies import provenance
 
 
 CYCLES = 3
@@ -129,11 +129,11 @@ def landscape_figure(path: Path, name: str, figure: dict) -> None:
     ax.set_ylabel("w1 (goal distance)")
     ax.set_title(f"{name}: eq. 11 over the weights (shortest path {figure['optimum']:.1f})")
     ax.legend(loc="lower right", fontsize=7)
-    save_png(fig, path)
-    plt.close(fig)
+    write_png(fig, path)
 
 
 def _weights(w) -> str:
+    """Weights f32[3] as text, three significant digits each."""
     return "(" + ", ".join(f"{float(v):.3g}" for v in w) + ")"
 
 
@@ -182,28 +182,23 @@ def verdict(rows: list[dict]) -> str:
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--maps", default=",".join(PAPER_PLANES))
+    parser.add_argument("--maps", type=names_argument(PAPER_PLANES), default="all",
+                        help=f"comma-separated, from {', '.join(PAPER_PLANES)} (default all)")
     parser.add_argument("--seeds", type=int, default=30, help="K, runs per weight setting")
     parser.add_argument("--grid", default="6x6x6", help="values of w1 x w2 x w3")
     parser.add_argument("--pairs", type=int, default=6, help="antithetic pairs per optax step")
     parser.add_argument("--sigma", type=float, default=0.05)
     parser.add_argument("--learning-rate", type=float, default=0.03)
     parser.add_argument("--search-seed", type=int, default=0)
-    parser.add_argument("--out", type=Path, default=Path("out/bees_inverse"))
+    add_out_argument(parser, "bees_inverse")
     args = parser.parse_args(argv)
-    args.maps = args.maps.split(",")
-    unknown = [m for m in args.maps if m not in PAPER_PLANES]
-    if unknown:
-        parser.error(f"--maps: unknown {unknown}; known: {', '.join(PAPER_PLANES)}")
     try:
         args.grid = tuple(int(v) for v in args.grid.split("x"))
     except ValueError:
         parser.error(f"--grid must be AxBxC, got {args.grid!r}")
     if len(args.grid) != 3 or min(args.grid) < 1:
         parser.error(f"--grid must be three counts >= 1, got {args.grid!r}")
-    for option in ("seeds", "pairs"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    check_counts(parser, args, "seeds", "pairs")
     record = provenance.begin(__file__, argv)
     landscape, tried, fresh = [], [], []
     for name in args.maps:

@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
 from pathlib import Path
 
@@ -44,12 +43,15 @@ import numpy as np  # noqa: E402
 
 from jaxswarm.exact.visibility import shortest_path  # noqa: E402
 from jaxswarm.maps.planes import paper_plane  # noqa: E402
-from jaxswarm.plot.graph import save_png  # noqa: E402
 from jaxswarm.plot.plane import draw_plane, draw_trajectory  # noqa: E402
 from jaxswarm.runtime.atomic import write_csv  # noqa: E402
+from jaxswarm.studies import provenance  # noqa: E402
+from jaxswarm.studies.arguments import (add_out_argument, check_counts,  # noqa: E402
+                                        numbers_argument)
+from jaxswarm.studies.figures import write_png  # noqa: E402
+from jaxswarm.studies.timing import timed_call  # noqa: E402
 from jaxswarm.swarm import definition, make, make_task, run  # noqa: E402
 from jaxswarm.world.plane import crossings  # noqa: E402
-from jaxswarm.studies import provenance
 
 
 STEPS = 200
@@ -156,10 +158,8 @@ def study(table: int, variant: str, runs: int) -> tuple[list[dict], np.ndarray]:
 
 def time_alone(swarm, seed: int, chosen, task, params) -> float:
     """The wall time of one run on its own (compiled by the first call of the variant)."""
-    began = time.perf_counter()
-    jax.block_until_ready(run(swarm, jax.random.key(seed), chosen.plane, task, params,
-                              iterations=STEPS))
-    return time.perf_counter() - began
+    return timed_call(run, swarm, jax.random.key(seed), chosen.plane, task, params,
+                      iterations=STEPS)[1]
 
 
 def warm_up(variant: str) -> None:
@@ -230,38 +230,33 @@ def trajectory_figure(path: Path, name: str, rows: list[dict], waypoints: np.nda
                         label=f"seed {row['seed']}: " + (f"reached, {row['length']:.1f}"
                                                          if row["reached"] else "stopped"))
     ax.legend(loc="lower right", fontsize=7)
-    save_png(fig, path)
-    plt.close(fig)
+    write_png(fig, path)
 
 
 def _mean(values, digits: int = 1) -> str:
+    """The mean of ``values`` with ``digits`` decimals, "-" for none."""
     return f"{statistics.mean(values):.{digits}f}" if values else "-"
 
 
 def _std(values, digits: int = 1) -> str:
+    """The population standard deviation of ``values`` with ``digits`` decimals, "-" for none."""
     return f"{statistics.pstdev(values):.{digits}f}" if values else "-"
 
 
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--tables", default="1,2,3,4,5,6,7", help="comma-separated, from 1-7")
+    parser.add_argument("--tables", type=numbers_argument(range(1, 8)), default="1,2,3,4,5,6,7",
+                        help="comma-separated, from 1-7")
     parser.add_argument("--runs", type=int, default=20, help="runs (seeds) per row")
-    parser.add_argument("--out", type=Path, default=Path("out/bees_tables"))
+    add_out_argument(parser, "bees_tables")
     args = parser.parse_args(argv)
-    if args.runs < 1:
-        parser.error(f"--runs must be at least 1, got {args.runs}")
-    try:
-        chosen = sorted({int(t) for t in args.tables.split(",")})
-    except ValueError:
-        parser.error(f"--tables must be numbers from 1-7, got {args.tables!r}")
-    if not set(chosen) <= set(range(1, 8)):
-        parser.error(f"--tables must be numbers from 1-7, got {args.tables!r}")
+    check_counts(parser, args, "runs")
     record = provenance.begin(__file__, argv)
     rows, sections, drawn = [], [], set()
     for variant in VARIANTS:
         warm_up(variant)
-    for table in chosen:
+    for table in args.tables:
         began = time.perf_counter()
         mine = []
         for variant in VARIANTS:

@@ -7,11 +7,11 @@ Dijkstra, A* and bidirectional A* against the grid size (mean and spread).
 
 Here each grid is :func:`jaxswarm.maps.random.random_grid` (obstacles with probability
 ``--density``, then a random monotone staircase from (0, 0) to (size-1, size-1) is cleared) turned
-into a :func:`jaxswarm.world.graph.grid_graph` (8-connected, diagonal sqrt 2, no corner cutting). The
-seed of grid ``index`` of a given ``size`` is derived from ``(--seed, size, index)`` by numpy's
+into a :func:`jaxswarm.world.graph.grid_graph` (8-connected, diagonal sqrt 2, no corner cutting).
+The seed of grid ``index`` of a given ``size`` is derived from ``(--seed, size, index)`` by numpy's
 ``SeedSequence``, so any row can be regenerated on its own. For every grid the report's three
-planners of :mod:`jaxswarm.exact`, and balanced bidirectional A* in its own row, record, from
-their ``SearchStats``:
+planners of :mod:`jaxswarm.exact`, and balanced bidirectional A* in its own row, record, from their
+``SearchStats``:
 
 * ``iterations``: priority-queue pops (the compiled planners re-key queued nodes, so no stale
   entries are popped),
@@ -27,7 +27,8 @@ Outputs (in ``--out``, default ``out/exact_study/``, each written atomically):
   iterations, expanded, generated and time_ms,
 * ``exact_study.png``: three panels (iterations, visited nodes, time in ms against grid size), a
   mean line and a shaded +-1 std band per planner;
-* ``table.md``: the provenance (:mod:`provenance`), then the summary as a Markdown table;
+* ``table.md``: the provenance (:mod:`jaxswarm.studies.provenance`), then the summary as a
+  Markdown table;
 * ``provenance.json``: the provenance and the arguments.
 
 ``make reproduce`` writes them to ``results/exact_study/``.
@@ -46,7 +47,6 @@ import argparse
 import math
 import sys
 import time
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -55,8 +55,9 @@ from matplotlib.figure import Figure
 from jaxswarm.exact import astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra
 from jaxswarm.maps.random import random_grid
 from jaxswarm.runtime.atomic import atomic_path, write_csv
-from jaxswarm.world.graph import grid_graph
 from jaxswarm.studies import provenance
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.world.graph import grid_graph
 
 
 PLANNERS: dict[str, Callable] = {
@@ -273,11 +274,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--density", type=float, default=0.3,
                         help="obstacle probability before the path is cleared (default 0.3)")
     parser.add_argument("--seed", type=int, default=0, help="base seed (default 0)")
-    parser.add_argument("--out", type=Path, default=Path("out", "exact_study"),
-                        help="output directory (default out/exact_study/)")
+    add_out_argument(parser, "exact_study")
     args = parser.parse_args(argv)
-    if args.grids < 1:
-        parser.error("--grids must be at least 1")
+    check_counts(parser, args, "grids")
     if not 0.0 <= args.density < 1.0:
         parser.error("--density must be in [0, 1)")
 

@@ -1,12 +1,13 @@
 """Intelligent Water Drops (``iwd``, the IWD_PG paper's baseline) on the RFD paper's nine maps,
 beside the optimum: its quality reported as it is, not tuned.
 
-Per map, ``--seeds`` runs (keys split from key 0) of ``iwd`` with its standard params,
-``--drops`` drops per iteration, at most ``--iterations`` iterations, stopped after
-``--patience`` iterations without gain once a path was found; each run compiled first, then
-timed alone. Reported per map: runs that found a path and runs at the optimum (A*), the mean and
-best length and mean gap over the runs that found one, iterations, fitness calls (complete paths
-evaluated: the IWD paper's measure of cost) and the median time.
+Per map, ``--seeds`` runs (keys split from key 0) of ``iwd`` with its standard params, ``--drops``
+drops per iteration, at most ``--iterations`` iterations, stopped after ``--patience`` iterations
+without gain once a path was found; each run compiled first, then timed alone. Reported per map:
+runs that found a path and runs at the optimum (A*; relative gap below 1e-4,
+:mod:`jaxswarm.studies.success`), the mean and best length and mean gap over the runs that found
+one, iterations, fitness calls (complete paths evaluated: the IWD paper's measure of cost) and the
+median time.
 
 Written to ``--out`` (default ``out/iwd_paper_maps``; ``make reproduce`` uses
 ``results/iwd_paper_maps``), each file atomically: ``runs.csv`` (one row per map and seed),
@@ -21,56 +22,45 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
-
-import jax
 
 from jaxswarm.exact import astar
-from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.maps.paper import paper_maps_argument
 from jaxswarm.runtime.atomic import write_csv
-from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.studies import provenance
-
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.studies.problems import named_problem
+from jaxswarm.studies.success import reaches_optimum, relative_gap
+from jaxswarm.studies.timing import median_milliseconds, seed_keys, timed_runs
+from jaxswarm.swarm import definition, make
 
 COLUMNS = ("map", "seed", "optimum", "cost", "gap", "found", "optimal", "iterations",
            "evaluations", "seconds")
 """Columns of runs.csv (``evaluations``: complete paths evaluated, all iterations)."""
-OPTIMAL_GAP = 1e-4
-"""A run reaches the optimum when its relative gap to it is below this."""
 TITLE = "Intelligent Water Drops (the IWD_PG paper's baseline) on the RFD paper's maps"
+"""Title of table.md."""
 ABOUT = ("`iwd` is Shah-Hosseini's IWD with its standard values, as the IWD_PG paper uses it "
          "(eqs. 1-6); the goal desirability h(j) = 1 / d_j is ours (the paper gives no "
          "formula). The optimum is A*'s.")
+"""What the rows are (the paragraph under the provenance)."""
 
 
 def study_map(name: str, *, seeds: int, drops: int, iterations: int,
               patience: int) -> list[dict]:
-    """The runs.csv rows of map ``name``."""
-    chosen = paper_map(name)
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
-    optimum = float(astar(graph, chosen.start, chosen.goal).cost)
+    """The runs.csv rows of map ``name``: ``iwd`` with its standard params once per seed (keys
+    split from key 0), compiled first, each run timed alone."""
+    problem = named_problem(name, planner=astar)
     swarm = make("iwd", num_agents=drops)
-
-    def one(key):
-        return jax.block_until_ready(run(swarm, key, graph, task, swarm.default_params,
-                                         iterations=iterations, patience=patience))
-
-    keys = jax.random.split(jax.random.key(0), seeds)
-    one(keys[0])  # compile
+    runs = timed_runs(swarm, seed_keys(seeds), problem.graph, problem.task, swarm.default_params,
+                      iterations=iterations, patience=patience)
     rows = []
-    for seed, key in enumerate(keys):
-        began = time.perf_counter()
-        state, trace = one(key)
-        seconds = time.perf_counter() - began
-        cost = float(swarm.best(state).cost)
-        gap = (cost - optimum) / optimum
-        rows.append(dict(map=name, seed=seed, optimum=optimum, cost=cost, gap=gap,
-                         found=cost != float("inf"), optimal=gap < OPTIMAL_GAP,
-                         iterations=int(trace.iterations),
-                         evaluations=int(trace.evaluations.sum()), seconds=seconds))
+    for seed, one in enumerate(runs):
+        cost = float(swarm.best(one.state).cost)
+        gap = relative_gap(cost, problem.optimum)
+        rows.append(dict(map=name, seed=seed, optimum=problem.optimum, cost=cost, gap=gap,
+                         found=cost != float("inf"), optimal=reaches_optimum(gap),
+                         iterations=int(one.trace.iterations),
+                         evaluations=int(one.trace.evaluations.sum()), seconds=one.seconds))
     return rows
 
 
@@ -94,7 +84,7 @@ def markdown(rows: list[dict], maps, args) -> str:
             f"{sum(r['optimal'] for r in runs)}/{len(runs)} | {length} | "
             f"{statistics.mean(r['iterations'] for r in runs):.1f} | "
             f"{statistics.mean(r['evaluations'] for r in runs):.0f} | "
-            f"{1e3 * statistics.median(r['seconds'] for r in runs):.1f} |")
+            f"{median_milliseconds(r['seconds'] for r in runs):.1f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -106,11 +96,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--drops", type=int, default=50)
     parser.add_argument("--iterations", type=int, default=100)
     parser.add_argument("--patience", type=int, default=30)
-    parser.add_argument("--out", type=Path, default=Path("out/iwd_paper_maps"))
+    add_out_argument(parser, "iwd_paper_maps")
     args = parser.parse_args(argv)
-    for option in ("seeds", "drops", "iterations", "patience"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    check_counts(parser, args, "seeds", "drops", "iterations", "patience")
     record = provenance.begin(__file__, argv)
     rows = []
     for name in args.maps:

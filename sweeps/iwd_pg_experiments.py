@@ -25,7 +25,8 @@ operator off (the memory alone changes nothing IWD does).
    each: success rate and fitness calls, beside the optimum.
 
 Maps: ``jaxswarm.maps.iwd_pg`` (field, complex: ours, drawn from the paper's words) and
-``jaxswarm.maps.paper``; every optimum is Dijkstra's. Written to ``--out`` (default
+``jaxswarm.maps.paper``; every optimum is Dijkstra's, and a run reaches it within a relative gap
+of 1e-4 (:mod:`jaxswarm.studies.success`). Written to ``--out`` (default
 ``out/iwd_pg_experiments``; ``make reproduce`` uses ``results/iwd_pg_experiments``), each file
 atomically: ``runs.csv`` (one row per run), ``curves.csv`` (best length after each iteration
 and the fitness calls so far, per run of experiments 2, 3 and 5), ``scores.csv`` (experiment
@@ -40,9 +41,8 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -52,15 +52,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from jaxswarm.exact import dijkstra  # noqa: E402
+from jaxswarm.dynamic.events import first_iteration_at  # noqa: E402
 from jaxswarm.maps.iwd_pg import iwd_pg_map  # noqa: E402
-from jaxswarm.maps.paper import paper_map  # noqa: E402
-from jaxswarm.plot.graph import draw_map, draw_paths, save_png  # noqa: E402
+from jaxswarm.maps.paper import paper_maps_argument  # noqa: E402
+from jaxswarm.plot.graph import draw_map, draw_paths  # noqa: E402
 from jaxswarm.runtime.atomic import write_csv  # noqa: E402
-from jaxswarm.swarm import definition, make, make_task, run  # noqa: E402
+from jaxswarm.studies import provenance  # noqa: E402
+from jaxswarm.studies.arguments import (add_out_argument, check_counts,  # noqa: E402
+                                        numbers_argument)
+from jaxswarm.studies.figures import write_png  # noqa: E402
+from jaxswarm.studies.problems import Problem, make_problem, named_problem  # noqa: E402
+from jaxswarm.studies.success import SUCCESS_GAP, at_optimum  # noqa: E402
+from jaxswarm.studies.timing import TimedRun, seed_keys, timed_runs  # noqa: E402
+from jaxswarm.swarm import Swarm, definition, make  # noqa: E402
 from jaxswarm.swarm.iwd import fuzzy  # noqa: E402
-from jaxswarm.studies import provenance
-
 
 OFF = dict(smooth=False, first_intersection=False, second_intersection=False,
            local_search=False)
@@ -84,61 +89,88 @@ EXPERIMENTS = {
     6: ("complex map", "complex", ("IWD_PG",)),
 }
 """Experiment -> (name, map, variants) of the experiments that compare runs."""
+CURVES = (2, 3, 5)
+"""The experiments whose runs' curves are written and drawn."""
+IWD_PG_MAPS = ("field", "complex")
+"""The maps of :mod:`jaxswarm.maps.iwd_pg`."""
 PAPER_MAPS = ("mosaic20", "alley20", "maze20", "mosaic50", "alley50", "maze50")
+"""The RFD paper's maps of experiment 7 (default)."""
 RUN_COLUMNS = ("experiment", "map", "variant", "seed", "optimum", "cost", "optimal",
                "iterations", "evaluations", "evaluations_to_optimum", "seconds")
+"""Columns of runs.csv."""
 CURVE_COLUMNS = ("experiment", "variant", "seed", "iteration", "best_cost", "evaluations")
+"""Columns of curves.csv."""
 SCORE_COLUMNS = ("path", "length", "section", "spl", "ospl", "score")
-OPTIMAL_GAP = 1e-4
-"""A run reaches the optimum when its relative gap to it is below this."""
+"""Columns of scores.csv."""
 TITLE = "The IWD_PG paper's experiments"
+"""Title of table.md."""
 ABOUT = ("`iwd_pg` is the IWD_PG paper's algorithm with each operator a switch; where the paper's "
          "figures, membership functions, rules and maps did not survive, ours are documented in "
          "`jaxswarm.swarm.iwd` and `jaxswarm.maps.iwd_pg`. `iwd` is its baseline. Optima are "
          "Dijkstra's.")
+"""What the rows are (the paragraph under the provenance)."""
 
 
-def load_map(name: str):
-    chosen = iwd_pg_map(name) if name in ("field", "complex") else paper_map(name)
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
-    return graph, task, float(dijkstra(graph, task.start, task.goal).cost)
+class Outcome(NamedTuple):
+    """What one experiment adds to the files: rows of runs.csv, curves.csv and scores.csv, and
+    its section of table.md (title, Markdown lines)."""
+
+    rows: list[dict]
+    curves: list[dict]
+    scores: list[dict]
+    section: tuple[str, list[str]]
 
 
-def study(experiment, map_name: str, swarm_name: str, variant: str, options: dict, *,
-          runs: int, iterations: int, drops: int):
-    """Rows of runs.csv and curves.csv, and the final states, of ``runs`` seeds of one
-    variant on one map."""
-    graph, task, optimum = load_map(map_name)
+class Study(NamedTuple):
+    """The runs of one variant on one map: runs.csv and curves.csv rows, the final states and
+    the problem."""
+
+    rows: list[dict]
+    curves: list[dict]
+    states: list
+    problem: Problem
+
+
+def load_problem(name: str) -> Problem:
+    """The problem of map ``name``: an IWD_PG map (:data:`IWD_PG_MAPS`) or a paper map."""
+    if name in IWD_PG_MAPS:
+        chosen = iwd_pg_map(name)
+        return make_problem(name, chosen.graph(), chosen.start, chosen.goal)
+    return named_problem(name)
+
+
+def run_rows(experiment: int, problem: Problem, variant: str, seed: int, swarm: Swarm,
+             one: TimedRun) -> tuple[dict, list[dict]]:
+    """The runs.csv row of one timed run and its curves.csv rows (one per iteration run)."""
+    used = int(one.trace.iterations)
+    best = np.asarray(one.trace.best_cost)[:used]
+    calls = np.cumsum(np.asarray(one.trace.evaluations)[:used])
+    first = first_iteration_at(one.trace, problem.optimum, gap=SUCCESS_GAP)
+    cost = float(swarm.best(one.state).cost)
+    row = dict(experiment=experiment, map=problem.label, variant=variant, seed=seed,
+               optimum=problem.optimum, cost=cost, optimal=at_optimum(cost, problem.optimum),
+               iterations=used, evaluations=int(calls[-1]) if used else 0,
+               evaluations_to_optimum="" if first is None else int(calls[first - 1]),
+               seconds=one.seconds)
+    curves = [dict(experiment=experiment, variant=variant, seed=seed, iteration=t + 1,
+                   best_cost=float(best[t]), evaluations=int(calls[t])) for t in range(used)]
+    return row, curves
+
+
+def study(experiment: int, map_name: str, swarm_name: str, variant: str, options: dict, *,
+          runs: int, iterations: int, drops: int) -> Study:
+    """``runs`` seeds (keys split from key 0) of one variant (``swarm_name`` with the Config
+    ``options``) on one map, compiled first, each run timed alone."""
+    problem = load_problem(map_name)
     swarm = make(swarm_name, num_agents=drops, **options)
-
-    def one(key):
-        return jax.block_until_ready(run(swarm, key, graph, task, swarm.default_params,
-                                         iterations=iterations))
-
-    keys = jax.random.split(jax.random.key(0), runs)
-    one(keys[0])  # compile
-    rows, curves, states = [], [], []
-    for seed, key in enumerate(keys):
-        began = time.perf_counter()
-        state, trace = one(key)
-        seconds = time.perf_counter() - began
-        used = int(trace.iterations)
-        best = np.asarray(trace.best_cost)[:used]
-        calls = np.cumsum(np.asarray(trace.evaluations)[:used])
-        reached = np.flatnonzero(best <= optimum * (1 + OPTIMAL_GAP))
-        cost = float(swarm.best(state).cost)
-        rows.append(dict(experiment=experiment, map=map_name, variant=variant, seed=seed,
-                         optimum=optimum, cost=cost,
-                         optimal=cost <= optimum * (1 + OPTIMAL_GAP), iterations=used,
-                         evaluations=int(calls[-1]) if used else 0,
-                         evaluations_to_optimum=int(calls[reached[0]]) if reached.size else "",
-                         seconds=seconds))
-        curves += [dict(experiment=experiment, variant=variant, seed=seed, iteration=t + 1,
-                        best_cost=float(best[t]), evaluations=int(calls[t]))
-                   for t in range(used)]
-        states.append(state)
-    return rows, curves, states, (graph, task)
+    timed = timed_runs(swarm, seed_keys(runs), problem.graph, problem.task, swarm.default_params,
+                       iterations=iterations)
+    rows, curves = [], []
+    for seed, one in enumerate(timed):
+        row, curve = run_rows(experiment, problem, variant, seed, swarm, one)
+        rows.append(row)
+        curves += curve
+    return Study(rows, curves, [one.state for one in timed], problem)
 
 
 def lengths_table(rows, variants) -> list[str]:
@@ -205,6 +237,8 @@ def best_within(curves, variant, budgets):
 
 
 def curve_figure(path, curves, variants, iterations, optimum, title):
+    """The mean best length per iteration of each variant (:func:`mean_curve`) beside the
+    optimum, written as a PNG to ``path``."""
     fig, ax = plt.subplots(figsize=(6, 4))
     for variant in variants:
         ax.plot(np.arange(1, iterations + 1), mean_curve(curves, variant, iterations),
@@ -212,8 +246,7 @@ def curve_figure(path, curves, variants, iterations, optimum, title):
     ax.axhline(optimum, color="k", linestyle=":", label="optimum")
     ax.set(xlabel="iteration", ylabel="best length (mean over runs)", title=title)
     ax.legend()
-    save_png(fig, path)
-    plt.close(fig)
+    write_png(fig, path)
 
 
 def fuzzy_example(states, graph, sections: int = 4):
@@ -233,109 +266,116 @@ def fuzzy_example(states, graph, sections: int = 4):
     return rows, np.asarray(paths)
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Command line entry point (see the module docstring); returns the exit status."""
+def fuzzy_scores_experiment(args: argparse.Namespace) -> Outcome:
+    """Experiment 4: the fuzzy section scores of three remembered paths (Table 4), their
+    figure written to ``args.out``."""
+    found = study(4, "field", "iwd_pg", "+ smoothing", VARIANTS["+ smoothing"], runs=args.runs,
+                  iterations=args.iterations, drops=args.drops)
+    graph = found.problem.graph
+    scores, paths = fuzzy_example(found.states, graph)
+    table = ["| path | length | " + " | ".join(f"section {s}" for s in range(1, 5)) + " |",
+             "| --- | ---: |" + " ---: |" * 4]
+    for p in sorted({r["path"] for r in scores}):
+        mine = [r for r in scores if r["path"] == p]
+        table.append(f"| {p} | {mine[0]['length']:.2f} | "
+                     + " | ".join(f"{r['score']:.3f}" for r in mine) + " |")
+    fig, ax = plt.subplots(figsize=(5, 5))
+    draw_map(ax, graph, start=found.problem.start, goal=found.problem.goal,
+             title="experiment 4: three remembered paths, four sections")
+    draw_paths(ax, graph, [p for p in paths if p[0] >= 0],
+               [f"path {i + 1}" for i in range(len(paths)) if paths[i][0] >= 0])
+    for s in range(1, 4):
+        ax.axvline(s * graph.shape[1] / 4 - 0.5, color="grey", linestyle="--")
+    ax.legend(loc="lower right", fontsize=7)
+    write_png(fig, args.out / "experiment4.png")
+    return Outcome([], [], scores, ("4. Fuzzy section scores (Table 4)", table))
+
+
+def paper_maps_experiment(args: argparse.Namespace) -> Outcome:
+    """Experiment 7: IWD and IWD_PG on the RFD paper's maps ``args.maps``."""
+    rows = [row for name in args.maps for swarm_name in ("iwd", "iwd_pg")
+            for row in study(7, name, swarm_name, swarm_name.upper(), {}, runs=args.runs,
+                             iterations=args.iterations, drops=args.drops).rows]
+    table = ["| map | optimum | " + " | ".join(
+        f"{v}: {what}" for v in ("IWD", "IWD_PG")
+        for what in ("found", "optimal", "mean length", "fitness calls")) + " |",
+        "| --- | ---: |" + " ---: |" * 8]
+    for name in args.maps:
+        cells = []
+        for v in ("IWD", "IWD_PG"):
+            runs = [r for r in rows if r["map"] == name and r["variant"] == v]
+            found = [r["cost"] for r in runs if np.isfinite(r["cost"])]
+            cells += [f"{len(found)}/{len(runs)}",
+                      f"{sum(r['optimal'] for r in runs)}/{len(runs)}",
+                      f"{statistics.mean(found):.2f}" if found else "-",
+                      f"{statistics.mean(r['evaluations'] for r in runs):.0f}"]
+        optimum = [r for r in rows if r["map"] == name][0]["optimum"]
+        table.append(f"| {name} | {optimum:.2f} | " + " | ".join(cells) + " |")
+    return Outcome(rows, [], [], ("7. IWD and IWD_PG on the RFD paper's maps", table))
+
+
+def comparison_experiment(experiment: int, args: argparse.Namespace) -> Outcome:
+    """Experiments 1, 2, 3, 5 and 6: the variants of :data:`EXPERIMENTS` side by side on one
+    map, the curve figure of 2, 3 and 5 written to ``args.out``."""
+    name, map_name, variants = EXPERIMENTS[experiment]
+    runs = {1: args.runs_smooth, 6: args.runs_complex}.get(experiment, args.runs)
+    rows, curves = [], []
+    for variant in variants:
+        found = study(experiment, map_name, "iwd_pg", variant, VARIANTS[variant], runs=runs,
+                      iterations=args.iterations, drops=args.drops)
+        rows += found.rows
+        curves += found.curves
+    optimum = rows[0]["optimum"]
+    table = [f"Map {map_name} (optimum {optimum:.2f}), {runs} runs per variant, "
+             f"{args.iterations} iterations at most, {args.drops} drops.", ""]
+    table += lengths_table(rows, variants)
+    if experiment == 5:
+        table += [""] + budget_table(curves, variants)
+    if experiment in CURVES:
+        curve_figure(args.out / f"experiment{experiment}.png", curves, variants,
+                     args.iterations, optimum, f"experiment {experiment}: {name}")
+    return Outcome(rows, curves if experiment in CURVES else [], [],
+                   (f"{experiment}. {name.capitalize()}", table))
+
+
+def parse_arguments(argv: list[str] | None) -> argparse.Namespace:
+    """The checked command-line arguments (see the module docstring)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--experiments", default="1,2,3,4,5,6,7",
-                        help="comma-separated, from 1-7")
+    parser.add_argument("--experiments", type=numbers_argument(range(1, 8)),
+                        default="1,2,3,4,5,6,7", help="comma-separated, from 1-7")
     parser.add_argument("--runs-smooth", type=int, default=50)
     parser.add_argument("--runs", type=int, default=10)
     parser.add_argument("--runs-complex", type=int, default=15)
     parser.add_argument("--iterations", type=int, default=50)
     parser.add_argument("--drops", type=int, default=50)
-    parser.add_argument("--maps", default=",".join(PAPER_MAPS),
+    parser.add_argument("--maps", type=paper_maps_argument, default=",".join(PAPER_MAPS),
                         help="the RFD paper's maps of experiment 7")
-    parser.add_argument("--out", type=Path, default=Path("out/iwd_pg_experiments"))
+    add_out_argument(parser, "iwd_pg_experiments")
     args = parser.parse_args(argv)
-    for option in ("runs_smooth", "runs", "runs_complex", "iterations", "drops"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option.replace('_', '-')} must be at least 1, "
-                         f"got {getattr(args, option)}")
-    try:
-        chosen = sorted({int(e) for e in args.experiments.split(",")})
-    except ValueError:
-        parser.error(f"--experiments must be numbers from 1-7, got {args.experiments!r}")
-    if not set(chosen) <= set(range(1, 8)):
-        parser.error(f"--experiments must be numbers from 1-7, got {args.experiments!r}")
+    check_counts(parser, args, "runs_smooth", "runs", "runs_complex", "iterations", "drops")
+    return args
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
+    args = parse_arguments(argv)
     record = provenance.begin(__file__, argv)
-    rows, curves, scores, sections = [], [], [], []
-    for experiment in chosen:
+    outcomes = []
+    for experiment in args.experiments:
         began = time.perf_counter()
         if experiment == 4:
-            _, _, states, (graph, task) = study(4, "field", "iwd_pg", "+ smoothing",
-                                                VARIANTS["+ smoothing"], runs=args.runs,
-                                                iterations=args.iterations, drops=args.drops)
-            scores, paths = fuzzy_example(states, graph)
-            table = ["| path | length | " + " | ".join(f"section {s}" for s in range(1, 5))
-                     + " |", "| --- | ---: |" + " ---: |" * 4]
-            for p in sorted({r["path"] for r in scores}):
-                mine = [r for r in scores if r["path"] == p]
-                table.append(f"| {p} | {mine[0]['length']:.2f} | "
-                             + " | ".join(f"{r['score']:.3f}" for r in mine) + " |")
-            fig, ax = plt.subplots(figsize=(5, 5))
-            draw_map(ax, graph, start=task.start, goal=task.goal,
-                     title="experiment 4: three remembered paths, four sections")
-            draw_paths(ax, graph, [p for p in paths if p[0] >= 0],
-                       [f"path {i + 1}" for i in range(len(paths)) if paths[i][0] >= 0])
-            for s in range(1, 4):
-                ax.axvline(s * graph.shape[1] / 4 - 0.5, color="grey", linestyle="--")
-            ax.legend(loc="lower right", fontsize=7)
-            save_png(fig, args.out / "experiment4.png")
-            plt.close(fig)
-            sections.append(("4. Fuzzy section scores (Table 4)", table))
+            outcomes.append(fuzzy_scores_experiment(args))
         elif experiment == 7:
-            mine = []
-            for name in args.maps.split(","):
-                for swarm_name in ("iwd", "iwd_pg"):
-                    found, _, _, _ = study(7, name, swarm_name, swarm_name.upper(), {},
-                                           runs=args.runs, iterations=args.iterations,
-                                           drops=args.drops)
-                    mine += found
-            rows += mine
-            table = ["| map | optimum | " + " | ".join(
-                f"{v}: {what}" for v in ("IWD", "IWD_PG")
-                for what in ("found", "optimal", "mean length", "fitness calls")) + " |",
-                "| --- | ---: |" + " ---: |" * 8]
-            for name in args.maps.split(","):
-                cells = []
-                for v in ("IWD", "IWD_PG"):
-                    runs = [r for r in mine if r["map"] == name and r["variant"] == v]
-                    found = [r["cost"] for r in runs if np.isfinite(r["cost"])]
-                    cells += [f"{len(found)}/{len(runs)}",
-                              f"{sum(r['optimal'] for r in runs)}/{len(runs)}",
-                              f"{statistics.mean(found):.2f}" if found else "-",
-                              f"{statistics.mean(r['evaluations'] for r in runs):.0f}"]
-                optimum = [r for r in mine if r["map"] == name][0]["optimum"]
-                table.append(f"| {name} | {optimum:.2f} | " + " | ".join(cells) + " |")
-            sections.append(("7. IWD and IWD_PG on the RFD paper's maps", table))
+            outcomes.append(paper_maps_experiment(args))
         else:
-            name, map_name, variants = EXPERIMENTS[experiment]
-            runs = {1: args.runs_smooth, 6: args.runs_complex}.get(experiment, args.runs)
-            mine, mine_curves = [], []
-            for variant in variants:
-                found, curve, _, _ = study(experiment, map_name, "iwd_pg", variant,
-                                           VARIANTS[variant], runs=runs,
-                                           iterations=args.iterations, drops=args.drops)
-                mine += found
-                mine_curves += curve
-            rows += mine
-            curves += [c for c in mine_curves if experiment in (2, 3, 5)]
-            optimum = mine[0]["optimum"]
-            table = [f"Map {map_name} (optimum {optimum:.2f}), {runs} runs per variant, "
-                     f"{args.iterations} iterations at most, {args.drops} drops.", ""]
-            table += lengths_table(mine, variants)
-            if experiment == 5:
-                table += [""] + budget_table(mine_curves, variants)
-            if experiment in (2, 3, 5):
-                curve_figure(args.out / f"experiment{experiment}.png", mine_curves, variants,
-                             args.iterations, optimum, f"experiment {experiment}: {name}")
-            sections.append((f"{experiment}. {name.capitalize()}", table))
+            outcomes.append(comparison_experiment(experiment, args))
         print(f"experiment {experiment}: {time.perf_counter() - began:.0f} s", flush=True)
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args),
                   swarm=definition(make("iwd_pg", num_agents=args.drops)))
-    write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
-    write_csv(args.out / "curves.csv", curves, CURVE_COLUMNS)
-    write_csv(args.out / "scores.csv", scores, SCORE_COLUMNS)
+    write_csv(args.out / "runs.csv", [r for o in outcomes for r in o.rows], RUN_COLUMNS)
+    write_csv(args.out / "curves.csv", [c for o in outcomes for c in o.curves], CURVE_COLUMNS)
+    write_csv(args.out / "scores.csv", [s for o in outcomes for s in o.scores], SCORE_COLUMNS)
+    sections = [o.section for o in outcomes]
     print("\n" + record.publish(args.out, provenance.join_sections(sections)))
     return 0
 

@@ -40,7 +40,8 @@ Outputs (in ``--out``, default ``out/mapf_study/``, each written atomically):
 * ``summary.csv``: per planner and agent count over all maps (``map`` = ``all``), then per map,
   agent count and planner: runs, solved, success rate, mean SoC / lower bound and mean makespan
   over the solved runs, median time over all runs, runs that raised;
-* ``table.md``: the provenance (:mod:`provenance`), then both summaries as Markdown tables;
+* ``table.md``: the provenance (:mod:`jaxswarm.studies.provenance`), then both summaries as
+  Markdown tables;
 * ``mapf_study.png``: success rate, mean SoC / lower bound and median time against the number of
   agents, one line per planner (over all maps);
 * ``provenance.json``: the provenance and the arguments.
@@ -76,6 +77,8 @@ from jaxswarm.multiagent import (Instance, cbs, load_instance, lower_bound, prio
                                  report_scheme, validate)
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.sweep.maps import MOVINGAI_DATA
 
 
 MAPS = ("empty-32-32", "random-32-32-10", "room-32-32-4", "maze-32-32-2", "den312d")
@@ -121,10 +124,10 @@ class InvalidPlan(RuntimeError):
 
 def default_data() -> Path:
     """The folder of the MAPF maps and scenarios (see the module docstring)."""
-    named = os.environ.get("JAXSWARM_MOVINGAI")
+    named = os.environ.get(MOVINGAI_DATA)
     if named:
         return Path(named) / "mapf"
-    return Path(HERE).parents[1] / "shared" / "benchdata" / "movingai" / "mapf"
+    return provenance.ROOT.parent / "shared" / "benchdata" / "movingai" / "mapf"
 
 
 def parse_maps(text: str) -> list[str]:
@@ -402,11 +405,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--data", type=Path, default=default_data(),
                         help="the folder of the MAPF .map and .scen files (default "
                              "$JAXSWARM_MOVINGAI/mapf, else ../shared/benchdata/movingai/mapf)")
-    parser.add_argument("--out", type=Path, default=Path("out", "mapf_study"),
-                        help="output directory (default out/mapf_study/)")
+    add_out_argument(parser, "mapf_study")
     args = parser.parse_args(argv)
-    if args.seeds < 1:
-        parser.error("--seeds must be at least 1")
+    check_counts(parser, args, "seeds")
     if args.cbs_time_limit <= 0:
         parser.error("--cbs-time-limit must be positive")
     for name in args.maps:

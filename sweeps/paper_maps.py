@@ -34,6 +34,7 @@ def ascii_map(chosen) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ascii", action="store_true", help="print the maps as text")
     parser.add_argument("--out", type=Path, default=Path("out/paper_maps.png"))

@@ -1,10 +1,10 @@
 """The RFD paper's Tables 2-5 (dynamic environment), reproduced on our nine paper maps.
 
-The rows of Table 1 (:mod:`rfd_paper_static`, the same labels, swarms and params) plus "D* Lite
-(repair)", a row the paper lacks. Per map, each swarm first solves the static map once per seed
-(keys split from key 0, ``--iterations`` iterations, like Table 1): its Table 1 state. Then for
-each of the paper's changes (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: Table 2 the goal
-moves, 3 obstacles added, 4 removed, 5 a major change) the swarm continues from that state:
+The rows of Table 1 (:mod:`jaxswarm.studies.rfd_table1`, the same labels, swarms and params) plus
+"D* Lite (repair)", a row the paper lacks. Per map, each swarm first solves the static map once per
+seed (keys split from key 0, ``--iterations`` iterations, like Table 1): its Table 1 state. Then
+for each of the paper's changes (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: Table 2 the
+goal moves, 3 obstacles added, 4 removed, 5 a major change) the swarm continues from that state:
 :func:`jaxswarm.dynamic.events.change` applies the change and the swarm's memory rule, then ``run``
 continues (``--iterations`` at most, patience ``--patience``; key ``fold_in(seed key, table)``).
 
@@ -34,43 +34,45 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import math
-import statistics
-import sys
 import time
-from pathlib import Path
 
 import jax
 import matplotlib
 
 matplotlib.use("Agg")
-from matplotlib import pyplot as plt
 
 from jaxswarm.dynamic.events import apply_event, check_events, first_iteration_at, replan
 from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
                                          paper_scenario)
 from jaxswarm.exact import astar, replanner
-from jaxswarm.maps.paper import paper_map, paper_maps_argument
-from jaxswarm.plot.graph import draw_map, draw_paths, save_png
+from jaxswarm.maps.named import named_map
+from jaxswarm.maps.paper import paper_maps_argument
+from jaxswarm.plot.graph import draw_map, draw_paths
 from jaxswarm.runtime.atomic import write_csv
+from jaxswarm.studies import provenance
+from jaxswarm.studies.arguments import add_out_argument, check_counts, numbers_argument
+from jaxswarm.studies.figures import panel_grid, write_png
+from jaxswarm.studies.rfd_table1 import (ABOUT as TABLE1_ABOUT, ALGORITHMS as TABLE1_LABELS,
+                                         PLANNERS, ROWS, draw_best_paths, length_cell,
+                                         optimal_cell, row_definitions, row_swarm, time_cell)
+from jaxswarm.studies.success import SUCCESS_GAP, relative_gap
+from jaxswarm.studies.timing import median_milliseconds, seed_keys, timed_call
 from jaxswarm.swarm import make_task, run
 from jaxswarm.world.graph import grid_graph
-from jaxswarm.studies import provenance
-
-import rfd_paper_static as static  # noqa: E402
 
 DSTAR = "D* Lite (repair)"
-LABELS = static.ALGORITHMS[:2] + (DSTAR,) + static.ALGORITHMS[2:]
+LABELS = TABLE1_LABELS[:2] + (DSTAR,) + TABLE1_LABELS[2:]
 """Row labels in table order: Table 1's, with D* Lite after the exact planners."""
 COLUMNS = ("map", "table", "algorithm", "planner", "seed", "optimum", "cost", "gap", "found",
            "iterations", "seconds", "target_iterations", "target_seconds")
 """Columns of runs.csv (``seconds``: time to stop; ``target_*``: to the new optimum)."""
 TITLE = "RFD paper, Tables 2-5 (dynamic environment): ours beside the paper's"
-ABOUT = static.ABOUT + (
+ABOUT = TABLE1_ABOUT + (
     " \"D* Lite (repair)\" is not in the paper: D* Lite (`jaxswarm.exact.replanner`) repairing "
     "its search of the static map. Each swarm continues from its own Table 1 state, its memory "
     "adapted by its rule (`jaxswarm.dynamic.events`).")
-PAPER_ROW = {**{row.label: row.paper for row in static.ROWS}, DSTAR: None}
+PAPER_ROW = {**{row.label: row.paper for row in ROWS}, DSTAR: None}
+"""Row label -> the paper's row beside it (None: no counterpart)."""
 
 
 def exact_runs(name, chosen, graph, scenario, table, seeds):
@@ -78,36 +80,34 @@ def exact_runs(name, chosen, graph, scenario, table, seeds):
     fresh = grid_graph(scenario.obstacles())
     goal = scenario.goal or chosen.goal
     rows, best = [], {}
-    for label in static.ALGORITHMS[:2]:
-        planner = static.PLANNERS[label]
+    for label in TABLE1_LABELS[:2]:
+        planner = PLANNERS[label]
         planner(fresh, chosen.start, goal)  # host arrays
         for seed in range(seeds):
             solution = planner(fresh, chosen.start, goal)
             seconds = solution.stats.wall_time
-            rows.append(record(name, table, label, planner.__name__, seed, scenario, solution,
-                               "", seconds, (None, seconds)))
+            rows.append(csv_row(name, table, label, planner.__name__, seed, scenario, solution,
+                                "", seconds, (None, seconds)))
         best[label] = solution
     edited = apply_event(scenario.event(graph), graph, make_task(graph, chosen.start,
                                                                  chosen.goal))[0]
     for seed in range(seeds):
         planner = replanner(graph, chosen.start, chosen.goal)
         planner.solve()
-        began = time.perf_counter()
-        solution = planner.update(edited, goal=scenario.goal)
-        seconds = time.perf_counter() - began
-        rows.append(record(name, table, DSTAR, "replanner", seed, scenario, solution, "",
-                           seconds, (None, seconds)))
+        solution, seconds = timed_call(planner.update, edited, goal=scenario.goal)
+        rows.append(csv_row(name, table, DSTAR, "replanner", seed, scenario, solution, "",
+                            seconds, (None, seconds)))
     best[DSTAR] = solution
     return rows, best
 
 
-def record(name, table, label, planner, seed, scenario, solution, iterations, seconds,
-           target=(None, None)):
+def csv_row(name, table, label, planner, seed, scenario, solution, iterations, seconds,
+            target=(None, None)):
     """One runs.csv row; ``target`` is (iterations, seconds) to the new optimum, or Nones."""
     cost = float(solution.cost)
     return dict(map=name, table=table, algorithm=label, planner=planner, seed=seed,
                 optimum=scenario.optimum, cost=cost,
-                gap=(cost - scenario.optimum) / scenario.optimum, found=bool(solution.found),
+                gap=relative_gap(cost, scenario.optimum), found=bool(solution.found),
                 iterations=iterations, seconds=seconds, target_iterations=target[0] or "",
                 target_seconds="" if target[1] is None else target[1])
 
@@ -115,8 +115,8 @@ def record(name, table, label, planner, seed, scenario, solution, iterations, se
 def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience, agents):
     """One swarm row on one map: its Table 1 states, then each table's change continued."""
     task = make_task(graph, chosen.start, chosen.goal)
-    swarm, params = static.row_swarm(row, agents)
-    keys = jax.random.split(jax.random.key(0), seeds)
+    swarm, params = row_swarm(row, agents)
+    keys = seed_keys(seeds)
     states = [run(swarm, key, graph, task, params, iterations=iterations)[0] for key in keys]
     rows, best = [], {}
     for table in tables:
@@ -134,34 +134,28 @@ def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience,
             key = jax.random.fold_in(key, table)
             if seed == 0:
                 jax.block_until_ready(replay(state, key, iterations))  # compile
-            solution, trace, seconds = _timed(replay, state, key, iterations)
-            first = first_iteration_at(trace, scenario.optimum, gap=static.OPTIMAL_GAP)
+            (solution, trace), seconds = timed_call(replay, state, key, iterations)
+            first = first_iteration_at(trace, scenario.optimum, gap=SUCCESS_GAP)
             target = (None, None) if first is None else (
-                first, _timed(replay, state, key, first)[2])
-            rows.append(record(name, table, row.label, row.planner(), seed, scenario, solution,
-                               int(trace.iterations), seconds, target))
+                first, timed_call(replay, state, key, first)[1])
+            rows.append(csv_row(name, table, row.label, row.planner(), seed, scenario, solution,
+                                int(trace.iterations), seconds, target))
             if table not in best or float(solution.cost) < float(best[table].cost):
                 best[table] = solution
     return rows, best
 
 
-def _timed(replay, state, key, budget):
-    began = time.perf_counter()
-    solution, trace = jax.block_until_ready(replay(state, key, budget))
-    return solution, trace, time.perf_counter() - began
-
-
 def solve_map(name, tables, **options):
     """Every row on paper map ``name``: (rows, table -> row label -> best Solution)."""
-    chosen = paper_map(name)
-    graph = chosen.graph()
+    chosen = named_map(name)
+    graph = chosen.graph
     rows, best = [], {table: {} for table in tables}
     for table in tables:
         mine, solutions = exact_runs(name, chosen, graph, paper_scenario(name, table), table,
                                      options["seeds"])
         rows += mine
         best[table].update(solutions)
-    for row in static.ROWS[2:]:
+    for row in ROWS[2:]:
         began = time.perf_counter()
         mine, solutions = swarm_runs(name, chosen, graph, row, tables, **options)
         rows += mine
@@ -172,6 +166,7 @@ def solve_map(name, tables, **options):
 
 
 def cells(rows, maps, label, table, ours):
+    """One cell per map: ``ours`` of the runs of row ``label`` after the change of ``table``."""
     return [ours([r for r in rows if r["map"] == m and r["table"] == table
                   and r["algorithm"] == label]) for m in maps]
 
@@ -179,7 +174,7 @@ def cells(rows, maps, label, table, ours):
 def target_cell(runs):
     """Median time to the new optimum [ms] over the runs that reached it (count)."""
     hit = [r["target_seconds"] for r in runs if r["target_seconds"] != ""]
-    median = f"{1e3 * statistics.median(hit):.2f}" if hit else "-"
+    median = f"{median_milliseconds(hit):.2f}" if hit else "-"
     return f"{median} ({len(hit)}/{len(runs)})"
 
 
@@ -200,6 +195,8 @@ def half(rows, maps, table, ours, paper=None):
 
 
 def markdown(rows, maps, tables, args):
+    """The Markdown body: the set-up, then per table its changes and its four halves (path
+    length, runs at the new optimum, time to stop, time to target)."""
     parts = [f"{args.seeds} seeds; each swarm continues from its Table 1 state ({args.agents} "
              f"agents, {args.iterations} iterations at most, patience {args.patience}). Times "
              "in ms (compile excluded); the paper's are C# on its own maps. An empty paper cell: "
@@ -208,10 +205,10 @@ def markdown(rows, maps, tables, args):
         changes = ", ".join(f"{m}: {_describe(paper_scenario(m, table))}" for m in maps)
         parts += ["", f"## Table {table}", "", f"Changes: {changes}.", "",
                   "### Path length: mean over the seeds that found a path", "",
-                  *half(rows, maps, table, static.length_cell, PAPER_DYNAMIC_LENGTH), "",
-                  "### Runs at the new optimum", "", *half(rows, maps, table, static.optimal_cell),
+                  *half(rows, maps, table, length_cell, PAPER_DYNAMIC_LENGTH), "",
+                  "### Runs at the new optimum", "", *half(rows, maps, table, optimal_cell),
                   "", "### Time to stop [ms]: median", "",
-                  *half(rows, maps, table, static.time_cell, PAPER_DYNAMIC_MS), "",
+                  *half(rows, maps, table, time_cell, PAPER_DYNAMIC_MS), "",
                   "### Time to target [ms]: median over the runs that reached the new optimum", "",
                   *half(rows, maps, table, target_cell)]
     return "\n".join(parts) + "\n"
@@ -227,34 +224,23 @@ def _describe(scenario):
 
 def figure(best, table):
     """Each map after the change of ``table``, changed cells marked, each row's best path."""
-    names = list(best)
-    rows, columns = math.ceil(len(names) / 3), min(len(names), 3)
-    fig, axes = plt.subplots(rows, columns, figsize=(5 * columns, 5.9 * rows), squeeze=False,
-                             layout="constrained")
-    for ax in axes.flat[len(names):]:
-        ax.set_visible(False)
-    for name, ax in zip(names, axes.flat):
-        scenario, chosen = paper_scenario(name, table), paper_map(name)
+    fig, axes = panel_grid(len(best), columns=3, width=5, height=5.9)
+    for name, ax in zip(best, axes):
+        scenario, chosen = paper_scenario(name, table), named_map(name)
         graph = grid_graph(scenario.obstacles())
         draw_map(ax, graph, start=chosen.start, goal=scenario.goal or chosen.goal, title=name)
         for cells_, marker in ((scenario.block, "s"), (scenario.unblock, "D")):
             if cells_:
                 xs, ys = zip(*cells_)
                 ax.scatter(xs, ys, marker=marker, s=12, color="tab:pink", zorder=3)
-        before = astar(chosen.graph(), chosen.start, chosen.goal)
+        before = astar(chosen.graph, chosen.start, chosen.goal)
         label = f"before: optimal ({scenario.static_optimum:.2f})"
         (line,) = draw_paths(ax, graph, [before], [label], colors=["dimgrey"], linewidth=1.5)
         line.set(linestyle=(0, (2, 2)), zorder=6)
         if scenario.goal is not None:
             ax.plot(*chosen.goal, marker="x", color="dimgrey", markersize=8, zorder=6,
                     linestyle="none", label="before: goal")
-        for thinner, (label, solution) in enumerate(best[name][table].items()):
-            cost = f"{float(solution.cost):.2f}" if bool(solution.found) else "no path"
-            colour = static.COLORS.get(label, "black")
-            draw_paths(ax, graph, [solution], [f"{label} ({cost})"], colors=[colour],
-                       linewidth=5 - 0.5 * thinner)
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.03), ncols=2, frameon=False,
-                  fontsize="small")
+        draw_best_paths(ax, graph, best[name][table], thinning=0.5)
     fig.suptitle(f"RFD paper, Table {table}: the map after the change (pink: cells blocked "
                  "(squares) or opened (diamonds)),\nthe optimal path before it (dashed) and each "
                  "algorithm's best path after it")
@@ -265,33 +251,28 @@ def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", type=paper_maps_argument, default="all")
-    parser.add_argument("--tables", default="2,3,4,5")
+    parser.add_argument("--tables", type=numbers_argument(TABLES), default="2,3,4,5",
+                        help=f"the paper's dynamic tables, from {', '.join(map(str, TABLES))}")
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--iterations", type=int, default=100)
     parser.add_argument("--patience", type=int, default=30)
     parser.add_argument("--agents", type=int, default=256)
-    parser.add_argument("--out", type=Path, default=Path("out/rfd_paper_dynamic"))
+    add_out_argument(parser, "rfd_paper_dynamic")
     args = parser.parse_args(argv)
-    tables = [int(t) for t in args.tables.split(",")]
-    if any(t not in TABLES for t in tables):
-        parser.error(f"--tables: the paper's dynamic tables are {', '.join(map(str, TABLES))}")
-    for option in ("seeds", "iterations", "patience", "agents"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
-    record_ = provenance.begin(__file__, argv)
+    check_counts(parser, args, "seeds", "iterations", "patience", "agents")
+    record = provenance.begin(__file__, argv)
     rows, best = [], {}
     for name in args.maps:
-        mine, best[name] = solve_map(name, tables, seeds=args.seeds, iterations=args.iterations,
-                                     patience=args.patience, agents=args.agents)
+        mine, best[name] = solve_map(name, args.tables, seeds=args.seeds,
+                                     iterations=args.iterations, patience=args.patience,
+                                     agents=args.agents)
         rows += mine
-    record_.finish(title=TITLE, about=ABOUT, arguments=vars(args),
-                   rows=static.row_definitions(args.agents))
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args),
+                  rows=row_definitions(args.agents))
     write_csv(args.out / "runs.csv", rows, COLUMNS)
-    text = record_.publish(args.out, markdown(rows, args.maps, tables, args))
-    for table in tables:
-        fig = figure(best, table)
-        save_png(fig, args.out / f"table{table}.png")
-        plt.close(fig)
+    text = record.publish(args.out, markdown(rows, args.maps, args.tables, args))
+    for table in args.tables:
+        write_png(figure(best, table), args.out / f"table{table}.png")
     print("\n" + text)
     return 0
 

@@ -1,6 +1,7 @@
 """The RFD paper's Table 1 (static environment), reproduced on our nine paper maps.
 
-The paper's six algorithms, with two of them in two variants, beside the paper's values:
+The paper's six algorithms, with two of them in two variants, beside the paper's values (the
+rows of :mod:`jaxswarm.studies.rfd_table1`):
 
 * Dijkstra and A* (exact);
 * "ACO (paper, eq. 7)": Ant System as the paper's eq. 7 writes it (``ant_system``, pheromone
@@ -9,7 +10,7 @@ The paper's six algorithms, with two of them in two variants, beside the paper's
 * ACO* (``aco_star``, eq. 7 over the goal distance) and RFD (``rfd``, eqs. 1-5);
 * "RFD* (paper)": the paper's RFD*, eq. 6 with the paper's erosion eqs. 4-5 (``rfd_star``), and
   "RFD graded (ours)": this project's law, RFD*'s transitions over a graded river bed
-  (``rfd_graded``, registered as ``rfd_star`` until jaxswarm 0.2.0); both beside the paper's RFD*.
+  (``rfd_graded``); both beside the paper's RFD*.
 
 Each swarm runs once per seed (``--seeds``, default 20) for up to ``--iterations`` iterations
 (default 100; a run stops earlier only when every agent of an iteration follows the same path)
@@ -23,7 +24,8 @@ paper's own, unpublished maps, whose optima differ slightly from our reconstruct
 
 * path length: the mean best length over the seeds that found a path ("n/a" if none did), with the
   count of those seeds;
-* runs that reach the optimum (relative gap below 1e-4; not in the paper);
+* runs that reach the optimum (relative gap below 1e-4, :mod:`jaxswarm.studies.success`; not
+  in the paper);
 * time: the median wall time of one run [ms].
 
 Written to ``--out`` (default ``out/rfd_paper_static``; ``make reproduce`` uses
@@ -33,8 +35,8 @@ Written to ``--out`` (default ``out/rfd_paper_static``; ``make reproduce`` uses
   planner or registered swarm and any param it replaces, seed, optimum, cost, gap, found,
   iterations, seconds); ``cost`` and ``gap`` are inf when no path was found, ``iterations`` is
   the number of swarm iterations run (empty for the exact planners);
-* ``table.md``: the provenance (:mod:`provenance`), then the halves of Table 1 (rows = algorithm,
-  ours and the paper's; columns = maps);
+* ``table.md``: the provenance (:mod:`jaxswarm.studies.provenance`), then the halves of Table 1
+  (rows = algorithm, ours and the paper's; columns = maps);
 * ``provenance.json``: the provenance, the arguments and each row's config and params;
 * ``best_paths.png``: the maps (3 per row) with each row's best path (its best seed's).
 
@@ -46,156 +48,65 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import math
-import statistics
-import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
-from typing import NamedTuple
 
-import jax
 import matplotlib
-import numpy as np
 
 matplotlib.use("Agg")
-from matplotlib import pyplot as plt
 from matplotlib.figure import Figure
 
-from jaxswarm.exact import astar, dijkstra
-from jaxswarm.maps.paper import (
-    PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, PaperMap, paper_map, paper_maps_argument)
-from jaxswarm.plot.graph import draw_map, draw_paths, save_png
+from jaxswarm.maps.named import named_map
+from jaxswarm.maps.paper import PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, paper_maps_argument
+from jaxswarm.plot.graph import draw_map
 from jaxswarm.runtime.atomic import write_csv
-from jaxswarm.swarm import Swarm, definition, make, make_task, run
-from jaxswarm.world.graph import Graph
-from jaxswarm.world.paths import Solution
 from jaxswarm.studies import provenance
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.studies.figures import panel_grid, write_png
+from jaxswarm.studies.problems import Problem, named_problem
+from jaxswarm.studies.rfd_table1 import (ABOUT, ALGORITHMS, BY_LABEL, ROWS, Row, draw_best_paths,
+                                         length_cell, optimal_cell, row_definitions,
+                                         run_planner_row, run_swarm_row, time_cell)
+from jaxswarm.studies.success import SUCCESS_GAP, relative_gap
+from jaxswarm.world.paths import Solution
 
-
-
-class Row(NamedTuple):
-    """One row of our Table 1: an exact planner (``swarm`` None) or a registered swarm."""
-
-    label: str
-    """The row's label in our table."""
-    paper: str | None
-    """The paper's Table 1 row it reproduces (a key of ``PAPER_TABLE1_LENGTH``), None if none."""
-    swarm: str | None = None
-    """The registered swarm; None for an exact planner (``PLANNERS[label]``)."""
-    params: tuple[tuple[str, float], ...] = ()
-    """(name, value) of the swarm params that replace its defaults."""
-
-    def planner(self) -> str:
-        """What runs: the planner, or the registered swarm with the params it replaces."""
-        if self.swarm is None:
-            return PLANNERS[self.label].__name__
-        return " ".join([self.swarm, *(f"{name}={value:g}" for name, value in self.params)])
-
-
-PLANNERS = {"Dijkstra": dijkstra, "A*": astar}
-"""Exact planners: Table 1 row label -> planner."""
-ROWS = (
-    Row("Dijkstra", "Dijkstra"),
-    Row("A*", "A*"),
-    Row("ACO (paper, eq. 7)", "ACO", "ant_system"),
-    Row("ACO with eta (beta=1)", "ACO", "ant_system", (("beta", 1.0),)),
-    Row("ACO*", "ACO*", "aco_star"),
-    Row("RFD", "RFD", "rfd"),
-    Row("RFD* (paper)", "RFD*", "rfd_star"),
-    Row("RFD graded (ours)", "RFD*", "rfd_graded"),
-)
-"""The rows, in the paper's order, each variant after the one the paper writes."""
-BY_LABEL = {row.label: row for row in ROWS}
-"""Row label -> Row."""
-ALGORITHMS = tuple(BY_LABEL)
-"""Row labels, in table order."""
-COLORS = dict(zip(ALGORITHMS, ("tab:blue", "tab:cyan", "tab:orange", "tab:brown", "tab:red",
-                               "tab:purple", "tab:olive", "tab:green")))
-"""Path colour of each row in the figure."""
 COLUMNS = ("map", "algorithm", "planner", "seed", "optimum", "cost", "gap", "found", "iterations",
            "seconds")
 """Columns of runs.csv."""
-OPTIMAL_GAP = 1e-4
-"""A run reaches the optimum when its relative gap to it is below this."""
 TITLE = "RFD paper, Table 1 (static environment): ours beside the paper's"
 """Title of table.md."""
-ABOUT = (
-    "Rows: Dijkstra and A* (exact); \"ACO (paper, eq. 7)\" is the RFD paper's Ant System "
-    "(`ant_system`, pheromone only, beta = 0) and \"ACO with eta (beta=1)\" the same with the "
-    "edge-length heuristic weighted by beta = 1; ACO* (`aco_star`) and RFD (`rfd`) are the "
-    "paper's; \"RFD* (paper)\" is the paper's RFD* as written (`rfd_star`: eq. 6 with the "
-    "erosion of eqs. 4-5). \"RFD graded (ours)\" (`rfd_graded`) is not the paper's algorithm but "
-    "this project's law (RFD*'s transitions over a graded river bed; registered as `rfd_star` "
-    "until jaxswarm 0.2.0). Under each row, the paper's values of the row it reproduces: both "
-    "ACO rows the paper's ACO, both RFD* rows the paper's RFD*.")
-"""What the rows are (the paragraph under the provenance)."""
 
 
-def make_row(name: str, row: Row, seed: int, optimum: float, solution: Solution,
-             iterations: int | str, seconds: float) -> dict:
-    """One runs.csv row for one run of ``row`` and its best ``solution`` (cost f[],
-    found bool[])."""
+def make_row(problem: Problem, row: Row, seed: int, solution: Solution, iterations: int | str,
+             seconds: float) -> dict:
+    """One runs.csv row for one run of ``row`` on ``problem`` and its best ``solution`` (cost
+    f[], found bool[])."""
     cost = float(solution.cost)
-    return dict(map=name, algorithm=row.label, planner=row.planner(), seed=seed, optimum=optimum,
-                cost=cost, gap=(cost - optimum) / optimum, found=bool(solution.found),
-                iterations=iterations, seconds=seconds)
+    return dict(map=problem.label, algorithm=row.label, planner=row.planner(), seed=seed,
+                optimum=problem.optimum, cost=cost, gap=relative_gap(cost, problem.optimum),
+                found=bool(solution.found), iterations=iterations, seconds=seconds)
 
 
-def run_planner(row: Row, chosen: PaperMap, graph: Graph, seeds: int,
-                optimum: float) -> tuple[list[dict], Solution]:
-    """Run the exact planner of ``row`` on paper map ``chosen`` (its ``graph``) ``seeds`` times.
-
-    Returns:
-      (one row per repeat, timed by the planner's own ``stats.wall_time``; the last Solution,
-      path i32[N] -1 padded; every repeat gives the same one).
-    """
-    rows = []
-    for seed in range(seeds):
-        solution = PLANNERS[row.label](graph, chosen.start, chosen.goal)
-        rows.append(make_row(chosen.name, row, seed, optimum, solution, "",
-                             solution.stats.wall_time))
-    return rows, solution
-
-
-def row_swarm(row: Row, agents: int) -> tuple[Swarm, tuple]:
-    """The swarm of ``row`` with ``agents`` drops or ants, and its params: the defaults with the
-    row's replacements (float32 scalars)."""
-    swarm = make(row.swarm, num_agents=agents)
-    params = swarm.default_params._replace(
-        **{name: np.float32(value) for name, value in row.params})
-    return swarm, params
-
-
-def run_swarm(row: Row, chosen: PaperMap, graph: Graph, seeds: int, optimum: float, *,
-              iterations: int, agents: int) -> tuple[list[dict], Solution]:
-    """Run the swarm of ``row`` on paper map ``chosen`` (its ``graph``) once per seed, with
-    keys split from key 0.
-
-    The run is compiled by a warm-up call first; each seed's run is then timed alone.
+def solve_row(row: Row, problem: Problem, seeds: int, *, iterations: int,
+              agents: int) -> tuple[list[dict], Solution]:
+    """Run ``row`` on ``problem`` once per seed: an exact planner as repeats (timed by its own
+    ``stats.wall_time``), a swarm with keys split from key 0 (compiled first, each run timed
+    alone).
 
     Returns:
-      (one row per seed; the Solution of the seed with the lowest cost, path i32[L] -1 padded).
+      (one runs.csv row per seed; the Solution of the first seed with the lowest cost, path
+      i32[L] -1 padded).
     """
-    task = make_task(graph, chosen.start, chosen.goal)
-    swarm, params = row_swarm(row, agents)
-
-    def one_run(key):
-        return run(swarm, key, graph, task, params, iterations=iterations)
-
-    keys = jax.random.split(jax.random.key(0), seeds)
-    jax.block_until_ready(one_run(keys[0]))  # compile
-    rows, best = [], None
-    for seed, key in enumerate(keys):
-        began = time.perf_counter()
-        state, trace = jax.block_until_ready(one_run(key))
-        seconds = time.perf_counter() - began
-        solution = swarm.best(state)
-        rows.append(make_row(chosen.name, row, seed, optimum, solution, int(trace.iterations),
-                             seconds))
-        if best is None or float(solution.cost) < float(best.cost):
-            best = solution
-    return rows, best
+    if row.swarm is None:
+        solutions = run_planner_row(row, problem, seeds)
+        rows = [make_row(problem, row, seed, solution, "", solution.stats.wall_time)
+                for seed, solution in enumerate(solutions)]
+    else:
+        swarm, runs = run_swarm_row(row, problem, seeds, iterations=iterations, agents=agents)
+        solutions = [swarm.best(one.state) for one in runs]
+        rows = [make_row(problem, row, seed, solution, int(one.trace.iterations), one.seconds)
+                for seed, (solution, one) in enumerate(zip(solutions, runs))]
+    return rows, min(solutions, key=lambda solution: float(solution.cost))
 
 
 def solve_map(name: str, seeds: int, *, iterations: int,
@@ -205,39 +116,17 @@ def solve_map(name: str, seeds: int, *, iterations: int,
     Returns:
       (the runs.csv rows, row label -> its best Solution over the seeds).
     """
-    chosen = paper_map(name)
-    graph = chosen.graph()
-    optimum = float(dijkstra(graph, chosen.start, chosen.goal).cost)
+    problem = named_problem(name)
     rows, best = [], {}
     for row in ROWS:
         began = time.perf_counter()
-        if row.swarm is None:
-            mine, best[row.label] = run_planner(row, chosen, graph, seeds, optimum)
-        else:
-            mine, best[row.label] = run_swarm(row, chosen, graph, seeds, optimum,
-                                              iterations=iterations, agents=agents)
+        mine, best[row.label] = solve_row(row, problem, seeds, iterations=iterations,
+                                          agents=agents)
         rows += mine
         print(f"{name:10} {row.label:22} found {sum(r['found'] for r in mine):2d}/{seeds} "
-              f"best {float(best[row.label].cost):8.2f} (optimum {optimum:.2f}, "
+              f"best {float(best[row.label].cost):8.2f} (optimum {problem.optimum:.2f}, "
               f"{time.perf_counter() - began:.0f} s)", flush=True)
     return rows, best
-
-
-def length_cell(runs: list[dict]) -> str:
-    """Mean cost over the runs that found a path ("n/a" if none did) and the found count."""
-    found = [r["cost"] for r in runs if r["found"]]
-    mean = f"{statistics.mean(found):.2f}" if found else "n/a"
-    return f"{mean} ({len(found)}/{len(runs)})"
-
-
-def optimal_cell(runs: list[dict]) -> str:
-    """How many of the runs reach the optimum (relative gap below ``OPTIMAL_GAP``)."""
-    return f"{sum(r['gap'] < OPTIMAL_GAP for r in runs)}/{len(runs)}"
-
-
-def time_cell(runs: list[dict]) -> str:
-    """Median wall time of one run, in ms."""
-    return f"{1e3 * statistics.median(r['seconds'] for r in runs):.2f}"
 
 
 def paper_cells(row: Row, maps: tuple[str, ...], paper: dict[str, dict[str, float | None]],
@@ -285,7 +174,7 @@ def table(rows: list[dict], maps: tuple[str, ...], *, seeds: int, iterations: in
         "",
         *half_table(rows, maps, length_cell, PAPER_TABLE1_LENGTH, lambda v: f"{v:.2f}"),
         "",
-        f"## Runs that reach the optimum (relative gap below {OPTIMAL_GAP:g}; not in the paper)",
+        f"## Runs that reach the optimum (relative gap below {SUCCESS_GAP:g}; not in the paper)",
         "",
         *half_table(rows, maps, optimal_cell),
         "",
@@ -293,20 +182,6 @@ def table(rows: list[dict], maps: tuple[str, ...], *, seeds: int, iterations: in
         "",
         *half_table(rows, maps, time_cell, PAPER_TABLE1_MS, str),
     ]) + "\n"
-
-
-def row_definitions(agents: int) -> dict[str, dict]:
-    """Row label -> what ran: the paper row it reproduces, and for a swarm its name, config and
-    the params used (JSON-ready)."""
-    definitions = {}
-    for row in ROWS:
-        entry = dict(paper=row.paper, planner=row.planner())
-        if row.swarm is not None:
-            swarm, params = row_swarm(row, agents)
-            entry.update(config=definition(swarm)["config"],
-                         params={k: float(v) for k, v in params._asdict().items()})
-        definitions[row.label] = entry
-    return definitions
 
 
 def figure(best: dict[str, dict[str, Solution]]) -> Figure:
@@ -319,22 +194,11 @@ def figure(best: dict[str, dict[str, Solution]]) -> Figure:
     Returns:
       The figure (close it with ``plt.close(fig)``).
     """
-    rows, columns = math.ceil(len(best) / 3), min(len(best), 3)
-    fig, axes = plt.subplots(rows, columns, figsize=(5 * columns, 5.9 * rows), squeeze=False,
-                             layout="constrained")
-    for ax in axes.flat[len(best):]:
-        ax.set_visible(False)
-    for (name, solutions), ax in zip(best.items(), axes.flat):
-        chosen = paper_map(name)
-        graph = chosen.graph()
-        draw_map(ax, graph, start=chosen.start, goal=chosen.goal, title=name)
-        # Thick lines first, so paths that coincide (Dijkstra and A*, or an optimal swarm) all show.
-        for thinner, (label, solution) in enumerate(solutions.items()):
-            cost = f"{float(solution.cost):.2f}" if bool(solution.found) else "no path"
-            draw_paths(ax, graph, [solution], [f"{label} ({cost})"],
-                       colors=[COLORS[label]], linewidth=5 - 0.55 * thinner)
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.03), ncols=2, frameon=False,
-                  fontsize="small")
+    fig, axes = panel_grid(len(best), columns=3, width=5, height=5.9)
+    for (name, solutions), ax in zip(best.items(), axes):
+        chosen = named_map(name)
+        draw_map(ax, chosen.graph, start=chosen.start, goal=chosen.goal, title=name)
+        draw_best_paths(ax, chosen.graph, solutions, thinning=0.55)
     fig.suptitle("Best path of each algorithm over the seeds (RFD paper, static environment)")
     return fig
 
@@ -347,12 +211,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--seeds", type=int, default=20, help="runs per map and algorithm")
     parser.add_argument("--iterations", type=int, default=100, help="iterations per swarm run")
     parser.add_argument("--agents", type=int, default=256, help="drops or ants per iteration")
-    parser.add_argument("--out", type=Path, default=Path("out/rfd_paper_static"),
-                        help="output folder (make reproduce: results/rfd_paper_table1)")
+    add_out_argument(parser, "rfd_paper_static", "rfd_paper_table1")
     args = parser.parse_args(argv)
-    for option in ("seeds", "iterations", "agents"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    check_counts(parser, args, "seeds", "iterations", "agents")
     record = provenance.begin(__file__, argv)
     rows, best = [], {}
     for name in args.maps:
@@ -364,9 +225,7 @@ def main(argv: list[str] | None = None) -> int:
     write_csv(args.out / "runs.csv", rows, COLUMNS)
     markdown = record.publish(args.out, table(rows, args.maps, seeds=args.seeds,
                                               iterations=args.iterations, agents=args.agents))
-    fig = figure(best)
-    save_png(fig, args.out / "best_paths.png")
-    plt.close(fig)
+    write_png(figure(best), args.out / "best_paths.png")
     print("\n" + markdown)
     return 0
 

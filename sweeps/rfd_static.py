@@ -1,14 +1,16 @@
 """RFD, RFD* and RFD graded on the nine paper maps, static environment (the RFD paper's Table 1
 set-up).
 
-Three rows per map: the RFD paper's RFD (``rfd``, eqs. 1-5) and RFD* (``rfd_star``, eq. 6 with the
-erosion of eqs. 4-5), and this project's own law ``rfd_graded`` (RFD*'s transitions over a graded
-river bed; registered as ``rfd_star`` until jaxswarm 0.2.0). Each runs with its default params once
-per seed (``--seeds``, default 20) for at most 100 iterations (``--iterations``; a run also stops
-when every drop follows the same path, and, if ``--patience`` is given, after that many iterations
-without improvement). Each run is jitted once per map and algorithm and then timed on its own
-(compile excluded). Reported per map and algorithm: the optimum (Dijkstra), the mean best length
-over the seeds, the success count (relative gap < 1e-4 to the optimum) and the median wall time
+Three rows per map, the three RFD rows of the RFD paper's Table 1 as
+:mod:`jaxswarm.studies.rfd_table1` runs them: the RFD paper's RFD (``rfd``, eqs. 1-5) and RFD*
+(``rfd_star``, eq. 6 with the erosion of eqs. 4-5), and this project's own law ``rfd_graded``
+(RFD*'s transitions over a graded river bed).
+Each runs with its default params once per seed (``--seeds``, default 20) for at most 100
+iterations (``--iterations``; a run also stops when every drop follows the same path, and, if
+``--patience`` is given, after that many iterations without improvement). Each run is jitted once
+per map and algorithm and then timed on its own (compile excluded). Reported per map and
+algorithm: the optimum (Dijkstra), the mean best length over the seeds, the success count
+(relative gap < 1e-4 to the optimum, :mod:`jaxswarm.studies.success`) and the median wall time
 of one run. Written to ``--out`` (default ``out/rfd_static``; ``make reproduce`` uses
 ``results/rfd_static``), each file atomically: ``runs.csv`` (one row per map, algorithm and
 seed), ``table.md`` (the provenance, then the table) and ``provenance.json``.
@@ -22,25 +24,23 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
-import jax
-
-from jaxswarm.exact import dijkstra
-from jaxswarm.maps.paper import paper_map, paper_maps_argument
+from jaxswarm.dynamic.events import first_iteration_at
+from jaxswarm.maps.paper import paper_maps_argument
 from jaxswarm.runtime.atomic import write_csv
-from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.studies import provenance
-
+from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.studies.problems import Problem, named_problem
+from jaxswarm.studies.rfd_table1 import BY_SWARM, run_swarm_row
+from jaxswarm.studies.success import SUCCESS_GAP, reaches_optimum, relative_gap
+from jaxswarm.studies.timing import median_milliseconds
+from jaxswarm.swarm import definition, make
 
 SOURCES = {"rfd": "RFD paper", "rfd_star": "RFD paper", "rfd_graded": "ours"}
 """Registered swarm -> where its algorithm comes from, in table order."""
 ALGORITHMS = tuple(SOURCES)
 """The registered swarms of the table, in order."""
-SUCCESS_GAP = 1e-4
-"""A run succeeds when its relative gap to the optimum is below this."""
 COLUMNS = ("map", "algorithm", "seed", "optimum", "cost", "gap", "success", "iterations",
            "first_optimal_iteration", "seconds", "moves", "lane_steps")
 """Columns of runs.csv (``moves``: the drops' moves in all iterations; ``lane_steps``: the
@@ -50,41 +50,28 @@ TITLE = "RFD, RFD* and RFD graded on the RFD paper's nine maps (static environme
 ABOUT = (
     "Rows: `rfd` (the RFD paper's RFD, eqs. 1-5) and `rfd_star` (the paper's RFD*: eq. 6 with "
     "the erosion of eqs. 4-5, as written) are the paper's algorithms; `rfd_graded` is ours, not "
-    "the paper's: RFD*'s transitions over a graded river bed (registered as `rfd_star` until "
-    "jaxswarm 0.2.0). Each runs with its default params; success means a best length within a "
-    "relative 1e-4 of the optimum (Dijkstra).")
+    "the paper's: RFD*'s transitions over a graded river bed. Each runs with its default "
+    "params; success means a best length within a relative 1e-4 of the optimum (Dijkstra).")
 """What the rows are (the paragraph under the provenance)."""
 
 
-def solve_map(name: str, algorithm: str, seeds: int, *, iterations: int, patience: int | None,
-              num_agents: int) -> list[dict]:
-    """Run ``algorithm`` on paper map ``name`` once per seed; one row per seed."""
-    chosen = paper_map(name)
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
-    optimum = dijkstra(graph, chosen.start, chosen.goal).cost
-    swarm = make(algorithm, num_agents=num_agents)
-
-    def one_run(key):
-        return run(swarm, key, graph, task, swarm.default_params, iterations=iterations,
-                   patience=patience)
-
-    keys = jax.random.split(jax.random.key(0), seeds)
-    jax.block_until_ready(one_run(keys[0]))  # compile
+def run_algorithm(problem: Problem, algorithm: str, seeds: int, *, iterations: int,
+                  patience: int | None, num_agents: int) -> list[dict]:
+    """Run ``algorithm`` (its Table 1 row) on ``problem`` once per seed; one row per seed."""
+    swarm, runs = run_swarm_row(BY_SWARM[algorithm], problem, seeds, iterations=iterations,
+                                agents=num_agents, patience=patience)
     rows = []
-    for seed, key in enumerate(keys):
-        began = time.perf_counter()
-        state, trace = jax.block_until_ready(one_run(key))
-        seconds = time.perf_counter() - began
-        cost = float(swarm.best(state).cost)
-        gap = (cost - optimum) / optimum
-        hits = [t + 1 for t, best in enumerate(trace.best_cost[: int(trace.iterations)].tolist())
-                if (best - optimum) / optimum < SUCCESS_GAP]
-        rows.append(dict(map=name, algorithm=algorithm, seed=seed, optimum=optimum, cost=cost,
-                         gap=gap, success=gap < SUCCESS_GAP, iterations=int(trace.iterations),
-                         moves=int(trace.moves.sum()), lane_steps=int(trace.lane_steps.sum()),
-                         first_optimal_iteration=hits[0] if hits else "",
-                         seconds=seconds))
+    for seed, one in enumerate(runs):
+        cost = float(swarm.best(one.state).cost)
+        gap = relative_gap(cost, problem.optimum)
+        first = first_iteration_at(one.trace, problem.optimum, gap=SUCCESS_GAP)
+        rows.append(dict(map=problem.label, algorithm=algorithm, seed=seed,
+                         optimum=problem.optimum, cost=cost, gap=gap,
+                         success=reaches_optimum(gap), iterations=int(one.trace.iterations),
+                         moves=int(one.trace.moves.sum()),
+                         lane_steps=int(one.trace.lane_steps.sum()),
+                         first_optimal_iteration="" if first is None else first,
+                         seconds=one.seconds))
     return rows
 
 
@@ -96,7 +83,7 @@ def summary_cells(runs: list[dict]) -> list[str]:
     if finite and len(finite) < len(runs):
         mean += f" ({len(finite)} found)"
     return [mean, f"{sum(r['success'] for r in runs)}/{len(runs)}",
-            f"{1e3 * statistics.median(r['seconds'] for r in runs):.0f}"]
+            f"{median_milliseconds(r['seconds'] for r in runs):.0f}"]
 
 
 def table(rows: list[dict], maps: tuple[str, ...]) -> str:
@@ -123,19 +110,17 @@ def main(argv: list[str] | None = None) -> int:
                         help="also stop after this many iterations without improvement "
                              "(default: never, the paper's plain 100 iterations)")
     parser.add_argument("--agents", type=int, default=256, help="drops per iteration")
-    parser.add_argument("--out", type=Path, default=Path("out/rfd_static"),
-                        help="output folder (make reproduce: results/rfd_static)")
+    add_out_argument(parser, "rfd_static")
     args = parser.parse_args(argv)
-    for option in ("seeds", "iterations", "agents"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option} must be at least 1, got {getattr(args, option)}")
+    check_counts(parser, args, "seeds", "iterations", "agents")
     record = provenance.begin(__file__, argv)
     rows = []
     for name in args.maps:
+        problem = named_problem(name)
         for algorithm in ALGORITHMS:
             began = time.perf_counter()
-            mine = solve_map(name, algorithm, args.seeds, iterations=args.iterations,
-                             patience=args.patience, num_agents=args.agents)
+            mine = run_algorithm(problem, algorithm, args.seeds, iterations=args.iterations,
+                                 patience=args.patience, num_agents=args.agents)
             rows += mine
             print(f"{name:10} {algorithm:10} success {sum(r['success'] for r in mine):2d}/"
                   f"{args.seeds} ({time.perf_counter() - began:.0f} s)", flush=True)

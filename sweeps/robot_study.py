@@ -6,8 +6,8 @@ Per map and seed, a world: the map the robot knows and ``--blocks`` hidden block
 robot meets them; passages with a thin wall on path maps, cells on the paper maps; fewer where
 no more keep the goal reachable, as on a perfect maze's single way, counted in ``blocks``).
 Path maps are the Max-Min ACO paper's sizes (10x10, 20x20, 40x25), one random map per seed
-(:func:`jaxswarm.maps.random.random_path_map`, map seed = seed), from the top-left cell to the
-bottom-right one; the paper maps are fixed, their blocks drawn per seed.
+(``pathmapWxH`` of :func:`jaxswarm.maps.named.named_map`, map seed = seed), from the top-left cell
+to the bottom-right one; the paper maps are fixed, their blocks drawn per seed.
 
 Rows: Improved Max-Min ACO as the paper has it (its pheromone kept at every re-plan, its Bug2-like
 first ant walking again from where the robot stands), the same with its memory wiped at every
@@ -36,30 +36,27 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import math
 import statistics
-import sys
 import time
-from pathlib import Path
 from typing import NamedTuple
 
-import jax
 import matplotlib
 
 matplotlib.use("Agg")
-from matplotlib import pyplot as plt
+from matplotlib.figure import Figure
 
 from jaxswarm.dynamic.events import Event
 from jaxswarm.dynamic.robot import check_world, dstar_robot, hidden_blocks, swarm_robot
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.random import random_path_map
-from jaxswarm.plot.graph import save_png
+from jaxswarm.maps.named import named_map
+from jaxswarm.maps.paper import PAPER_MAPS
 from jaxswarm.plot.robot import animate_robot, draw_robot
 from jaxswarm.runtime.atomic import write_csv
-from jaxswarm.swarm import definition, make, make_task
-from jaxswarm.world.graph import Graph, path_map_graph
 from jaxswarm.studies import provenance
-
+from jaxswarm.studies.arguments import add_out_argument, check_counts, names_argument
+from jaxswarm.studies.figures import panel_grid, write_png
+from jaxswarm.studies.timing import compile_then_time, median_milliseconds, seed_keys
+from jaxswarm.swarm import definition, make, make_task
+from jaxswarm.world.graph import Graph
 
 
 class Row(NamedTuple):
@@ -76,18 +73,22 @@ ROWS = (Row("Improved Max-Min ACO (paper: pheromone kept)", "improved_max_min_ac
         Row("RFD* (paper)", "rfd_star"),
         Row("RFD graded (ours)", "rfd_graded"),
         Row("D* Lite (repair)", None))
-PATH_MAPS = {"pathmap10x10": (10, 10), "pathmap20x20": (20, 20), "pathmap40x25": (40, 25)}
-"""The Max-Min ACO paper's sizes (width, height)."""
+"""The planners, in table order; the first is drawn."""
+PATH_MAPS = ("pathmap10x10", "pathmap20x20", "pathmap40x25")
+"""Random path maps of the Max-Min ACO paper's sizes."""
 MAPS = (*PATH_MAPS, *PAPER_MAPS)
+"""The maps ``--maps all`` names."""
 COLUMNS = ("map", "algorithm", "planner", "memory", "seed", "blocks", "optimum", "travelled",
            "ratio", "reached", "plans", "iterations", "moves", "seconds")
 """Columns of runs.csv (``ratio``: travelled / optimum; ``seconds``: planning time)."""
 TITLE = "The robot that finds blocked paths as it goes (Max-Min ACO paper, Algorithm 1)"
+"""Title of table.md."""
 ABOUT = ("\"Improved Max-Min ACO (paper: pheromone kept)\" is the Max-Min ACO paper's planner and "
          "re-planning rule; \"(memory wiped)\" is the same with fresh pheromone at every "
          "re-plan, the paper's point of comparison. \"RFD* (paper)\" is the RFD paper's RFD*, "
          "its altitudes kept by the RFD paper's rule; \"RFD graded (ours)\" is this project's "
          "river law with its own memory rule; \"D* Lite (repair)\" is not in the paper.")
+"""What the rows are (the paragraph under the provenance)."""
 
 
 class World(NamedTuple):
@@ -102,14 +103,8 @@ class World(NamedTuple):
 
 
 def world(name: str, seed: int, blocks: int) -> World:
-    """The world of map ``name`` (a path map size or a paper map) for ``seed``."""
-    if name in PATH_MAPS:
-        width, height = PATH_MAPS[name]
-        known = path_map_graph(random_path_map(width, height, seed))
-        start, goal = (0, 0), (width - 1, height - 1)
-    else:
-        chosen = paper_map(name)
-        known, start, goal = chosen.graph(), chosen.start, chosen.goal
+    """The world of map ``name`` (a path map, drawn by ``seed``, or a paper map) for ``seed``."""
+    _, known, start, goal = named_map(name, seed=seed)
     for count in range(blocks, 0, -1):  # a perfect maze's way may hold fewer detours
         try:
             hidden = hidden_blocks(known, start, goal, count=count, seed=seed)
@@ -130,17 +125,14 @@ def run_row(row: Row, worlds: list[World], *, iterations: int, patience: int,
         return runs[1:]  # the first compiled the kernels
     swarm = make(row.swarm)
 
-    def one(w, key):
-        task = make_task(w.known, w.start, w.goal)
-        began = time.perf_counter()
-        walk = jax.block_until_ready(swarm_robot(
-            swarm, key, w.known, task, w.hidden, swarm.default_params, iterations=iterations,
-            patience=patience, max_plans=max_plans, memory=row.memory))
-        return walk, time.perf_counter() - began
+    def walk(world_task_key):
+        w, task, key = world_task_key
+        return swarm_robot(swarm, key, w.known, task, w.hidden, swarm.default_params,
+                           iterations=iterations, patience=patience, max_plans=max_plans,
+                           memory=row.memory)
 
-    keys = jax.random.split(jax.random.key(0), len(worlds))
-    one(worlds[0], keys[0])  # compile
-    return [one(w, key) for w, key in zip(worlds, keys)]
+    return compile_then_time(walk, [(w, make_task(w.known, w.start, w.goal), key)
+                                    for w, key in zip(worlds, seed_keys(len(worlds)))])
 
 
 def study_map(name: str, *, seeds: int, blocks: int, **options) -> tuple[list[dict], dict]:
@@ -187,7 +179,7 @@ def map_table(rows: list[dict], name: str, blocks: int) -> list[str]:
         lines.append(
             f"| {row.label} | {sum(r['reached'] for r in runs)}/{len(runs)} | {ratio} | "
             f"{statistics.mean(r['plans'] for r in runs):.2f} | "
-            f"{1e3 * statistics.median(r['seconds'] for r in runs):.2f} | "
+            f"{median_milliseconds(r['seconds'] for r in runs):.2f} | "
             + (f"{statistics.mean(r['iterations'] for r in runs):.1f} |" if row.swarm else "- |"))
     return lines
 
@@ -227,17 +219,12 @@ def markdown(rows: list[dict], maps, args) -> str:
     return "\n".join(parts) + "\n"
 
 
-def walks_figure(examples: dict) -> plt.Figure:
-    """Seed 0's walk of the first row on every map."""
-    names = list(examples)
-    columns = min(len(names), 4)
-    rows = math.ceil(len(names) / columns)
-    fig, axes = plt.subplots(rows, columns, figsize=(4.5 * columns, 5.2 * rows), squeeze=False,
-                             layout="constrained")
-    for ax in axes.flat[len(names):]:
-        ax.set_visible(False)
+def walks_figure(examples: dict) -> Figure:
+    """Seed 0's walk of the first row on every map (``examples``: map -> row label -> (World,
+    walk)), four maps a row."""
+    fig, axes = panel_grid(len(examples), columns=4, width=4.5, height=5.2)
     label = ROWS[0].label
-    for name, ax in zip(names, axes.flat):
+    for name, ax in zip(examples, axes):
         w, walk = examples[name][label]
         draw_robot(ax, w.known, w.hidden, walk, start=w.start, goal=w.goal,
                    title=f"{name}: {float(walk.travelled):.2f} (optimum {w.optimum:.2f})")
@@ -248,23 +235,17 @@ def walks_figure(examples: dict) -> plt.Figure:
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--maps", default="all",
+    parser.add_argument("--maps", type=names_argument(MAPS), default="all",
                         help=f"comma-separated, from {', '.join(MAPS)} (default all)")
     parser.add_argument("--seeds", type=int, default=20)
     parser.add_argument("--blocks", type=int, default=2, help="hidden blocks per world")
     parser.add_argument("--iterations", type=int, default=100, help="iterations per plan")
     parser.add_argument("--patience", type=int, default=30)
     parser.add_argument("--max-plans", type=int, default=8)
-    parser.add_argument("--out", type=Path, default=Path("out/robot_study"))
+    add_out_argument(parser, "robot_study")
     args = parser.parse_args(argv)
-    maps = MAPS if args.maps == "all" else tuple(args.maps.split(","))
-    unknown = [m for m in maps if m not in MAPS]
-    if unknown:
-        parser.error(f"--maps: unknown {', '.join(unknown)}; choose from {', '.join(MAPS)}")
-    for option in ("seeds", "blocks", "iterations", "patience", "max_plans"):
-        if getattr(args, option) < 1:
-            parser.error(f"--{option.replace('_', '-')} must be at least 1, "
-                         f"got {getattr(args, option)}")
+    maps = args.maps
+    check_counts(parser, args, "seeds", "blocks", "iterations", "patience", "max_plans")
     record = provenance.begin(__file__, argv)
     rows, examples = [], {}
     for name in maps:
@@ -277,9 +258,7 @@ def main(argv: list[str] | None = None) -> int:
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args), swarms=swarms)
     write_csv(args.out / "runs.csv", rows, COLUMNS)
     text = record.publish(args.out, markdown(rows, maps, args))
-    fig = walks_figure(examples)
-    save_png(fig, args.out / "walks.png")
-    plt.close(fig)
+    write_png(walks_figure(examples), args.out / "walks.png")
     shown = "pathmap20x20" if "pathmap20x20" in maps else maps[0]
     w, walk = examples[shown][ROWS[0].label]
     animate_robot(w.known, w.hidden, walk, args.out / "robot.gif", start=w.start, goal=w.goal,

@@ -2,11 +2,15 @@ import os
 from pathlib import Path
 
 import pytest
+from golden.isa import cap_isa
 
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
 # Where the library looks for Moving AI maps named in sweep specs (it never guesses a folder).
 os.environ.setdefault("JAXSWARM_MOVINGAI", str(MOVINGAI))
+# The golden records hold bit for bit only for one set of vector instructions (golden/isa.py); the
+# scripts and notebooks the tests start inherit the setting.
+cap_isa()
 
 
 @pytest.fixture(scope="session")

@@ -81,7 +81,7 @@ def test_improved_max_min_starts_from_its_first_ants_path_and_keeps_the_floor(fi
     assert bool(is_valid_path(graph, state.best_path, task.start, task.goal))
     assert len(set(nodes.tolist())) == len(nodes)  # its memory: no node twice
     assert float(state.best_cost) == pytest.approx(float(path_length(graph, state.best_path)))
-    if first_ant == "greedy":  # the deterministic depth-first ant of 0.1.0
+    if first_ant == "greedy":  # a deterministic depth-first ant
         path, cost, _ = bug2_path(graph, task.start, task.goal)
         np.testing.assert_array_equal(nodes, np.asarray(path)[: len(nodes)])
     # Algorithm 1: nothing is deposited before the first population has walked.

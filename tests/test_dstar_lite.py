@@ -75,7 +75,7 @@ def test_random_edit_sequences_on_directed_general_graphs(seed):
     random_edits(rng, graph, replanner(graph, start, goal), start, goal, steps=25)
 
 
-@pytest.mark.slow  # the default suite keeps under ten minutes
+@pytest.mark.slow  # every edit sequence on two large maps
 @pytest.mark.parametrize("name", ["den312d", "maze-32-32-4"])
 def test_random_edit_sequences_on_movingai_maps(movingai_dir, name):
     graph = load_map(MOVINGAI / "mapf" / f"{name}.map")

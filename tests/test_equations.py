@@ -1,4 +1,4 @@
-"""Every transition rule and every memory update against a hand computation (issue 18).
+"""Every transition rule and every memory update against a hand computation.
 
 The maps are 3 x 3 grids (nodes ``y * 3 + x``, 8-connected, diagonals sqrt 2, no corner
 cutting; slot order E S W N SE SW NW NE) or small variants with obstacles. Expected numbers are

@@ -117,7 +117,7 @@ def test_notebooks_are_stored_without_outputs():
                     f"{path.name}: clear the outputs before committing")
 
 
-@pytest.mark.slow  # about 50 s of compiles; the default suite keeps under ten minutes
+@pytest.mark.slow  # about 50 s of compiles
 def test_quickstart(notebook_env):
     nb = execute("quickstart.ipynb")
     checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
@@ -165,7 +165,7 @@ def test_sweep_analysis(notebook_env):
     assert count_images(nb) >= 6  # heat maps, lines, the PNG shown, and one replay per map
 
 
-@pytest.mark.slow  # about a minute; the default suite keeps under ten
+@pytest.mark.slow  # about a minute of compiles
 def test_dynamic(notebook_env):
     nb = execute("dynamic.ipynb")
     checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]

@@ -15,7 +15,7 @@ from jaxswarm.world.graph import grid_graph
 
 @pytest.mark.parametrize("name", [
     "mosaic20",
-    pytest.param("alley20", marks=pytest.mark.slow),  # the default suite keeps under ten minutes
+    pytest.param("alley20", marks=pytest.mark.slow),
     pytest.param("maze20", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("table", [2, 3, 4, 5])
 def test_scenarios_change_the_optimum_as_described(name, table):

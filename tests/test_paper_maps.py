@@ -1,4 +1,5 @@
-"""The RFD paper's maps (jaxswarm.maps.paper), checked against scipy's Dijkstra as an oracle."""
+"""The RFD paper's maps (jaxswarm.maps.paper), checked against scipy's Dijkstra as an oracle, and
+the names that pick a map (jaxswarm.maps.named)."""
 import functools
 import math
 import re
@@ -8,6 +9,7 @@ import pytest
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from jaxswarm.maps.named import MAP_FILE, PAPER, PATH_MAP, map_kind, named_map
 from jaxswarm.maps.paper import (PAPER_MAPS, PAPER_OPTIMA, PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS,
                                  PaperMap, paper_map, paper_map_names)
 
@@ -149,3 +151,34 @@ def test_table1_transcription():
     assert PAPER_TABLE1_LENGTH["A*"] == PAPER_TABLE1_LENGTH["RFD*"] == PAPER_OPTIMA
     assert PAPER_TABLE1_MS["RFD*"]["alley100"] == 5934.1
     assert PAPER_TABLE1_MS["ACO"]["mosaic100"] == 131071.05
+
+
+@pytest.mark.parametrize("name, kind", [
+    ("maze100", PAPER), ("pathmap40x25", PATH_MAP), ("maps/den312d.map", MAP_FILE),
+    ("maze30", None), ("pathmap40", None), ("pathmap40x25.png", None)])
+def test_a_name_says_which_kind_of_map_it_picks(name, kind):
+    assert map_kind(name) == kind
+
+
+def test_a_named_paper_map_is_the_paper_map_unless_its_endpoints_are_given():
+    named, chosen = named_map("alley20"), paper_map("alley20")
+    assert (named.label, named.start, named.goal) == ("alley20", chosen.start, chosen.goal)
+    assert np.array_equal(np.asarray(named.graph.free), ~chosen.obstacles.ravel())
+    assert named_map("alley20", start=(4, 9), goal=(15, 9))[2:] == ((4, 9), (15, 9))
+
+
+def test_a_path_map_name_gives_its_size_its_corners_and_its_seed_the_walls():
+    named = named_map("pathmap12x7", seed=3)
+    assert (named.label, named.graph.shape, named.start, named.goal) == (
+        "pathmap12x7", (7, 12), (0, 0), (11, 6))
+    assert np.array_equal(named_map("pathmap12x7", seed=3).graph.open, named.graph.open)
+    assert not np.array_equal(named_map("pathmap12x7", seed=4).graph.open, named.graph.open)
+
+
+@pytest.mark.parametrize("name, endpoints, message", [
+    ("atlantis", {}, "--map must be one of mosaic20, "),
+    ("nosuch.map", dict(start=(1, 1), goal=(2, 2)), "--map nosuch.map: no such file"),
+    ("nosuch.map", dict(start=(1, 1)), "--start and --goal are required with a .map file")])
+def test_a_bad_name_is_an_error_naming_the_option(name, endpoints, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        named_map(name, **endpoints)

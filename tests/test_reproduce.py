@@ -1,8 +1,11 @@
-"""The reproduction of results/: the shared provenance helper (jaxswarm.studies.provenance), every table
-script's provenance header at a tiny size, the path-map table beside the Max-Min ACO paper's
-(sweeps/aco_pathmaps.py), the results index, and the Makefile's reproduce targets."""
+"""The reproduction of results/: what the table scripts share (jaxswarm.studies: provenance,
+argument checks, timed runs, the success rule), every table script's provenance header at a tiny
+size, the path-map table beside the Max-Min ACO paper's (sweeps/aco_pathmaps.py), the results
+index, and the Makefile's reproduce targets."""
 from __future__ import annotations
 
+import argparse
+import ast
 import csv
 import importlib.metadata
 import json
@@ -21,7 +24,12 @@ import pytest
 
 from repo_scripts import ROOT, load_script
 
+import jaxswarm.sweep
 from jaxswarm.studies import provenance
+from jaxswarm.studies.arguments import check_counts, names_argument, numbers_argument
+from jaxswarm.studies.success import SUCCESS_GAP, at_optimum
+from jaxswarm.studies.timing import compile_then_time, median_milliseconds, seed_keys
+
 pathmaps = load_script("sweeps/aco_pathmaps.py")
 robot_study = load_script("sweeps/robot_study.py")
 
@@ -389,3 +397,71 @@ def test_the_quick_target_runs(tmp_path):
     for name in TINY:
         assert provenance.load(tmp_path / name)["seconds"] > 0
         assert (tmp_path / name / "table.md").read_text(encoding="utf-8").startswith("# ")
+
+
+def test_no_function_of_a_script_is_longer_than_60_lines():
+    long = []
+    for script in sorted((ROOT / "sweeps").glob("*.py")):
+        for node in ast.walk(ast.parse(script.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                lines = node.end_lineno - node.lineno + 1
+                if lines > 60:
+                    long.append(f"{script.name}:{node.lineno} {node.name}: {lines} lines")
+    assert not long, "\n".join(long)
+
+
+def test_scripts_reach_the_package_without_editing_sys_path():
+    for script in sorted((ROOT / "sweeps").glob("*.py")):
+        assert "sys.path" not in script.read_text(encoding="utf-8"), script.name
+
+
+def test_a_count_below_one_stops_the_script_naming_the_option(capsys):
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--max-plans", type=int)
+    with pytest.raises(SystemExit) as exit_info:
+        check_counts(parser, parser.parse_args(["--max-plans", "0"]), "max_plans")
+    assert exit_info.value.code == 2
+    assert "--max-plans must be at least 1, got 0" in capsys.readouterr().err
+
+
+def test_number_lists_are_sorted_once_each_and_checked():
+    numbers = numbers_argument(range(1, 8))
+    assert numbers("4,1,4") == [1, 4]
+    for bad in ("0", "1,8", "1,x", ""):
+        with pytest.raises(argparse.ArgumentTypeError, match="expected numbers from 1, 2, "):
+            numbers(bad)
+
+
+def test_name_lists_keep_their_order_and_name_the_unknown():
+    names = names_argument(("map1", "map2", "map3"))
+    assert names("all") == ("map1", "map2", "map3")
+    assert names("map3, map1,map3") == ("map3", "map1")
+    with pytest.raises(argparse.ArgumentTypeError, match="unknown map9; choose from all or map1"):
+        names("map1,map9")
+    with pytest.raises(argparse.ArgumentTypeError, match="no name given"):
+        names(",")
+
+
+def test_success_is_the_sweeps_rule():
+    assert SUCCESS_GAP is jaxswarm.sweep.SUCCESS_GAP
+    assert at_optimum(10 * (1 + SUCCESS_GAP / 2), 10.0)
+    assert not at_optimum(10 * (1 + 2 * SUCCESS_GAP), 10.0)
+    assert not at_optimum(math.inf, 10.0)
+
+
+def test_the_first_input_runs_once_more_to_compile_and_every_run_is_timed():
+    calls = []
+
+    def double(value):
+        calls.append(value)
+        return 2 * value
+
+    timed = compile_then_time(double, [3, 5])
+    assert [result for result, _ in timed] == [6, 10] and calls == [3, 3, 5]
+    assert all(seconds >= 0 for _, seconds in timed)
+    assert median_milliseconds([0.001, 0.003, 0.002]) == pytest.approx(2.0)
+
+
+def test_seed_keys_split_the_seed_key():
+    assert (jax.random.key_data(seed_keys(3, seed=7))
+            == jax.random.key_data(jax.random.split(jax.random.key(7), 3))).all()

@@ -1,6 +1,6 @@
-"""The RFD paper's Table 1 script (sweeps/rfd_paper_static.py) at a tiny size: its files, its rows
-(both variants of ACO and of RFD*), the costs it reports, the best paths it draws, its provenance
-and its transcription of the paper."""
+"""The RFD paper's Table 1 script (sweeps/rfd_paper_static.py) at a tiny size, with the rows it
+runs (jaxswarm.studies.rfd_table1): its files, its rows (both variants of ACO and of RFD*), the
+costs it reports, the best paths it draws, its provenance and its transcription of the paper."""
 from __future__ import annotations
 
 import csv
@@ -12,6 +12,8 @@ import numpy as np
 import pytest
 
 from jaxswarm.maps.paper import PAPER_TABLE1_LENGTH, PAPER_TABLE1_MS, paper_map
+from jaxswarm.studies import rfd_table1
+from jaxswarm.studies.success import SUCCESS_GAP
 from jaxswarm.world.paths import as_node, is_valid_path, path_length
 from repo_scripts import load_script
 
@@ -50,7 +52,7 @@ def rows(out):
 def test_one_row_per_algorithm_and_seed(rows):
     assert sorted((r["map"], r["algorithm"], int(r["seed"])) for r in rows) == sorted(
         (MAP, a, s) for a in (*EXACT, *SWARMS) for s in range(SEEDS))
-    assert script.ALGORITHMS == (*EXACT, *SWARMS)  # the paper's order, variants after
+    assert rfd_table1.ALGORITHMS == (*EXACT, *SWARMS)  # the paper's order, variants after
     for r in rows:
         assert float(r["seconds"]) > 0
         assert r["planner"] == (SWARMS[r["algorithm"]][0] if r["algorithm"] in SWARMS
@@ -101,7 +103,7 @@ def test_markdown_counts_the_runs_that_reach_the_optimum(out, rows):
     lines = (out / "table.md").read_text(encoding="utf-8").splitlines()
     section = lines.index(next(line for line in lines if line.startswith("## Runs that reach")))
     for algorithm in (*EXACT, *SWARMS):
-        optimal = sum(float(r["gap"]) < script.OPTIMAL_GAP for r in rows
+        optimal = sum(float(r["gap"]) < SUCCESS_GAP for r in rows
                       if r["algorithm"] == algorithm)
         line = next(line for line in lines[section:]
                     if line.startswith(f"| {algorithm} | ours | "))
@@ -124,17 +126,18 @@ def test_markdown_and_json_carry_the_provenance(out):
 
 
 def test_a_row_without_a_paper_counterpart_shows_a_dash():
-    mine = script.Row("ours only", None, "rfd_graded")
+    mine = rfd_table1.Row("ours only", None, "rfd_graded")
     assert script.paper_cells(mine, ("mosaic20", "alley20"), PAPER_TABLE1_LENGTH, str) == [
         "-", "-"]
     # A paper row with no value (the paper's ACO found no path on maze20) shows n/a.
-    assert script.paper_cells(script.BY_LABEL["ACO with eta (beta=1)"], ("mosaic20", "maze20"),
-                              PAPER_TABLE1_LENGTH, str) == ["51.68", "n/a"]
+    eta = rfd_table1.BY_LABEL["ACO with eta (beta=1)"]
+    assert script.paper_cells(eta, ("mosaic20", "maze20"), PAPER_TABLE1_LENGTH, str) == [
+        "51.68", "n/a"]
 
 
 def test_the_eta_row_runs_ant_system_with_beta_one():
-    plain_swarm, plain = script.row_swarm(script.BY_LABEL["ACO (paper, eq. 7)"], 8)
-    eta_swarm, eta = script.row_swarm(script.BY_LABEL["ACO with eta (beta=1)"], 8)
+    plain_swarm, plain = rfd_table1.row_swarm(rfd_table1.BY_LABEL["ACO (paper, eq. 7)"], 8)
+    eta_swarm, eta = rfd_table1.row_swarm(rfd_table1.BY_LABEL["ACO with eta (beta=1)"], 8)
     assert eta_swarm is plain_swarm and plain == plain_swarm.default_params
     assert float(plain.beta) == 0.0 and float(eta.beta) == 1.0
     assert eta._replace(beta=plain.beta) == plain
@@ -154,7 +157,7 @@ def test_best_paths_are_valid_and_match_the_rows(out):
     chosen = paper_map(MAP)
     graph = chosen.graph()
     start, goal = (as_node(graph, p) for p in (chosen.start, chosen.goal))
-    assert list(best) == list(script.ALGORITHMS)
+    assert list(best) == list(rfd_table1.ALGORITHMS)
     for algorithm, solution in best.items():
         costs = [r["cost"] for r in rows if r["algorithm"] == algorithm]
         assert float(solution.cost) == min(costs)
@@ -168,9 +171,10 @@ def test_best_paths_are_valid_and_match_the_rows(out):
 
 def test_every_row_has_the_papers_values_beside_it():
     assert list(PAPER_TABLE1_LENGTH) == list(PAPER_TABLE1_MS)
-    assert [row.paper for row in script.ROWS] == [
+    assert [row.paper for row in rfd_table1.ROWS] == [
         "Dijkstra", "A*", *(paper for _, paper in SWARMS.values())]
-    assert set(PAPER_TABLE1_LENGTH) == {row.paper for row in script.ROWS}  # no paper row left out
+    # No paper row left out.
+    assert set(PAPER_TABLE1_LENGTH) == {row.paper for row in rfd_table1.ROWS}
 
 
 @pytest.mark.parametrize("argv, message", [

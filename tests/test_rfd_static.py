@@ -11,6 +11,7 @@ import pytest
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.studies.success import SUCCESS_GAP
 from repo_scripts import load_script
 
 MAP, SEEDS, ITERATIONS, AGENTS = "maze20", 2, 4, 16
@@ -42,7 +43,7 @@ def test_rows_carry_the_dijkstra_optimum_and_a_consistent_gap(out):
         assert cost >= optimum * (1 - 1e-6)  # no drop beats Dijkstra
         if math.isfinite(cost):
             assert gap == pytest.approx((cost - optimum) / optimum, abs=1e-9)
-        assert (r["success"] == "True") == (gap < script.SUCCESS_GAP)
+        assert (r["success"] == "True") == (gap < SUCCESS_GAP)
         assert 1 <= int(r["iterations"]) <= ITERATIONS
         first = r["first_optimal_iteration"]
         assert (first != "") == (r["success"] == "True")

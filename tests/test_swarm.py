@@ -49,8 +49,8 @@ def world_of(name, maze, field):
 SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd",
                     "iwd_pg"}
 """Swarms whose heavier conformance checks (reproducible under vmap, compiled once for a sweep)
-run with the slow checks, to keep the default suite under ten minutes; rfd_star, rfd_graded
-and aco_star's, and every swarm's validity check but IWD_PG's, stay in it."""
+run with the slow checks (their compiles are the default suite's longest); rfd_star,
+rfd_graded and aco_star's, and every swarm's validity check but IWD_PG's, stay in it."""
 
 SLOW_VALIDITY = {"iwd_pg"}
 """Swarms whose validity check runs with the slow checks too: IWD_PG compiles its local

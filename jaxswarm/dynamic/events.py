@@ -161,7 +161,8 @@ def change(swarm: Swarm, state, event: Event, graph: Graph, task: Task, params):
     """Apply ``event``: ``(state, graph, task)`` after it, the swarm's memory adapted by its rule
     and a best path the event made invalid forgotten (jittable, vmappable over events).
 
-    Check events on the host first (:func:`check_events`); :func:`run` does not."""
+    Check events on the host first (:func:`check_events`); :func:`~jaxswarm.swarm.core.run` does
+    not."""
     after, new_task = apply_event(event, graph, task)
     state = swarm.adapt(state, graph, after, task, new_task, params)
     return forget_invalid_best(state, after, new_task), after, new_task

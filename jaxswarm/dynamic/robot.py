@@ -9,10 +9,10 @@ thin wall) it does not know. Until it stands on the goal, or ``max_plans`` plans
    diagonal squeezes between, the passage); if the move is blocked in the world it stays on the
    node before and adds what it saw to its map (:func:`walk_plan`);
 3. re-plan from there, keeping memory: a swarm's memory rule adapts it to the new start and the
-   new blocks (:func:`jaxswarm.dynamic.events.change`: Improved Max-Min ACO keeps its pheromone and its
-   Bug2-like first ant walks again, RFD keeps its altitudes, ...) and its run continues; D* Lite
-   repairs its search. ``memory="wipe"`` starts every plan from fresh memory instead, to measure
-   what keeping it buys.
+   new blocks (:func:`jaxswarm.dynamic.events.change`: Improved Max-Min ACO keeps its pheromone
+   and its Bug2-like first ant walks again, RFD keeps its altitudes, ...) and its run continues; D*
+   Lite repairs its search. ``memory="wipe"`` starts every plan from fresh memory instead, to
+   measure what keeping it buys.
 
 :func:`swarm_robot` is one jitted program (vmap it over keys, maps of one shape, tasks and
 hidden blocks); :func:`dstar_robot` runs D* Lite on the host. Both return a :class:`RobotWalk`;
@@ -46,8 +46,9 @@ class Leg(NamedTuple):
       stop: i32[] index into the plan of the node the robot stands on afterwards.
       reached: bool[] it stands on the plan's last node (the goal).
       length: f32[] the length it walked.
-      seen: the :class:`Event` of what it found (``start`` where it stands, ``block`` i32[3]
-        cells, ``close`` i32[1, 2] passage; all -1 when the plan was not blocked).
+      seen: the :class:`~jaxswarm.dynamic.events.Event` of what it found (``start`` where it
+        stands, ``block`` i32[3] cells, ``close`` i32[1, 2] passage; all -1 when the plan was not
+        blocked).
     """
 
     stop: jax.Array
@@ -68,7 +69,8 @@ class RobotWalk(NamedTuple):
       trajectory: i32[P * (L - 1) + 1] the nodes it stood on, in order, -1 padded.
       plan_paths: i32[P, L] each plan's path from where the robot stood, -1 padded (all -1 for
         a plan not made, or one that found no path).
-      seen: :class:`Event` with a leading axis P: what it found at the end of each plan.
+      seen: :class:`~jaxswarm.dynamic.events.Event` with a leading axis P: what it found at the
+        end of each plan.
     """
 
     reached: jax.Array
@@ -301,7 +303,8 @@ def hidden_blocks(known: Graph, start, goal, *, count: int, seed: int,
         without obstacle cells (thin-wall path maps).
 
     Returns:
-      An :class:`Event` with ``block`` (cells) or ``close`` (passages) of ``count`` entries.
+      An :class:`~jaxswarm.dynamic.events.Event` with ``block`` (cells) or ``close`` (passages)
+      of ``count`` entries.
 
     Raises:
       ValueError: fewer than ``count`` places keep the goal reachable.

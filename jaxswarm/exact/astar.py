@@ -22,7 +22,8 @@ def astar(graph: Graph, start, goal, *, heuristic: str | None = None,
       max_len: length L of the padded path buffer (default N).
 
     Returns:
-      Solution with path i32[L], cost f64[], found bool[], stats (:class:`SearchStats`).
+      Solution with path i32[L], cost f64[], found bool[], stats
+      (:class:`~jaxswarm.exact.stats.SearchStats`).
 
     Raises:
       ValueError: start or goal off the map or blocked; unknown heuristic.

@@ -29,8 +29,8 @@ class Lengths(NamedTuple):
     Attributes:
       cost: f64[Q] shortest-path lengths (inf where the goal cannot be reached).
       found: bool[Q] whether each goal was reached.
-      stats: :class:`SearchStats` with i64[Q] ``iterations``, ``expanded`` and ``generated``
-        per query and ``wall_time`` the seconds of the whole batch.
+      stats: :class:`~jaxswarm.exact.stats.SearchStats` with i64[Q] ``iterations``, ``expanded``
+        and ``generated`` per query and ``wall_time`` the seconds of the whole batch.
     """
 
     cost: np.ndarray

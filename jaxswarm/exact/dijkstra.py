@@ -17,7 +17,8 @@ def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Soluti
 
     Returns:
       Solution with path i32[L] (-1 padded), cost f64[] (inf if unreachable), found bool[] and
-      ``stats`` (:class:`SearchStats`). An unreachable goal gives ``found=False``.
+      ``stats`` (:class:`~jaxswarm.exact.stats.SearchStats`). An unreachable goal gives
+      ``found=False``.
 
     Raises:
       ValueError: start or goal off the map or blocked.
@@ -27,8 +28,8 @@ def dijkstra(graph: Graph, start, goal, *, max_len: int | None = None) -> Soluti
 
 def optimal_length(graph: Graph, start, goal) -> float:
     """The optimum as the swarms measure their paths: Dijkstra's shortest path, its length
-    summed in float32 by :func:`jaxswarm.world.paths.path_length` (moves counted by kind on grids and
-    path maps). A swarm path is never shorter, so a gap to it is never negative; inf where the
+    summed in float32 by :func:`jaxswarm.world.paths.path_length` (moves counted by kind on grids
+    and path maps). A swarm path is never shorter, so a gap to it is never negative; inf where the
     goal cannot be reached.
 
     Raises:

@@ -50,8 +50,8 @@ def replanner(graph: Graph, start, goal, *, heuristic: str | None = None,
       max_len: length L of the returned paths' buffers (default N).
 
     Returns:
-      A :class:`DStarLite`; call ``solve()`` for the first Solution and ``update(...)`` after
-      every change.
+      A :class:`~jaxswarm.exact.dstar_lite.DStarLite`; call ``solve()`` for the first Solution
+      and ``update(...)`` after every change.
 
     Raises:
       ValueError: start or goal off the map or blocked; unknown heuristic.

@@ -3,7 +3,7 @@
 numba because a priority-queue search is a scalar loop with data-dependent branches: XLA has no
 fast form of it, and a pure-Python heap spends most of its time in the interpreter (7-9 ms per A*
 query on a 128 x 128 maze where a C++ A* takes 0.3 ms). The loops are written over plain arrays
-(:class:`~jaxswarm.exact._host.EdgeArrays`, a :class:`~jaxswarm.exact.search.Workspace`), so a
+(``jaxswarm.exact._host.EdgeArrays``, a :class:`~jaxswarm.exact.search.Workspace`), so a
 batch of queries reuses its buffers and pays no Python per node.
 
 The indexed binary heap orders entries by ``(f, -g, node)`` exactly as the readable heapq planners

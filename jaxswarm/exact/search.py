@@ -2,7 +2,7 @@
 
 A :class:`Workspace` holds the per-node labels and heaps of one map's searches. Its labels are
 valid where ``seen`` equals the current stamp, so a new query starts by taking a new stamp instead
-of clearing N entries. Workspaces are cached per :class:`~jaxswarm.exact._host.EdgeArrays` (per
+of clearing N entries. Workspaces are cached per ``jaxswarm.exact._host.EdgeArrays`` (per
 map), and are not shared between threads: a search from another thread gets its own.
 """
 from __future__ import annotations
@@ -22,8 +22,8 @@ from jaxswarm.world.paths import Solution, as_node
 
 
 def side_buffers(arrays: EdgeArrays) -> tuple:
-    """Labels and heap of one search direction, as :func:`kernels.best_first` takes them:
-    ``(g f64[N], parent i32[N], seen i32[N], heap f64[N + 1, 3], position i32[N])``."""
+    """Labels and heap of one search direction, as :func:`~jaxswarm.exact.kernels.best_first`
+    takes them: ``(g f64[N], parent i32[N], seen i32[N], heap f64[N + 1, 3], position i32[N])``."""
     n = arrays.num_nodes
     return (np.empty(n), np.full(n, -1, np.int32), np.zeros(n, np.int32), np.empty((n + 1, 3)),
             np.full(n, -1, np.int32))
@@ -89,7 +89,8 @@ def _node(graph: Graph, arrays: EdgeArrays, point, name: str) -> int:
 
 def best_first_search(graph: Graph, start, goal, *, heuristic: str | None,
                       max_len: int | None) -> Solution:
-    """A* with ``heuristic`` (``"zero"``: Dijkstra) as a Solution with :class:`SearchStats`."""
+    """A* with ``heuristic`` (``"zero"``: Dijkstra) as a Solution with
+    :class:`~jaxswarm.exact.stats.SearchStats`."""
     arrays = edge_arrays(graph)
     source, target = endpoints(graph, arrays, start, goal)
     kind = heuristic_code(default_heuristic(graph, heuristic))
@@ -105,7 +106,7 @@ def best_first_search(graph: Graph, start, goal, *, heuristic: str | None,
 def bidirectional_search(graph: Graph, start, goal, *, heuristic: str | None,
                          max_len: int | None, balanced: bool) -> Solution:
     """Bidirectional A* (``balanced``: the balanced variant) as a Solution with
-    :class:`SearchStats` (both directions counted)."""
+    :class:`~jaxswarm.exact.stats.SearchStats` (both directions counted)."""
     arrays = edge_arrays(graph)
     source, target = endpoints(graph, arrays, start, goal)
     kind = heuristic_code(default_heuristic(graph, heuristic))

@@ -1,7 +1,7 @@
 """Planes for the bees: the paper's maps #1 and #2 (ours) and seeded random planes.
 
 The paper's maps #1 and #2 (its Figures 1 and 2) did not survive the text: :func:`paper_plane`
-builds ours in their spirit (see :data:`PAPER_PLANES`).
+builds ours in their spirit (see :data:`~jaxswarm.maps.planes.PAPER_PLANES`).
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ class PlaneMap(NamedTuple):
 
     Attributes:
       label: its name in tables (``map1``, ``random-s3``).
-      plane: the :class:`Plane`.
+      plane: the :class:`~jaxswarm.world.plane.Plane`.
       start, goal: ``(x, y)`` floats.
     """
 
@@ -67,8 +67,8 @@ PAPER_PLANES: dict[str, dict] = {
 
 
 def paper_plane(name: str) -> PlaneMap:
-    """The paper's map ``"map1"`` or ``"map2"`` (see :data:`PAPER_PLANES`), padded to
-    :data:`PLANE_CAPACITY` rectangles.
+    """The paper's map ``"map1"`` or ``"map2"`` (see :data:`~jaxswarm.maps.planes.PAPER_PLANES`),
+    padded to :data:`~jaxswarm.maps.planes.PLANE_CAPACITY` rectangles.
 
     Raises:
       ValueError: an unknown name (the message lists the known ones).
@@ -91,7 +91,8 @@ def random_plane(key: jax.Array, *, num_rectangles: int = RANDOM_RECTANGLES,
     """A seeded random plane: ``num_rectangles`` axis-aligned rectangles with sides uniform in
     ``sides``, placed uniformly in an ``extent`` x ``extent`` plane; rectangles that would contain
     the start or the goal are left out (their slots stay padding), so the query is always valid
-    (the goal may still be walled in: :func:`jaxswarm.exact.visibility.shortest_path` then says inf).
+    (the goal may still be walled in: :func:`jaxswarm.exact.visibility.shortest_path` then says
+    inf).
 
     Args:
       key: a JAX PRNG key (the plane is a function of it alone).

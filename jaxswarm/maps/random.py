@@ -67,9 +67,10 @@ def random_path_map(width: int, height: int, seed: int, *, extra: float = 0.3) -
       extra: probability that each lattice edge not in the spanning tree is open too, in [0, 1].
 
     Returns:
-      ``conn[y, x, k] == 1`` where the move in direction slot k (``graph.DIRECTIONS``) is open;
-      ``conn`` is symmetric (a move is open iff its reverse is) and connects every cell. Feed it
-      to :func:`jaxswarm.world.graph.path_map_graph`.
+      ``conn[y, x, k] == 1`` where the move in direction slot k
+      (:data:`jaxswarm.world.lattice.DIRECTIONS`) is open; ``conn`` is symmetric (a move is open iff
+      its reverse is) and connects every cell. Feed it to
+      :func:`jaxswarm.world.graph.path_map_graph`.
     """
     if width < 1 or height < 1 or width * height < 2:
         raise ValueError(f"a path map needs at least 2 cells, got {width}x{height}")

@@ -102,7 +102,8 @@ def distance_fields(graph: Graph, goals) -> np.ndarray:
 
 def hop_fields(graph: Graph, goals) -> np.ndarray:
     """i32[A, N]: the number of steps from every node to each agent's goal, ``UNREACHABLE``
-    where the goal cannot be reached (:func:`distance_fields` on :func:`hop_graph`).
+    where the goal cannot be reached (:func:`~jaxswarm.multiagent.agents.distance_fields` on
+    :func:`~jaxswarm.multiagent.agents.hop_graph`).
 
     Args:
       graph: the map.

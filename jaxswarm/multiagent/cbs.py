@@ -13,9 +13,11 @@ that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "
 """
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import itertools
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -38,9 +40,9 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       max_expansions: the limit on expanded space-time states per low-level search.
 
     Returns:
-      A :class:`Plan` (``planner="cbs"``) with the least sum of costs; not solved when an
-      agent's goal cannot be reached (naming it), when no solution exists (the tree runs out),
-      or at a limit (naming the agents of the collision it was resolving).
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="cbs"``) with the least sum of
+      costs; not solved when an agent's goal cannot be reached (naming it), when no solution exists
+      (the tree runs out), or at a limit (naming the agents of the collision it was resolving).
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
@@ -48,77 +50,164 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     agents = len(start_nodes)
-    fields = hop_fields(graph, goal_nodes)
-    counts = {"expanded": 0, "nodes": 0}
-
-    def plan_agent(agent: int, vertex: frozenset, edge: frozenset):
-        path, expanded, _ = search(graph, int(start_nodes[agent]), int(goal_nodes[agent]),
-                                   fields[agent], _reservations(graph.num_nodes, vertex, edge),
-                                   max_expansions=max_expansions)
-        counts["expanded"] += expanded
-        return path
-
-    def stop(paths, solved: bool, reason: str = "", agent=None) -> Plan:
-        return Plan(*pack(paths, goal_nodes), solved=solved, planner="cbs", reason=reason,
-                    agent=agent, stats={**counts, "seconds": time.perf_counter() - began})
-
+    instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
+                         max_expansions=max_expansions, began=began)
     waiting = [np.array([s], np.int32) for s in start_nodes]
-    unreachable = np.nonzero(fields[np.arange(agents), start_nodes] == UNREACHABLE)[0]
+    unreachable = np.nonzero(instance.fields[np.arange(agents), start_nodes] == UNREACHABLE)[0]
     if unreachable.size:
         a = int(unreachable[0])
-        return stop(waiting, False, f"agent {a} cannot reach its goal "
-                                    f"{place(graph, goal_nodes[a])} from "
-                                    f"{place(graph, start_nodes[a])}", a)
+        return instance.stop(waiting, False, f"agent {a} cannot reach its goal "
+                                             f"{place(graph, goal_nodes[a])} from "
+                                             f"{place(graph, start_nodes[a])}", a)
     no_constraints = [(frozenset(), frozenset())] * agents
-    root = [plan_agent(a, *no_constraints[a]) for a in range(agents)]
+    root = [instance.plan_agent(a, *no_constraints[a]) for a in range(agents)]
     tiebreak = itertools.count()
     frontier = [_node(root, no_constraints, pair_collisions(pack(root)[0]), next(tiebreak))]
     last = None
     while frontier:
-        _, _, _, paths, constraints, first = heapq.heappop(frontier)
-        if not (first >= 0).any():
-            return stop(paths, True)
-        pair = np.argwhere(first == first[first >= 0].min())[0]
-        last = (int(pair[0]), int(pair[1]))
-        if counts["nodes"] >= max_nodes or time.perf_counter() - began > time_limit:
-            limit = (f"{max_nodes} nodes" if counts["nodes"] >= max_nodes
-                     else f"the time limit ({time_limit:g} s)")
-            return stop(paths, False, f"reached {limit} while resolving a collision of agents "
-                                      f"{last[0]} and {last[1]}", last[1])
-        counts["nodes"] += 1
-        padded = pack(paths)[0]
-        step = int(first[pair[0], pair[1]])
-        for agent, other in (last, last[::-1]):
-            vertex, edge = constraints[agent]
-            here = int(padded[agent, step])
-            if here == padded[other, step]:
-                vertex = vertex | {(step, here)}
-            else:
-                edge = edge | {(step - 1, int(padded[agent, step - 1]), here)}
-            path = plan_agent(agent, vertex, edge)
-            if path is None:
-                continue
-            child_paths = list(paths)
-            child_paths[agent] = path
-            child_constraints = list(constraints)
-            child_constraints[agent] = (vertex, edge)
-            # Only the re-planned agent's collisions change.
-            child_collisions = first.copy()
-            changed = pair_collisions(pack(child_paths)[0], [agent])[0]
-            child_collisions[agent, :] = changed
-            child_collisions[:, agent] = changed
-            heapq.heappush(frontier, _node(child_paths, child_constraints, child_collisions,
-                                           next(tiebreak)))
-    return stop(waiting, False, "no solution exists: every way of resolving the collisions of "
-                                f"agents {last[0]} and {last[1]} failed",
-                last[1] if last else None)
+        node = heapq.heappop(frontier)
+        collision = _earliest_collision(node.collisions)
+        if collision is None:
+            return instance.stop(node.paths, True)
+        last, step = collision
+        limit = _reached_limit(instance, max_nodes, time_limit)
+        if limit is not None:
+            return instance.stop(node.paths, False, f"reached {limit} while resolving a "
+                                                    f"collision of agents {last[0]} and "
+                                                    f"{last[1]}", last[1])
+        instance.counts["nodes"] += 1
+        for child in _children(instance, node, last, step, tiebreak):
+            heapq.heappush(frontier, child)
+    return instance.stop(waiting, False, "no solution exists: every way of resolving the "
+                                         f"collisions of agents {last[0]} and {last[1]} "
+                                         "failed", last[1] if last else None)
 
 
-def _node(paths, constraints, collisions: np.ndarray, order: int) -> tuple:
-    """A heap entry: (sum of costs, colliding pairs, order, paths, constraints, collisions
-    i32[A, A] as :func:`pair_collisions` gives them)."""
+class _Node(NamedTuple):
+    """A constraint-tree node, as a heap entry ordered by its first three fields.
+
+    Attributes:
+      cost: the sum of costs of its paths.
+      colliding_pairs: how many pairs of agents collide.
+      order: its creation number, the oldest first at equal cost and pairs.
+      paths: per agent, its node list i32[T_a].
+      constraints: per agent, ``(vertex, edge)``: frozensets of ``(t, v)`` (not on ``v`` at
+        step ``t``) and of ``(t, u, v)`` (not along ``u -> v`` from step ``t``).
+      collisions: i32[A, A] as :func:`pair_collisions` gives them for ``paths``.
+    """
+
+    cost: int
+    colliding_pairs: int
+    order: int
+    paths: list
+    constraints: list
+    collisions: np.ndarray
+
+
+@dataclasses.dataclass
+class _Instance:
+    """One CBS instance, the low-level search's limit and the counters of its work.
+
+    Attributes:
+      graph: the map (N nodes).
+      start_nodes, goal_nodes: i32[A] the agents' starts and goals.
+      fields: i32[A, N] steps from every node to each agent's goal (:func:`hop_fields`).
+      max_expansions: the limit on expanded space-time states per low-level search.
+      began: ``time.perf_counter()`` when the search began.
+      counts: ``expanded`` space-time states and constraint-tree ``nodes`` so far.
+    """
+
+    graph: Graph
+    start_nodes: np.ndarray
+    goal_nodes: np.ndarray
+    fields: np.ndarray
+    max_expansions: int
+    began: float
+    counts: dict = dataclasses.field(default_factory=lambda: {"expanded": 0, "nodes": 0})
+
+    def plan_agent(self, agent: int, vertex: frozenset, edge: frozenset):
+        """The agent's fewest-steps path (i32[T]) under its constraints, or None."""
+        path, expanded, _ = search(self.graph, int(self.start_nodes[agent]),
+                                   int(self.goal_nodes[agent]), self.fields[agent],
+                                   _reservations(self.graph.num_nodes, vertex, edge),
+                                   max_expansions=self.max_expansions)
+        self.counts["expanded"] += expanded
+        return path
+
+    def stop(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
+        """The search's :class:`~jaxswarm.multiagent.plan.Plan` of ``paths`` (one node list
+        per agent)."""
+        return Plan(*pack(paths, self.goal_nodes), solved=solved, planner="cbs", reason=reason,
+                    agent=agent,
+                    stats={**self.counts, "seconds": time.perf_counter() - self.began})
+
+
+def _earliest_collision(collisions: np.ndarray) -> tuple[tuple[int, int], int] | None:
+    """``((a, b), step)``: the first step at which two agents collide and the lowest such
+    pair (``a < b``), from ``collisions`` i32[A, A] (:func:`pair_collisions`); None when no
+    pair collides."""
+    if not (collisions >= 0).any():
+        return None
+    pair = np.argwhere(collisions == collisions[collisions >= 0].min())[0]
+    return (int(pair[0]), int(pair[1])), int(collisions[pair[0], pair[1]])
+
+
+def _reached_limit(instance: _Instance, max_nodes: int, time_limit: float) -> str | None:
+    """The limit the search has reached, in words, or None: ``max_nodes`` expanded nodes,
+    then ``time_limit`` seconds."""
+    if instance.counts["nodes"] >= max_nodes:
+        return f"{max_nodes} nodes"
+    if time.perf_counter() - instance.began > time_limit:
+        return f"the time limit ({time_limit:g} s)"
+    return None
+
+
+def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int,
+              tiebreak) -> list[_Node]:
+    """Expand ``node`` at the collision of ``pair`` arriving at ``step``: one child per agent
+    of the pair, forbidding the collision to that agent and re-planning it, none for an agent
+    that then has no path. ``tiebreak`` numbers the children in the order they are made."""
+    padded = pack(node.paths)[0]
+    children = []
+    for agent, other in (pair, pair[::-1]):
+        constraints = _forbid(node.constraints[agent], padded, agent, other, step)
+        path = instance.plan_agent(agent, *constraints)
+        if path is not None:
+            children.append(_child(node, agent, path, constraints, next(tiebreak)))
+    return children
+
+
+def _forbid(constraints: tuple, padded: np.ndarray, agent: int, other: int,
+            step: int) -> tuple[frozenset, frozenset]:
+    """``agent``'s ``(vertex, edge)`` constraints, plus one against its collision with
+    ``other`` arriving at ``step`` (``padded``: i32[A, T] the node's paths): the node they
+    share at ``step``, or, where they swap, ``agent``'s move into its node at ``step``."""
+    vertex, edge = constraints
+    here = int(padded[agent, step])
+    if here == padded[other, step]:
+        return vertex | {(step, here)}, edge
+    return vertex, edge | {(step - 1, int(padded[agent, step - 1]), here)}
+
+
+def _child(node: _Node, agent: int, path, constraints: tuple, order: int) -> _Node:
+    """``node`` with ``agent`` on ``path`` (i32[T]) under its new ``constraints``."""
+    paths = list(node.paths)
+    paths[agent] = path
+    all_constraints = list(node.constraints)
+    all_constraints[agent] = constraints
+    # Only the re-planned agent's collisions change.
+    collisions = node.collisions.copy()
+    changed = pair_collisions(pack(paths)[0], [agent])[0]
+    collisions[agent, :] = changed
+    collisions[:, agent] = changed
+    return _node(paths, all_constraints, collisions, order)
+
+
+def _node(paths, constraints, collisions: np.ndarray, order: int) -> _Node:
+    """The node of ``paths`` (node lists), ``constraints`` and their ``collisions`` i32[A, A]
+    (as :func:`pair_collisions` gives them), made ``order``-th."""
     cost = sum(len(path) - 1 for path in paths)
-    return cost, int((collisions >= 0).sum()) // 2, order, paths, constraints, collisions
+    return _Node(cost, int((collisions >= 0).sum()) // 2, order, paths, constraints, collisions)
 
 
 def _reservations(num_nodes: int, vertex: frozenset, edge: frozenset) -> Reservations:

@@ -57,8 +57,9 @@ def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "gi
       max_expansions: the per-agent limit on expanded space-time states.
 
     Returns:
-      A :class:`Plan` (``planner="prioritized"``); not solved, naming the agent, when an agent's
-      goal cannot be reached at all, or cannot be reached around the agents planned before it.
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="prioritized"``); not solved, naming
+      the agent, when an agent's goal cannot be reached at all, or cannot be reached around the
+      agents planned before it.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or order.

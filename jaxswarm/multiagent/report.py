@@ -25,6 +25,7 @@ tests). Its grids are 8-connected with corner cutting ("the diagonal box is a va
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -71,9 +72,9 @@ def report_scheme(graph: Graph, starts, goals, *, max_repairs: int | None = None
       max_repairs: give up after this many repairs (default 20 per robot).
 
     Returns:
-      A :class:`Plan` (``planner="report"``) whose ``log`` has the report's messages; not solved,
-      naming the robots, when a robot has no A* path, both fallback re-plans fail, or the
-      repairs run out.
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="report"``) whose ``log`` has the
+      report's messages; not solved, naming the robots, when a robot has no A* path, both fallback
+      re-plans fail, or the repairs run out.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
@@ -82,45 +83,72 @@ def report_scheme(graph: Graph, starts, goals, *, max_repairs: int | None = None
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     robots = len(start_nodes)
     limit = 20 * robots if max_repairs is None else max_repairs
-    log: list[str] = []
-    xy = np.asarray(graph.xy).astype(int)
-
-    def cells(path) -> str:
-        return "[" + ", ".join(f"({xy[v][0]}, {xy[v][1]})" for v in path) + "]"
-
-    def finish(paths, solved: bool, reason: str = "", agent=None) -> Plan:
-        return Plan(*pack(paths, goal_nodes), solved=solved, planner="report", reason=reason,
-                    agent=agent, stats={"repairs": repairs,
-                                        "seconds": time.perf_counter() - began},
-                    log=tuple(log))
-
-    repairs = 0
+    scheme = _Scheme(goal_nodes, np.asarray(graph.xy).astype(int), began)
     paths = []
     for r in range(robots):
         path = _astar(graph, start_nodes[r], goal_nodes[r])
         if path is None:
             paths.append([int(start_nodes[r])])
-            return finish(paths + [[int(s)] for s in start_nodes[r + 1:]], False,
-                          f"agent {r} has no path to its goal", r)
+            return scheme.finish(paths + [[int(s)] for s in start_nodes[r + 1:]], False,
+                                 f"agent {r} has no path to its goal", r)
         paths.append(path)
-        log.append(f"robot{r + 1} initialized path : {cells(path)}")
-    to_goal = distance_fields(graph, goal_nodes)
+        scheme.log.append(f"robot{r + 1} initialized path : {scheme.cells(path)}")
+    return _repair_collisions(scheme, graph, paths, distance_fields(graph, goal_nodes), limit)
+
+
+@dataclasses.dataclass
+class _Scheme:
+    """One run of the scheme: where the robots go, what it has logged and how many repairs it
+    made.
+
+    Attributes:
+      goal_nodes: i32[R] the robots' goals.
+      xy: int[N, 2] every node's cell (x, y), for the log.
+      began: ``time.perf_counter()`` when the run began.
+      log: the report's messages so far.
+      repairs: the repairs made so far.
+    """
+
+    goal_nodes: np.ndarray
+    xy: np.ndarray
+    began: float
+    log: list[str] = dataclasses.field(default_factory=list)
+    repairs: int = 0
+
+    def cells(self, path) -> str:
+        """The nodes of ``path`` as the report prints them: ``[(x, y), ...]``."""
+        return "[" + ", ".join(f"({self.xy[v][0]}, {self.xy[v][1]})" for v in path) + "]"
+
+    def finish(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
+        """The scheme's :class:`~jaxswarm.multiagent.plan.Plan` of ``paths`` (one node list
+        per robot)."""
+        return Plan(*pack(paths, self.goal_nodes), solved=solved, planner="report",
+                    reason=reason, agent=agent,
+                    stats={"repairs": self.repairs, "seconds": time.perf_counter() - self.began},
+                    log=tuple(self.log))
+
+
+def _repair_collisions(scheme: _Scheme, graph: Graph, paths: list, to_goal: np.ndarray,
+                       limit: int) -> Plan:
+    """Repair the first colliding pair of ``paths`` (one node list per robot) until none
+    collides (solved), a pair cannot be repaired or ``limit`` repairs were made (not solved).
+    ``to_goal``: f32[R, N] every node's distance to each robot's goal."""
     first = pair_collisions(pack(paths)[0])
     while True:
         colliding = np.argwhere(np.triu(first >= 0))
         if colliding.size == 0:
-            return finish(paths, True)
-        if repairs == limit:
+            return scheme.finish(paths, True)
+        if scheme.repairs == limit:
             i, j = colliding[0]
-            return finish(paths, False, f"agents {i} and {j} still collide after {limit} "
-                                        "repairs", int(j))
+            return scheme.finish(paths, False, f"agents {i} and {j} still collide after {limit} "
+                                               "repairs", int(j))
         i, j = (int(v) for v in colliding[0])
-        repairs += 1
-        repaired = _repair(graph, paths[i], paths[j], int(first[i, j]), to_goal[j], log, cells,
-                           (i + 1, j + 1))
+        scheme.repairs += 1
+        repaired = _repair(graph, paths[i], paths[j], int(first[i, j]), to_goal[j], scheme.log,
+                           scheme.cells, (i + 1, j + 1))
         if repaired is None:
-            return finish(paths, False, f"agents {i} and {j} cannot pass each other: no "
-                                        "side-step and no plan with one moving first", j)
+            return scheme.finish(paths, False, f"agents {i} and {j} cannot pass each other: no "
+                                               "side-step and no plan with one moving first", j)
         paths[i], paths[j] = repaired
         # Only the two repaired robots' collisions change (the others, padded with their goals
         # if the new paths are longer, gain none).

@@ -4,8 +4,8 @@ moving step by step.
 Every agent has its own colour (:func:`agent_colors`). Its start is a filled square, its goal a
 hollow ring and, in the animation, the agent itself a filled dot, so an agent that has arrived is
 a dot inside its ring. Paths are ``i32[A, T]`` node indices, one row per agent and one column per
-time step, as in :class:`jaxswarm.multiagent.Plan`. Coordinates follow :mod:`jaxswarm.plot.graph`: cell
-``(x, y)`` is centred at ``(x, y)``, with ``y`` growing downwards on grids.
+time step, as in :class:`jaxswarm.multiagent.Plan`. Coordinates follow :mod:`jaxswarm.plot.graph`:
+cell ``(x, y)`` is centred at ``(x, y)``, with ``y`` growing downwards on grids.
 """
 from __future__ import annotations
 
@@ -106,53 +106,89 @@ def animate_plan(graph: Graph, paths, path, *, goals=None, colors=None, fps: flo
         ``max_frames`` below 2 or ``trail`` negative.
     """
     paths, goals, colors = _checked(graph, paths, goals, colors)
+    _check_animation(fps, substeps, max_frames, trail)
+    times = _frame_times(paths.shape[1], substeps, max_frames)
+    xy = np.asarray(graph.xy, np.float64)
+    fig, ax = plt.subplots(figsize=(6, 6.3), layout="constrained")
+    try:
+        draw_map(ax, graph)
+        size = _marker_size(ax, graph)
+        _draw_goals(ax, xy[goals], colors, size)
+        show, moving = _moving_agents(ax, xy, paths, colors, size, times, trail=trail,
+                                      title=title, substeps=substeps)
+        show(0)  # the title, for the layout
+        _write_gif(fig, show, [*moving, ax.title], len(times), path, fps)
+    finally:
+        plt.close(fig)
+    return len(times)
+
+
+def _check_animation(fps: float, substeps: int, max_frames: int, trail: int) -> None:
+    """Raise ValueError for an option of :func:`animate_plan` out of its range."""
     if not fps > 0:
         raise ValueError(f"fps must be positive, got {fps}")
     for name, value, least in (("substeps", substeps, 1), ("max_frames", max_frames, 2),
                                ("trail", trail, 0)):
         if value < least:
             raise ValueError(f"{name} must be at least {least}, got {value}")
-    steps = paths.shape[1]
+
+
+def _frame_times(steps: int, substeps: int, max_frames: int) -> np.ndarray:
+    """f64[F] the (fractional) step each frame shows: ``substeps`` frames per step over
+    ``steps`` steps, then, beyond ``max_frames``, evenly spaced ones keeping the first and the
+    last moment."""
     times = np.linspace(0, steps - 1, (steps - 1) * substeps + 1)
-    if len(times) > max_frames:  # evenly spaced, keeping the first and the last moment
+    if len(times) > max_frames:
         keep = np.unique(np.round(np.linspace(0, len(times) - 1, max_frames)).astype(int))
         times = times[keep]
-    xy = np.asarray(graph.xy, np.float64)
+    return times
 
-    def where(t: float) -> np.ndarray:
-        """f64[A, 2] the agents' positions at (fractional) time t, between nodes mid-move."""
-        before = int(np.floor(t))
-        after = min(before + 1, steps - 1)
-        part = t - before
-        return (1 - part) * xy[paths[:, before]] + part * xy[paths[:, after]]
 
-    fig, ax = plt.subplots(figsize=(6, 6.3), layout="constrained")
-    try:
-        draw_map(ax, graph)
-        size = _marker_size(ax, graph)
-        _draw_goals(ax, xy[goals], colors, size)
-        trails = [ax.plot([], [], color=colors[a], linewidth=2, alpha=0.45, zorder=3,
-                          solid_capstyle="round")[0] for a in range(len(paths))]
-        dots = ax.scatter(*where(0).T, s=0.8 * size, c=colors, edgecolors="black",
-                          linewidths=0.5, zorder=5)
+def _positions(xy: np.ndarray, paths: np.ndarray, t: float) -> np.ndarray:
+    """f64[A, 2] the agents' positions at (fractional) step ``t``, part of the way between
+    nodes mid-move. ``xy``: f64[N, 2] node coordinates; ``paths``: i64[A, T]."""
+    steps = paths.shape[1]
+    before = int(np.floor(t))
+    after = min(before + 1, steps - 1)
+    part = t - before
+    return (1 - part) * xy[paths[:, before]] + part * xy[paths[:, after]]
 
-        def show(k):
-            t = times[k]
-            now = where(t)
-            dots.set_offsets(now)
-            for a, line in enumerate(trails):
-                if trail:
-                    past = xy[paths[a, max(0, int(np.ceil(t)) - trail):int(t) + 1]]
-                    line.set_data(*np.concatenate([past, now[a:a + 1]]).T)
-            step = f"{t:.2f}" if substeps > 1 else str(int(t))
-            ax.set_title(title.format(step=step, steps=steps - 1))
-            return (dots, *trails)
 
-        show(0)  # the title, for the layout
-        _write_gif(fig, show, [dots, *trails, ax.title], len(times), path, fps)
-    finally:
-        plt.close(fig)
-    return len(times)
+def _moving_agents(ax: Axes, xy: np.ndarray, paths: np.ndarray, colors, size: float,
+                   times: np.ndarray, *, trail: int, title: str, substeps: int):
+    """Draw the agents (dots) and their trails at step 0, and say how to move them.
+
+    Args:
+      ax: the axes, its map and goals drawn.
+      xy: f64[N, 2] node coordinates.
+      paths: i64[A, T] node indices.
+      colors: A matplotlib colours.
+      size: the marker area (points^2).
+      times: f64[F] the step each frame shows (:func:`_frame_times`).
+      trail, title, substeps: as :func:`animate_plan`'s.
+
+    Returns:
+      ``(show, moving)``: ``show(k)`` puts the dots, the trails and the title at frame ``k``;
+      ``moving``: the dots and the trails, the artists it changes besides the title.
+    """
+    steps = paths.shape[1]
+    trails = [ax.plot([], [], color=colors[a], linewidth=2, alpha=0.45, zorder=3,
+                      solid_capstyle="round")[0] for a in range(len(paths))]
+    dots = ax.scatter(*_positions(xy, paths, 0).T, s=0.8 * size, c=colors, edgecolors="black",
+                      linewidths=0.5, zorder=5)
+
+    def show(k: int) -> None:
+        t = times[k]
+        now = _positions(xy, paths, t)
+        dots.set_offsets(now)
+        for a, line in enumerate(trails):
+            if trail:
+                past = xy[paths[a, max(0, int(np.ceil(t)) - trail):int(t) + 1]]
+                line.set_data(*np.concatenate([past, now[a:a + 1]]).T)
+        step = f"{t:.2f}" if substeps > 1 else str(int(t))
+        ax.set_title(title.format(step=step, steps=steps - 1))
+
+    return show, (dots, *trails)
 
 
 def _write_gif(fig, show, animated, frames: int, path, fps: float) -> None:

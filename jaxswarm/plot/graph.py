@@ -82,8 +82,8 @@ def draw_paths(ax: Axes, graph: Graph, paths, labels=None, *, colors=None,
     Args:
       ax: the axes to draw into.
       graph: the map the paths live on (N nodes).
-      paths: a sequence of P paths, each a :class:`Solution` or an i32[L] node array with -1
-        padding (an i32[P, L] array works too).
+      paths: a sequence of P paths, each a :class:`~jaxswarm.world.paths.Solution` or an i32[L]
+        node array with -1 padding (an i32[P, L] array works too).
       labels: optional P legend labels.
       colors: optional P matplotlib colours (default: the axes' colour cycle).
       linewidth: line width in points.

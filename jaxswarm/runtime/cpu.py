@@ -58,10 +58,15 @@ def configure(*, devices: int | None = None, threads: int | None = None) -> None
 
 
 def _backends_started() -> bool:
-    # jax 0.10 has no public query; the private one is stable since jax 0.4.
-    from jax._src import xla_bridge
-
-    return xla_bridge.backends_are_initialized()
+    """Whether JAX has started its backends. JAX's public API has no query for it, but it refuses
+    a new CPU device count once they have started: try one, then put the old one back."""
+    current = jax.config.jax_num_cpu_devices
+    try:
+        jax.config.update("jax_num_cpu_devices", current + 1 if current > 0 else 1)
+    except RuntimeError:
+        return True
+    jax.config.update("jax_num_cpu_devices", current)
+    return False
 
 
 def cpu_model(cpuinfo: Path = Path("/proc/cpuinfo")) -> str:

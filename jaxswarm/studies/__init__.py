@@ -1,2 +1,12 @@
-"""What the table scripts of ``sweeps/`` share: provenance records of every table
-(:mod:`~jaxswarm.studies.provenance`)."""
+"""What the table scripts of ``sweeps/`` share, one idea a module:
+
+* :mod:`~jaxswarm.studies.provenance`: the provenance record of every table, and the index of a
+  results folder;
+* :mod:`~jaxswarm.studies.arguments`: the command-line checks (counts, lists, ``--out``);
+* :mod:`~jaxswarm.studies.problems`: a named map with its task and its optimum;
+* :mod:`~jaxswarm.studies.timing`: compile once, then time each run alone;
+* :mod:`~jaxswarm.studies.success`: when a run reaches the optimum;
+* :mod:`~jaxswarm.studies.figures`: grids of map panels, written as PNG files;
+* :mod:`~jaxswarm.studies.rfd_table1`: the rows of the RFD paper's Table 1, which three scripts
+  run.
+"""

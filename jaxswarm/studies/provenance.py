@@ -9,17 +9,14 @@ that regenerates the table (run from the repository root) and the wall time. It 
 of the script's Markdown (:meth:`Provenance.document`) and into ``provenance.json`` beside its CSV
 (:meth:`Provenance.write`).
 
-The scripts import this file as ``provenance``, whether they run as ``python sweeps/NAME.py`` (the
-script's folder is then first on ``sys.path``) or are loaded by the tests from their path (each
-script puts its own folder on ``sys.path`` first).
-
-Run as a script, it writes the index of a results folder (``README.md``: each table's title, what
-its rows are, the command that made it, when, at which commit, and how long it took)::
+:func:`main`, run by ``sweeps/index_results.py``, writes the index of a results folder
+(``README.md``: each table's title, what its rows are, the command that made it, when, at which
+commit, and how long it took)::
 
     python sweeps/index_results.py results
 """
-# No "from __future__ import annotations": the dataclass below then needs no entry in
-# sys.modules, so the tests can load this file by its path as they load the scripts.
+from __future__ import annotations
+
 import argparse
 import dataclasses
 import datetime
@@ -45,8 +42,8 @@ except ModuleNotFoundError:  # Python 3.10
 from jaxswarm.runtime.atomic import write_atomically
 from jaxswarm.runtime.cpu import cpu_model
 
-ROOT = Path(__file__).resolve().parents[1]
-"""The repository root: commands are written relative to it."""
+ROOT = Path(__file__).resolve().parents[2]
+"""The repository root (above ``jaxswarm/studies/``): commands are written relative to it."""
 METADATA = "provenance.json"
 """The name of the provenance file each script writes beside its CSV."""
 INDEX = "README.md"
@@ -73,7 +70,7 @@ class Provenance:
     seconds: float | None = None
     details: dict = dataclasses.field(default_factory=dict)
 
-    def finish(self, *, title: str, about: str, **details) -> "Provenance":
+    def finish(self, *, title: str, about: str, **details) -> Provenance:
         """Record the wall time since :attr:`started`, the table's ``title``, a paragraph
         ``about`` its rows (which are the papers' algorithms, which are this project's) and any
         JSON-ready ``details``; returns self."""

@@ -1,17 +1,18 @@
-"""The swarm protocol, the run loop with its stop conditions, and the registry of swarms.
+"""The swarm protocol (:class:`Swarm`, :class:`Task`, :class:`StepInfo`, :class:`Trace`) and the
+run loop with its stop conditions; the names of the swarms are in :mod:`jaxswarm.swarm.registry`.
 
 A swarm is a bundle of pure functions built by a factory that closes over a static, hashable
 ``Config`` (sizes and switches); the numbers a sweep varies live in a traced ``Params`` pytree; the
 memory that persists between iterations (altitudes, pheromone) lives in a pytree ``State``::
 
     swarm = jaxswarm.swarm.make("rfd_star", num_agents=256)
-    task = make_task(graph, start=(0, 0), goal=(19, 19))
-    state, trace = run(swarm, key, graph, task, swarm.default_params, iterations=100)
+    task = make_task(world, start=(0, 0), goal=(19, 19))
+    state, trace = run(swarm, key, world, task, swarm.default_params, iterations=100)
     swarm.best(state)  # Solution(path, cost, found)
 
 ``run`` is jitted (the swarm and the iteration budget are static), so it vmaps over keys and over
-params and compiles once per map shape. The graph is an argument, never stored in the state, so a
-batch of runs shares one copy.
+params and compiles once per map shape. The world (a graph or a plane) is an argument, never
+stored in the state, so a batch of runs shares one copy.
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ import numpy as np
 
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
-from jaxswarm.world.plane import check_point, Plane
+from jaxswarm.world.plane import Plane, check_point
 
 World = Graph | Plane
 """What a swarm plans in: a graph (the walkers) or a plane of rectangles (the bees)."""
@@ -142,8 +143,10 @@ class Trace:
       arrived: f32[T] share of agents that reached the goal in each iteration.
       iterations: i32[] iterations actually run (<= T).
       moves: i32[T] moves the agents made in each iteration.
-      lane_steps: i32[T] lane-steps of each iteration's walk (see :class:`StepInfo`).
-      evaluations: i32[T] fitness calls in each iteration (see :class:`StepInfo`).
+      lane_steps: i32[T] lane-steps of each iteration's walk (see
+        :class:`~jaxswarm.swarm.core.StepInfo`).
+      evaluations: i32[T] fitness calls in each iteration (see
+        :class:`~jaxswarm.swarm.core.StepInfo`).
     """
 
     best_cost: jax.Array
@@ -160,7 +163,7 @@ jax.tree_util.register_dataclass(
                         "lane_steps", "evaluations"], meta_fields=[])
 
 
-def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
+def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
         iterations: int = 100, patience: int | None = None, state=None, budget=None):
     """Iterate a swarm until a stop condition holds, from fresh memory or from ``state``.
 
@@ -174,22 +177,22 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
     Args:
       swarm: the algorithm (static).
       key: PRNG key; the same key and inputs give bit-identical results.
-      graph: the world: a Graph, or a Plane for the swarms that plan on one (``swarm.world``).
-      task: start and goal (see :func:`make_task`).
+      world: a Graph, or a Plane for the swarms that plan on one (``swarm.world``).
+      task: start and goal (see :func:`~jaxswarm.swarm.core.make_task`).
       params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
       iterations: the iteration budget T (static).
       patience: stop after this many iterations without improvement of a path found
         (static; None = never).
       state: a State to continue from (the memory of an earlier run, after
-        :func:`jaxswarm.dynamic.events.change` when the map or the task changed); its key is replaced
-        by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
+        :func:`jaxswarm.dynamic.events.change` when the map or the task changed); its key is
+        replaced by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
         iteration count and the patience count start again either way.
       budget: i32[] stop after at most this many iterations (traced, so runs of different
         budgets share one compiled program: replaying a run up to the iteration where something
         happened); None: ``iterations``.
 
     Returns:
-      ``(state, trace)``: the final State and a :class:`Trace`.
+      ``(state, trace)``: the final State and a :class:`~jaxswarm.swarm.core.Trace`.
 
     Raises:
       ValueError: a world of the wrong kind, or concrete params out of range (checked on the
@@ -199,17 +202,17 @@ def run(swarm: Swarm, key: jax.Array, graph: Graph, task: Task, params, *,
         raise ValueError(f"iterations must be at least 1, got {iterations}")
     if patience is not None and patience < 1:
         raise ValueError(f"patience must be at least 1, got {patience}")
-    require_world(swarm, graph)
+    require_world(swarm, world)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)
-    return _run(swarm, key, graph, task, params, iterations, patience, state, budget)
+    return _run(swarm, key, world, task, params, iterations, patience, state, budget)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 5, 6))
-def _run(swarm, key, graph, task, params, iterations, patience, state, budget):
+def _run(swarm, key, world, task, params, iterations, patience, state, budget):
     if state is None:
-        state = swarm.init(key, graph, task, params)
+        state = swarm.init(key, world, task, params)
     else:
         state = dataclasses.replace(state, key=key)
     nan = jnp.full((iterations,), jnp.nan, jnp.float32)
@@ -231,7 +234,7 @@ def _run(swarm, key, graph, task, params, iterations, patience, state, budget):
         # empty, so the walker's lanes go to the runs still going (the goal stays as it is:
         # work that depends on it alone is hoisted out of the loop).
         going = keep_going(carry)
-        state, info = swarm.step(state, graph, task._replace(
+        state, info = swarm.step(state, world, task._replace(
             start=jnp.where(going, task.start, task.goal)), params)
         after = swarm.best(state).cost
         t = trace.iterations
@@ -268,7 +271,8 @@ class SwarmConfig:
 
 def default_params(params_type, **values):
     """A Params tuple of NumPy float32 scalars, not JAX arrays: importing a swarm must not start
-    JAX's backend (see :func:`jaxswarm.runtime.cpu.configure`); jit and vmap take them as f32 arrays."""
+    JAX's backend (see :func:`jaxswarm.runtime.cpu.configure`); jit and vmap take them as f32
+    arrays."""
     return params_type(**{name: np.float32(value) for name, value in values.items()})
 
 

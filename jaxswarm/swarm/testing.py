@@ -26,7 +26,7 @@ import numpy as np
 
 from jaxswarm.swarm.core import Swarm, Task, World, run
 from jaxswarm.world.paths import is_valid_path, path_length
-from jaxswarm.world.plane import in_plane, Plane, trajectory_length, violations
+from jaxswarm.world.plane import Plane, in_plane, trajectory_length, violations
 
 
 def leaves_equal(a, b) -> bool:

@@ -4,7 +4,7 @@ An entry is a paper map name (``"mosaic50"``), a seeded random grid
 (``{ random = 50, seed = 3, density = 0.3 }``, corner to corner), a plane of rectangles for the
 bees (``{ plane = "map1" }``, the bees paper's map #1 or #2, or
 ``{ plane = "random", seed = 3, rectangles = 40 }``, see
-:func:`jaxswarm.world.plane.random_plane`) or one row of a Moving AI
+:func:`jaxswarm.maps.planes.random_plane`) or one row of a Moving AI
 scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 counted from 0;
 ``scenario_file = "random"`` takes the MAPF set's ``<map>-random-1.scen`` instead of the default
 ``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map).
@@ -22,8 +22,9 @@ import jax
 from jaxswarm.exact import optimal_length
 from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps import movingai
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.planes import paper_plane, PAPER_PLANES, random_plane, RANDOM_RECTANGLES
+from jaxswarm.maps.named import PAPER, map_kind, named_map
+from jaxswarm.maps.paper import PAPER_MAPS
+from jaxswarm.maps.planes import PAPER_PLANES, RANDOM_RECTANGLES, paper_plane, random_plane
 from jaxswarm.maps.random import random_grid
 from jaxswarm.swarm import make_task
 from jaxswarm.world.graph import Graph, grid_graph
@@ -63,7 +64,8 @@ class SweepMap:
     def optimum(self) -> float:
         """The optimal path length, measured as the swarms measure theirs: Dijkstra's path on a
         graph (:func:`jaxswarm.exact.optimal_length`), the visibility-graph shortest path on a
-        plane (:func:`jaxswarm.exact.visibility.shortest_path`); inf when the goal is unreachable."""
+        plane (:func:`jaxswarm.exact.visibility.shortest_path`); inf when the goal is
+        unreachable."""
         if isinstance(self.world, Plane):
             return shortest_path(self.world, self.start, self.goal)[0]
         return optimal_length(self.world, self.start, self.goal)
@@ -73,7 +75,9 @@ def check_map_entry(entry) -> str | None:
     """The problem with a spec's map entry, or None if it is well formed (files are looked up
     when the map is resolved)."""
     if isinstance(entry, str):
-        if entry not in PAPER_MAPS:
+        # A string names a paper map; seeded and Moving AI maps are tables, whose keys give the
+        # seed or the scenario row that a bare name cannot.
+        if map_kind(entry) != PAPER:
             return (f"unknown map {entry!r}; paper maps: {', '.join(PAPER_MAPS)} (or a table "
                     "{ random = SIZE, seed = S } / { movingai = FILE, scenario = ROW } / "
                     "{ plane = NAME })")
@@ -145,8 +149,8 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
     if problem:
         raise ValueError(problem)
     if isinstance(entry, str):
-        chosen = paper_map(entry)
-        return SweepMap(entry, chosen.graph(), tuple(chosen.start), tuple(chosen.goal))
+        named = named_map(entry)
+        return SweepMap(named.label, named.graph, tuple(named.start), tuple(named.goal))
     if "plane" in entry:
         if entry["plane"] == "random":
             count = entry.get("rectangles", RANDOM_RECTANGLES)

@@ -26,6 +26,7 @@ skips them.
 """
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import importlib.metadata
 import math
@@ -33,7 +34,7 @@ import platform
 import subprocess
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import jax
 import jax.numpy as jnp
@@ -87,6 +88,65 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     out = Path(out) if out is not None else default_out(spec)
     base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
     maps = _resolve_maps(spec, base_dir)  # every entry checked before anything is written
+    chunks = _set_up(spec, maps, out, log)
+    todo, finished_runs = _unfinished_chunks(chunks, len(maps), out)
+    bar = tqdm(total=chunks.num_runs * len(maps), unit="run", disable=not progress,
+               desc=spec.name, initial=finished_runs)
+    try:
+        for m, sweep_map in enumerate(maps):
+            if todo[m]:
+                _run_map(chunks, m, sweep_map, todo[m], bar)
+    finally:
+        bar.close()
+    return read_results(out)
+
+
+@dataclasses.dataclass(frozen=True)
+class _SweepChunks:
+    """What every chunk of one sweep shares, set up once by :func:`_set_up`.
+
+    Attributes:
+      spec: the sweep.
+      grid: its param combinations (``spec.grid()``), P of them.
+      seeds: int[S] its seeds.
+      num_runs: runs per map, P * S.
+      params: the swarm's params with leaves f32[P * S]: run ``r``'s at index ``r``.
+      padded: runs per chunk call: ``chunk_size`` rounded up to a multiple of the device count.
+      group: runs vmapped together on one device.
+      batch_sharding: the runs axis split over the devices.
+      replicated: a whole copy on every device (the world and the task).
+      program: the jitted chunk (:func:`_chunk_program`).
+      compiled: :func:`_program_key` -> ``program`` compiled for that map shape, filled as the
+        shapes come.
+      store: the results store.
+      writer: whether this process writes the store (process 0).
+      log: where one-line messages go.
+    """
+
+    spec: SweepSpec
+    grid: list
+    seeds: np.ndarray
+    num_runs: int
+    params: Any
+    padded: int
+    group: int
+    batch_sharding: NamedSharding
+    replicated: NamedSharding
+    program: Callable
+    compiled: dict
+    store: ResultsStore
+    writer: bool
+    log: Callable[[str], None]
+
+
+def _set_up(spec: SweepSpec, maps: list[SweepMap], out: Path,
+            log: Callable[[str], None]) -> _SweepChunks:
+    """Lay a sweep's chunks out over ``jax.devices()``, open (or create) its store in ``out``
+    and stack its runs' params.
+
+    Raises:
+      StoreMismatchError: ``out`` holds another spec or another definition of the swarm.
+    """
     writer = jax.process_index() == 0
     swarm = make(spec.algorithm, **spec.config)
     devices = jax.devices()
@@ -96,54 +156,67 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
                          writer=writer)
     grid = spec.grid()
     seeds = np.asarray(spec.seeds)
-    num_runs = spec.num_runs
-    params = _stacked_params(swarm.default_params, grid, len(seeds))
     mesh = Mesh(np.asarray(devices), (RUNS_AXIS,))
-    batch_sharding = NamedSharding(mesh, P(RUNS_AXIS))
-    replicated = NamedSharding(mesh, P())
-    batch = _chunk_program(swarm, spec, mesh, group)
-    compiled = {}
+    return _SweepChunks(
+        spec=spec, grid=grid, seeds=seeds, num_runs=spec.num_runs,
+        params=_stacked_params(swarm.default_params, grid, len(seeds)), padded=padded,
+        group=group, batch_sharding=NamedSharding(mesh, P(RUNS_AXIS)),
+        replicated=NamedSharding(mesh, P()), program=_chunk_program(swarm, spec, mesh, group),
+        compiled={}, store=store, writer=writer, log=log)
 
-    per_map = math.ceil(num_runs / spec.chunk_size)
-    chunks = [(m, c) for m in range(len(maps)) for c in range(per_map)]
-    done = {(m, c) for m, c in chunks if store.finished(m, c)}
+
+def _unfinished_chunks(chunks: _SweepChunks, num_maps: int, out: Path) -> tuple[list, int]:
+    """``(todo, finished_runs)``: per map, the indices of the chunks its store does not hold
+    yet (in order), and how many runs the finished chunks of all maps hold; logs a resume."""
+    spec = chunks.spec
+    per_map = math.ceil(chunks.num_runs / spec.chunk_size)
+    done = {(m, c) for m in range(num_maps) for c in range(per_map)
+            if chunks.store.finished(m, c)}
     if done:
-        log(f"resuming {out}: {len(done)} of {len(chunks)} chunks already finished")
-    bar = tqdm(total=num_runs * len(maps), unit="run", disable=not progress, desc=spec.name,
-               initial=sum(_chunk_runs(c, spec.chunk_size, num_runs) for _, c in done))
-    try:
-        for m, sweep_map in enumerate(maps):
-            todo = [c for mm, c in chunks if mm == m and (mm, c) not in done]
-            if not todo:
-                continue
-            task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
-            best = sweep_map.optimum()
-            world, task = jax.device_put((sweep_map.world, task), replicated)
-            program = _program_key(sweep_map.world)
-            if program not in compiled:
-                began = time.perf_counter()
-                example = _chunk_inputs(params, seeds, 0, padded, num_runs, batch_sharding)
-                compiled[program] = batch.lower(*example, world, task).compile()
-                log(f"compiled {spec.algorithm} for {sweep_map.label}'s shape, {padded} runs "
-                    f"per chunk on {len(devices)} device(s), {group} at a time, in "
-                    f"{time.perf_counter() - began:.1f} s")
-            for c in todo:
-                first = c * spec.chunk_size
-                count = _chunk_runs(c, spec.chunk_size, num_runs)
-                inputs = _chunk_inputs(params, seeds, first, padded, num_runs, batch_sharding)
-                began = time.perf_counter()
-                cost, iterations, moves, evaluations = _gather(
-                    compiled[program](*inputs, world, task))
-                seconds = time.perf_counter() - began
-                rows = _rows(spec, grid, seeds, sweep_map.label, m, c, first, count,
-                             cost[:count], iterations[:count], moves[:count],
-                             evaluations[:count], best, seconds)
-                if writer:
-                    store.write_chunk(m, c, rows)
-                bar.update(count)
-    finally:
-        bar.close()
-    return read_results(out)
+        chunks.log(f"resuming {out}: {len(done)} of {num_maps * per_map} chunks already "
+                   "finished")
+    todo = [[c for c in range(per_map) if (m, c) not in done] for m in range(num_maps)]
+    return todo, sum(_chunk_runs(c, spec.chunk_size, chunks.num_runs) for _, c in done)
+
+
+def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: list[int],
+             bar) -> None:
+    """Run the chunks ``todo`` of one map (compiling for its shape when it is the first of
+    it), write each to the store as it finishes and advance the progress bar."""
+    spec = chunks.spec
+    task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
+    best = sweep_map.optimum()
+    world, task = jax.device_put((sweep_map.world, task), chunks.replicated)
+    compiled = _compiled(chunks, sweep_map, world, task)
+    for c in todo:
+        first = c * spec.chunk_size
+        count = _chunk_runs(c, spec.chunk_size, chunks.num_runs)
+        inputs = _chunk_inputs(chunks.params, chunks.seeds, first, chunks.padded,
+                               chunks.num_runs, chunks.batch_sharding)
+        began = time.perf_counter()
+        cost, iterations, moves, evaluations = _gather(compiled(*inputs, world, task))
+        seconds = time.perf_counter() - began
+        rows = _rows(spec, chunks.grid, chunks.seeds, sweep_map.label, map_index, c, first,
+                     count, cost[:count], iterations[:count], moves[:count],
+                     evaluations[:count], best, seconds)
+        if chunks.writer:
+            chunks.store.write_chunk(map_index, c, rows)
+        bar.update(count)
+
+
+def _compiled(chunks: _SweepChunks, sweep_map: SweepMap, world, task):
+    """The chunk program compiled for ``sweep_map``'s shape (``world`` and ``task`` already
+    on the devices): compiled and logged the first time a shape comes, reused after."""
+    program = _program_key(sweep_map.world)
+    if program not in chunks.compiled:
+        began = time.perf_counter()
+        example = _chunk_inputs(chunks.params, chunks.seeds, 0, chunks.padded, chunks.num_runs,
+                                chunks.batch_sharding)
+        chunks.compiled[program] = chunks.program.lower(*example, world, task).compile()
+        chunks.log(f"compiled {chunks.spec.algorithm} for {sweep_map.label}'s shape, "
+                   f"{chunks.padded} runs per chunk on {len(jax.devices())} device(s), "
+                   f"{chunks.group} at a time, in {time.perf_counter() - began:.1f} s")
+    return chunks.compiled[program]
 
 
 def _resolve_maps(spec: SweepSpec, base_dir: Path | None) -> list[SweepMap]:

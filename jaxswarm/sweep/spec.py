@@ -138,12 +138,37 @@ def load_spec(path) -> SweepSpec:
 
 
 def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
-    """Check a parsed spec (the TOML document as a dict); see :func:`load_spec`."""
-    where = source
+    """Check a parsed spec (the TOML document as a dict); see :func:`load_spec`.
 
+    The checks go in the order a reader meets the spec: the sections and the [sweep] keys, the
+    algorithm and name, the maps, the seeds, the run options, [config] (and whether the maps
+    are the swarm's world), [params], and last every combination's values; the first mistake
+    raises.
+    """
     def fail(key: str, problem: str):
-        raise SpecError(f"{where}: {key}: {problem}")
+        raise SpecError(f"{source}: {key}: {problem}")
 
+    sweep = _sweep_table(document, fail)
+    algorithm, name = _algorithm_and_name(sweep, fail)
+    maps = _maps(sweep["maps"], fail)
+    seeds = _seeds(sweep["seeds"], fail)
+    options = _run_options(sweep, fail)
+    config = document.get("config", {})
+    swarm = _configured_swarm(algorithm, config, fail)
+    _check_map_worlds(maps, swarm, algorithm, fail)
+    params = document.get("params", {})
+    checked = _params(params, swarm, algorithm, fail)
+    spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds, **options,
+                     config=dict(config), params=checked, source=source,
+                     log_scale=frozenset(k for k, v in params.items()
+                                         if isinstance(v, dict) and v.get("log", False)))
+    _check_grid(spec, swarm, fail)
+    return spec
+
+
+def _sweep_table(document: dict, fail) -> dict:
+    """The [sweep] table, once the document has only known sections and the table only known
+    keys, among them the required ``algorithm``, ``maps`` and ``seeds``."""
     for section in document:
         if section not in SECTIONS:
             fail(section, f"unknown section; expected {', '.join(sorted(SECTIONS))}")
@@ -156,7 +181,12 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     for key in ("algorithm", "maps", "seeds"):
         if key not in sweep:
             fail(f"sweep.{key}", "missing")
+    return sweep
 
+
+def _algorithm_and_name(sweep: dict, fail) -> tuple[str, str]:
+    """``(algorithm, name)``: a registered swarm and the sweep's name (default: the
+    algorithm's), a non-empty string without '/' since it names a directory."""
     algorithm = sweep["algorithm"]
     if algorithm not in swarm_registry.registered():
         fail("sweep.algorithm", f"unknown algorithm {algorithm!r}; registered: "
@@ -164,16 +194,24 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     name = sweep.get("name", algorithm)
     if not isinstance(name, str) or not name or "/" in name:
         fail("sweep.name", f"must be a non-empty string without '/', got {name!r}")
+    return algorithm, name
 
-    maps = sweep["maps"]
+
+def _maps(maps: Any, fail) -> list:
+    """The map entries, a non-empty list of entries that :func:`check_map_entry` accepts."""
     if not isinstance(maps, list) or not maps:
         fail("sweep.maps", "must be a non-empty list")
     for i, entry in enumerate(maps):
         problem = check_map_entry(entry)
         if problem:
             fail(f"sweep.maps[{i}]", problem)
+    return maps
 
-    seeds = _seeds(sweep["seeds"], fail)
+
+def _run_options(sweep: dict, fail) -> dict:
+    """The [sweep] numbers that shape every run, as :class:`SweepSpec` fields: ``iterations``
+    (default 100), ``patience`` (default None), ``chunk_size`` (default
+    ``DEFAULT_CHUNK_SIZE``) and ``vmap_size`` (default None), each a positive integer."""
     iterations = _positive_int(sweep.get("iterations", 100), "sweep.iterations", fail)
     patience = sweep.get("patience")
     if patience is not None:
@@ -183,8 +221,13 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     vmap_size = sweep.get("vmap_size")
     if vmap_size is not None:
         vmap_size = _positive_int(vmap_size, "sweep.vmap_size", fail)
+    return dict(iterations=iterations, patience=patience, chunk_size=chunk_size,
+                vmap_size=vmap_size)
 
-    config = document.get("config", {})
+
+def _configured_swarm(algorithm: str, config: Any, fail):
+    """The swarm the [config] table builds: a table of the factory's options that it
+    accepts."""
     if not isinstance(config, dict):
         fail("[config]", "must be a table")
     accepted = swarm_registry.config_options(algorithm)
@@ -193,15 +236,21 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
             fail(f"config.{key}", f"unknown config of {algorithm}; accepted: "
                  f"{', '.join(accepted)}")
     try:
-        swarm = swarm_registry.make(algorithm, **config)
+        return swarm_registry.make(algorithm, **config)
     except (TypeError, ValueError) as error:
         fail("[config]", str(error))
+
+
+def _check_map_worlds(maps: list, swarm, algorithm: str, fail) -> None:
+    """Every map is of the world the swarm plans on (a graph or a plane)."""
     for i, entry in enumerate(maps):
         if entry_world(entry) is not swarm.world:
             fail(f"sweep.maps[{i}]", f"{algorithm} plans on a {swarm.world.__name__}, this map "
                  f"is a {entry_world(entry).__name__}")
 
-    params = document.get("params", {})
+
+def _params(params: Any, swarm, algorithm: str, fail) -> dict[str, tuple[float, ...]]:
+    """The [params] table checked: param name -> its values, for params the swarm knows."""
     if not isinstance(params, dict):
         fail("[params]", "must be a table")
     known = swarm.default_params._fields
@@ -210,19 +259,20 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         if key not in known:
             fail(f"params.{key}", f"unknown param of {algorithm}; known: {', '.join(known)}")
         checked[key] = _values(value, f"params.{key}", fail)
-    spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds,
-                     iterations=iterations, patience=patience, chunk_size=chunk_size,
-                     vmap_size=vmap_size, config=dict(config), params=checked, source=source,
-                     log_scale=frozenset(k for k, v in params.items()
-                                         if isinstance(v, dict) and v.get("log", False)))
-    for combination in spec.grid():  # out-of-range values fail here, before any compute
+    return checked
+
+
+def _check_grid(spec: SweepSpec, swarm, fail) -> None:
+    """Every combination of the grid is a valid set of params for the swarm, so an
+    out-of-range value fails here, before any compute; the error names the param when the
+    swarm's message starts with it."""
+    for combination in spec.grid():
         try:
             swarm.check_params(swarm.default_params._replace(
                 **{k: np.float32(v) for k, v in combination.items()}))
         except ValueError as error:
             key = next((k for k in combination if str(error).startswith(k)), "[params]")
             fail(f"params.{key}" if key in combination else key, str(error))
-    return spec
 
 
 def _seeds(value: Any, fail) -> tuple[int, ...]:

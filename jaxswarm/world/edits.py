@@ -1,8 +1,8 @@
 """Pure, shape-preserving map edits.
 
-Each edit returns a new :class:`~jaxswarm.world.graph.Graph` whose ``free`` or ``open`` array differs;
-no shape changes, so a jitted planner called on the edited map does not recompile. The node and
-slot arguments may be traced arrays (the edits are jittable and vmappable).
+Each edit returns a new :class:`~jaxswarm.world.graph.Graph` whose ``free`` or ``open`` array
+differs; no shape changes, so a jitted planner called on the edited map does not recompile. The node
+and slot arguments may be traced arrays (the edits are jittable and vmappable).
 """
 from __future__ import annotations
 
@@ -38,7 +38,8 @@ def close_edges(graph: Graph, nodes, slots) -> Graph:
     Args:
       graph: the map.
       nodes: int or i32[M] source nodes.
-      slots: int or i32[M] neighbour slots (grid direction indices, see ``graph.DIRECTIONS``).
+      slots: int or i32[M] neighbour slots (grid direction indices, see
+        :data:`jaxswarm.world.lattice.DIRECTIONS`).
 
     Returns:
       The map with both directions of each edge closed. Slots without a neighbour, and nodes

@@ -4,10 +4,12 @@
 Each record names its swarm, world, config, iterations, patience and seed, and holds the
 SHA-256 of every leaf of what the run returned (state and trace, PRNG keys as their data)
 beside a few readable figures (best cost, iterations run) that say what changed when a digest
-does. Write them again, from the repository root, only after a change that is meant to change
-results (and say why in the CHANGELOG)::
+does. Write them again only after a change that is meant to change results (and say why in the
+CHANGELOG), from ``tests/``::
 
-    python tests/golden/swarms.py
+    python -m golden.swarms
+
+Both write and replay with XLA's vector instructions capped (:mod:`golden.isa`).
 """
 from __future__ import annotations
 
@@ -18,6 +20,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
+from golden.isa import cap_isa
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, registered, run
 from jaxswarm.swarm.testing import key_data
@@ -66,5 +69,6 @@ def cases() -> list[dict]:
 
 
 if __name__ == "__main__":
+    cap_isa()
     GOLDEN.write_text(json.dumps([dict(case, **replay(case)) for case in cases()], indent=1) + "\n")
     print(f"wrote {GOLDEN}")

@@ -11,8 +11,8 @@
   (its ``delta``) added on every edge of the best path so far, which a path as short replaces
   (the paper's ``<=``).
 
-Switch: ``first_ant="greedy"`` makes the first ant always take its most likely move (the
-deterministic depth-first ant of jaxswarm 0.1.0) instead of drawing it.
+Switch: ``first_ant="greedy"`` makes the first ant always take its most likely move (a
+deterministic depth-first ant) instead of drawing it.
 """
 from __future__ import annotations
 

@@ -5,30 +5,35 @@ bees paper, sections III-IV).
 One ``run`` iteration is one vehicle step: the colony (:mod:`.colony`) starts afresh in the sensor
 window (the square of side ``window`` centred on the vehicle, clipped to the plane), runs
 ``inner_iterations`` cycles on the guided function (:mod:`.guided`) and returns its best point by
-Deb's rules. A feasible best point is the vehicle's next position; when no candidate is feasible
-the vehicle stays. The vehicle has arrived when it is within ``tolerance`` of the goal; the goal
-is then appended to its trajectory, so the path length is the length of a trajectory from start
-to goal (never below the optimum of :func:`jaxswarm.exact.visibility.shortest_path`). It moves at most
-``max_steps`` times (the paper's M = 200). Sizes the paper leaves open are ours: N = 20 sources;
-a window of side 2, so that a move shifts each coordinate by at most 1, less than the thinnest
-wall of our maps (2): the vehicle cannot hop over an obstacle, only clip a corner (the paper's
-vehicle checks only where it lands, and its map #2 traps it, which a vehicle that hops over walls
-would not notice); a tolerance of 0.5.
+Deb's rules. A feasible best point is the vehicle's next position; when no candidate is feasible the
+vehicle stays. The vehicle has arrived when it is within ``tolerance`` of the goal; the goal is then
+appended to its trajectory, so the path length is the length of a trajectory from start to goal
+(never below the optimum of :func:`jaxswarm.exact.visibility.shortest_path`). It moves at most
+``max_steps`` times (the paper's M = 200). Sizes the paper leaves open are ours: N = 20 sources; a
+window of side 2, so that a move shifts each coordinate by at most 1, less than the thinnest wall of
+our maps (2): the vehicle cannot hop over an obstacle, only clip a corner (the paper's vehicle
+checks only where it lands, and its map #2 traps it, which a vehicle that hops over walls would not
+notice); a tolerance of 0.5.
+
+The module holds cABC's config, params and state, the vehicle's arrival test, the colony's pick
+in the sensor window, and the swarm's init, step and change rule, which :func:`build_cabc` binds
+to a config.
 """
 from __future__ import annotations
 
 import dataclasses
+import functools
 from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.bees.colony import search
+from jaxswarm.swarm.bees.colony import Best, search
 from jaxswarm.swarm.bees.guided import constraint_violations, guided, revisits
 from jaxswarm.swarm.core import StepInfo, Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.world.paths import Solution
-from jaxswarm.world.plane import crossings, Plane, trajectory_length
+from jaxswarm.world.plane import Plane, crossings, trajectory_length
 
 
 @dataclasses.dataclass(frozen=True)
@@ -139,75 +144,111 @@ def trajectory(state: CABCState) -> Solution:
                     found=state.reached)
 
 
+def arrive(state: CABCState, plane: Plane, goal: jax.Array, tolerance: jax.Array, *,
+           forbid_crossing: bool) -> CABCState:
+    """Mark the vehicle arrived when it stands within ``tolerance`` (f32[]) of ``goal`` (f32[2])
+    (and, with ``forbid_crossing``, sees it past no obstacle), and end its trajectory at the
+    goal: the goal becomes the last waypoint unless the vehicle stands on it already."""
+    here = state.waypoints[state.count - 1]
+    gap = jnp.linalg.norm(goal - here)
+    arrives = ~state.reached & (gap <= tolerance)
+    if forbid_crossing:
+        arrives &= crossings(plane, here, goal) == 0
+    extra = arrives & (gap > 0)
+    waypoints = state.waypoints.at[state.count].set(
+        jnp.where(extra, goal, state.waypoints[state.count]))
+    return dataclasses.replace(state, waypoints=waypoints,
+                               count=state.count + extra.astype(jnp.int32),
+                               reached=state.reached | arrives)
+
+
+def colony_pick(config: CABCConfig, key: jax.Array, state: CABCState, plane: Plane,
+                goal: jax.Array, params: CABCParams) -> Best:
+    """The point a fresh colony of ``num_agents`` sources picks in the sensor window around the
+    vehicle (``inner_iterations`` cycles on the guided function, best by Deb's rules).
+
+    Args:
+      key: PRNG key of the colony's search.
+      goal: f32[2] the goal.
+
+    Returns:
+      :class:`~.colony.Best`: ``point`` f32[2], its ``phi`` f32[] and ``violations`` i32[],
+      and the search's guided-function ``evaluations`` i32[].
+    """
+    here = state.waypoints[state.count - 1]
+    previous = state.waypoints[jnp.maximum(state.count - 2, 0)]
+    half = params.window / 2
+    lower = jnp.clip(here - half, 0.0, plane.extent)
+    upper = jnp.clip(here + half, 0.0, plane.extent)
+    weights = jnp.stack([params.w1, params.w2, params.w3])
+
+    def evaluate(candidates):
+        """``(phi f32[C], violations i32[C])`` of the candidate points f32[C, 2]."""
+        phi = guided(candidates, weights, plane, goal, here, previous,
+                     state.count >= 2, lower, upper, half)
+        if config.remember:
+            phi = phi + params.w4 * revisits(candidates, state.waypoints, state.count, half)
+        return phi, constraint_violations(candidates, plane, here,
+                                          forbid_crossing=config.forbid_crossing)
+
+    return search(key, evaluate, lower, upper, num_sources=config.num_agents,
+                  cycles=params.inner_iterations.astype(jnp.int32),
+                  limit=params.limit.astype(jnp.int32))
+
+
+def _init(config: CABCConfig, key: jax.Array, plane: Plane, task: Task,
+          params: CABCParams) -> CABCState:
+    """The vehicle at ``task.start`` (f32[2]), arrived already if the goal is within
+    ``tolerance``; ``waypoints`` f32[M + 2, 2]."""
+    waypoints = jnp.full((config.max_steps + 2, 2), jnp.nan, jnp.float32).at[0].set(task.start)
+    state = CABCState(key=key, waypoints=waypoints, count=jnp.int32(1),
+                      reached=jnp.array(False))
+    return arrive(state, plane, task.goal, params.tolerance,
+                  forbid_crossing=config.forbid_crossing)
+
+
+def _step(config: CABCConfig, state: CABCState, plane: Plane, task: Task,
+          params: CABCParams) -> tuple[CABCState, StepInfo]:
+    """One vehicle step: the colony picks a point in the sensor window and the vehicle moves
+    there when the point is feasible, it has not arrived and it has moves left (``max_steps``);
+    else it stays. Returns the state and the :class:`~jaxswarm.swarm.core.StepInfo` (f32[] cost
+    of a trajectory completed by this step, else inf; i32[] moves, 0 or 1; i32[] the colony's
+    guided-function evaluations as lane steps and evaluations)."""
+    key, search_key = jax.random.split(state.key)
+    best = colony_pick(config, search_key, state, plane, task.goal, params)
+    moves = (~state.reached & (best.violations == 0)
+             & (state.count <= config.max_steps))
+    moved = CABCState(key=key, waypoints=state.waypoints.at[state.count].set(best.point),
+                      count=state.count + 1, reached=state.reached)
+    moved = arrive(moved, plane, task.goal, params.tolerance,
+                   forbid_crossing=config.forbid_crossing)
+    after = jax.tree_util.tree_map(lambda new, old: jnp.where(moves, new, old), moved,
+                                   dataclasses.replace(state, key=key))
+    arrived = after.reached & ~state.reached
+    info = StepInfo(iteration_cost=jnp.where(arrived, trajectory(after).cost, jnp.inf),
+                    arrived=after.reached.astype(jnp.float32), converged=after.reached,
+                    moves=moves.astype(jnp.int32), lane_steps=best.evaluations,
+                    evaluations=best.evaluations)
+    return after, info
+
+
+def _adapt(config: CABCConfig, state: CABCState, before: Plane, after: Plane, old_task: Task,
+           new_task: Task, params: CABCParams) -> CABCState:
+    """cABC's rule for a change of the plane or the goal: the vehicle remembers nothing of the
+    plane, so it goes on from where it stands, towards the (possibly new) goal; a new goal
+    makes an arrived vehicle set out again."""
+    if_new_goal = dataclasses.replace(state, reached=jnp.array(False))
+    restart = jnp.any(new_task.goal != old_task.goal)
+    state = jax.tree_util.tree_map(lambda a, b: jnp.where(restart, a, b), if_new_goal, state)
+    return arrive(state, after, new_task.goal, params.tolerance,
+                  forbid_crossing=config.forbid_crossing)
+
+
 def build_cabc(config: CABCConfig) -> Swarm:
-    """cABC on a :class:`~jaxswarm.world.plane.Plane` (see the module docstring)."""
-    points = config.max_steps + 2
-
-    def init(key, plane: Plane, task: Task, params: CABCParams) -> CABCState:
-        waypoints = jnp.full((points, 2), jnp.nan, jnp.float32).at[0].set(task.start)
-        state = CABCState(key=key, waypoints=waypoints, count=jnp.int32(1),
-                          reached=jnp.array(False))
-        return arrive(state, plane, task.goal, params.tolerance)
-
-    def step(state: CABCState, plane: Plane, task: Task, params: CABCParams):
-        key, search_key = jax.random.split(state.key)
-        here = state.waypoints[state.count - 1]
-        previous = state.waypoints[jnp.maximum(state.count - 2, 0)]
-        half = params.window / 2
-        lower = jnp.clip(here - half, 0.0, plane.extent)
-        upper = jnp.clip(here + half, 0.0, plane.extent)
-        weights = jnp.stack([params.w1, params.w2, params.w3])
-
-        def evaluate(candidates):
-            phi = guided(candidates, weights, plane, task.goal, here, previous,
-                         state.count >= 2, lower, upper, half)
-            if config.remember:
-                phi = phi + params.w4 * revisits(candidates, state.waypoints, state.count, half)
-            return phi, constraint_violations(candidates, plane, here,
-                                              forbid_crossing=config.forbid_crossing)
-
-        best = search(search_key, evaluate, lower, upper, num_sources=config.num_agents,
-                      cycles=params.inner_iterations.astype(jnp.int32),
-                      limit=params.limit.astype(jnp.int32))
-        moves = (~state.reached & (best.violations == 0)
-                 & (state.count <= config.max_steps))
-        moved = CABCState(key=key, waypoints=state.waypoints.at[state.count].set(best.point),
-                          count=state.count + 1, reached=state.reached)
-        moved = arrive(moved, plane, task.goal, params.tolerance)
-        after = jax.tree_util.tree_map(lambda new, old: jnp.where(moves, new, old), moved,
-                                       dataclasses.replace(state, key=key))
-        arrived = after.reached & ~state.reached
-        info = StepInfo(iteration_cost=jnp.where(arrived, trajectory(after).cost, jnp.inf),
-                        arrived=after.reached.astype(jnp.float32), converged=after.reached,
-                        moves=moves.astype(jnp.int32), lane_steps=best.evaluations,
-                        evaluations=best.evaluations)
-        return after, info
-
-    def arrive(state: CABCState, plane: Plane, goal, tolerance) -> CABCState:
-        """Mark the vehicle arrived when it stands within ``tolerance`` of the goal (and, with
-        ``forbid_crossing``, sees it past no obstacle), and end its trajectory at the goal."""
-        here = state.waypoints[state.count - 1]
-        gap = jnp.linalg.norm(goal - here)
-        arrives = ~state.reached & (gap <= tolerance)
-        if config.forbid_crossing:
-            arrives &= crossings(plane, here, goal) == 0
-        extra = arrives & (gap > 0)
-        waypoints = state.waypoints.at[state.count].set(
-            jnp.where(extra, goal, state.waypoints[state.count]))
-        return dataclasses.replace(state, waypoints=waypoints,
-                                   count=state.count + extra.astype(jnp.int32),
-                                   reached=state.reached | arrives)
-
-    def adapt(state: CABCState, before, after, old_task: Task, new_task: Task, params):
-        # The vehicle remembers nothing of the plane: after a change it goes on from where it
-        # stands, towards the (possibly new) goal.
-        if_new_goal = dataclasses.replace(state, reached=jnp.array(False))
-        restart = jnp.any(new_task.goal != old_task.goal)
-        state = jax.tree_util.tree_map(lambda a, b: jnp.where(restart, a, b), if_new_goal, state)
-        return arrive(state, after, new_task.goal, params.tolerance)
-
-    return Swarm(name="cabc", config=config, init=jax.jit(init), step=jax.jit(step),
-                 best=trajectory, default_params=cabc_defaults(config.num_agents),
-                 check_params=check_cabc, memory=lambda state: state.waypoints,
-                 memory_label=WAYPOINTS_LABEL, adapt=adapt, world=Plane)
-
+    """cABC on a :class:`~jaxswarm.world.plane.Plane` (see the module docstring): its init, step
+    and change rule with ``config`` bound."""
+    return Swarm(name="cabc", config=config, init=jax.jit(functools.partial(_init, config)),
+                 step=jax.jit(functools.partial(_step, config)), best=trajectory,
+                 default_params=cabc_defaults(config.num_agents), check_params=check_cabc,
+                 memory=lambda state: state.waypoints, memory_label=WAYPOINTS_LABEL,
+                 adapt=functools.partial(_adapt, config), world=Plane)

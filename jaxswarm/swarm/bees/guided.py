@@ -30,7 +30,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.world.plane import crossings, Plane, violations
+from jaxswarm.world.plane import Plane, crossings, violations
 
 
 def goal_distance(points: jax.Array, goal: jax.Array) -> jax.Array:

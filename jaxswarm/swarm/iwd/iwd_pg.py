@@ -26,12 +26,19 @@ Local searches are small IWD runs (``local_agents`` drops, ``local_iterations`` 
 fresh soil: :mod:`.local`) of one batch each stage, all through the shared walker. Every
 complete path measured counts as a fitness call: the drops that arrived, the local searches'
 drops that arrived, each child and each spliced path. After a change of the map (see
-:func:`jaxswarm.dynamic.events.change`) the soil is kept as IWD keeps it and the memory is emptied: its
-paths may cross the change.
+:func:`jaxswarm.dynamic.events.change`) the soil is kept as IWD keeps it and the memory is
+emptied: its paths may cross the change.
+
+The module holds IWD_PG's config and state, and its stages as functions of a ``_Setup`` (the
+config and the local searches' swarm) that :func:`build_iwd_pg` binds: the iteration, the
+measuring of the drops' (smoothed) paths, the memory operators, the intersection stage with its
+steps on the memory's pairs, and the section local search.
 """
 from __future__ import annotations
 
 import dataclasses
+import functools
+from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -43,10 +50,10 @@ from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection
 from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, SOIL_LABEL, IWDConfig, IWDParams, build_iwd,
                                     check_iwd, drop_walk, initial_soil, soil_after_best,
                                     soil_per_node, soil_rule)
-from jaxswarm.swarm.iwd.local import connect, improve_between, splice_if_shorter
+from jaxswarm.swarm.iwd.local import connect_all, improve_between, splice_if_shorter
 from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
 from jaxswarm.swarm.iwd.smooth import smooth_path
-from jaxswarm.swarm.walking import step_budget
+from jaxswarm.swarm.walking import Walk, step_budget
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
 
@@ -120,6 +127,218 @@ jax.tree_util.register_dataclass(
     IWDPGState, data_fields=["key", "soil", "memory", "stale"], meta_fields=[])
 
 
+class _Setup(NamedTuple):
+    """What the stages of one built IWD_PG share.
+
+    Attributes:
+      config: its static sizes and switches.
+      local: the ``iwd`` swarm of its local searches (``local_agents`` drops).
+    """
+
+    config: IWDPGConfig
+    local: Swarm
+
+
+class _Pairs(NamedTuple):
+    """The memory's pairs (0, q), q = 1..P (P = M - 1), that the intersection operators cross.
+
+    Attributes:
+      best: i32[L] the best path (the memory's first).
+      others: i32[P, L] the other remembered paths.
+      present: bool[P] both paths of the pair are there (their costs are finite).
+    """
+
+    best: jax.Array
+    others: jax.Array
+    present: jax.Array
+
+
+class _Offspring(NamedTuple):
+    """The children of the pairs (0, q), q = 1..P, as the intersection operators build them.
+
+    Attributes:
+      paths: i32[P, 2, L] each pair's child with the best path's head (column 0) and the child
+        with path q's head (column 1).
+      costs: f32[P, 2] their lengths, inf where the pair has no child.
+      evaluations: i32[] the fitness calls so far.
+    """
+
+    paths: jax.Array
+    costs: jax.Array
+    evaluations: jax.Array
+
+
+class _Spans(NamedTuple):
+    """Sub-paths for local searches to shorten.
+
+    Attributes:
+      paths: i32[B, L] the paths.
+      begins, ends: i32[B] the positions of each sub-path's first and last node.
+    """
+
+    paths: jax.Array
+    begins: jax.Array
+    ends: jax.Array
+
+
+def _init(config: IWDPGConfig, key, graph: Graph, task: Task, params: IWDParams) -> IWDPGState:
+    """The soil at ``initial_soil`` everywhere (f32[N, K]) and an empty memory of
+    ``memory_size`` paths as long as a walk can be (i32[M, L])."""
+    length = step_budget(graph, config.max_steps) + 1
+    return IWDPGState(key=key, soil=initial_soil(graph, params),
+                      memory=empty_memory(config.memory_size, length), stale=jnp.int32(0))
+
+
+def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IWDParams):
+    """One IWD_PG iteration: the drops walk (changing the soil), their paths are smoothed and
+    measured, the best of them gets the global soil update, all are offered to the memory, and
+    the memory operators run once the best has not improved for ``operator_patience``
+    iterations. Returns ``(state, StepInfo)``."""
+    config = setup.config
+    key, walk_key, operator_key = jax.random.split(state.key, 3)
+    drops = drop_walk(walk_key, graph, task, state.soil, params,
+                      num_agents=config.num_agents, max_steps=config.max_steps)
+    paths, lengths = _measured_paths(graph, drops, smooth=config.smooth)
+    _, _, info = keep_best(drops._replace(path=paths, length=lengths), state.best_path,
+                           state.best_cost)
+    costs = jnp.where(drops.arrived, lengths, jnp.inf)
+    soil = soil_after_best(graph, drops, paths, costs, params)
+    memory = remember(state.memory, paths, costs)
+    stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
+    run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
+    walked = memory
+    memory, extra = jax.lax.cond(
+        run_operators, lambda m: _operators(setup, operator_key, graph, m, params),
+        lambda m: (m, jnp.int32(0)), memory)
+    stale = jnp.where(memory.costs[0] < state.best_cost, 0, stale)
+    # Drops that all took one path have converged only if the operators found nothing.
+    converged = info.converged & ~(memory.costs[0] < walked.costs[0])
+    return (IWDPGState(key=key, soil=soil, memory=memory, stale=stale),
+            info._replace(evaluations=info.evaluations + extra, converged=converged))
+
+
+def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool):
+    """The drops' paths, with ``smooth`` each one that arrived through the global smooth
+    operator, and their lengths: ``(paths i32[A, L], lengths f32[A])`` (a drop that did not
+    arrive keeps its walked length)."""
+    paths = drops.path
+    if smooth:
+        # Every drop's path is smoothed (under vmap a cond would run both sides anyway); a
+        # drop that did not arrive keeps its path.
+        smoothed = jax.vmap(lambda p: smooth_path(graph, p))(paths)
+        paths = jnp.where(drops.arrived[:, None], smoothed, paths)
+    lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
+                        drops.length)
+    return paths, lengths
+
+
+def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
+    """The memory operators that are switched on, the intersection operators first, then the
+    section local search: ``(memory, evaluations i32[])``, the memory sorted again without
+    duplicates."""
+    config = setup.config
+    intersection_key, section_key = jax.random.split(key)
+    evaluations = jnp.int32(0)
+    if config.first_intersection or config.second_intersection:
+        memory, count = _intersections(setup, intersection_key, graph, memory, params)
+        evaluations += count
+    if config.local_search:
+        memory, count = _section_search(setup, section_key, graph, memory, params)
+        evaluations += count
+    return remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs), evaluations
+
+
+def _intersections(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
+    """The intersection operators on the pairs (0, q): ``(memory, evaluations i32[])``, each
+    parent replaced by its child where that is shorter. Their local searches (around the first
+    operator's joints, and the second's connections) run as one batch."""
+    config = setup.config
+    pairs = _Pairs(best=memory.paths[0], others=memory.paths[1:],
+                   present=jnp.isfinite(memory.costs[0]) & jnp.isfinite(memory.costs[1:]))
+    num_pairs = pairs.others.shape[0]
+    offspring, joints, crossing = _first_children(graph, pairs, on=config.first_intersection)
+    improve_first = config.first_intersection and config.local_search
+    heres, theres = [], []
+    if improve_first:
+        around = _around_joints(offspring.paths, joints, config.local_span)
+        rows = jnp.arange(around.paths.shape[0])
+        heres.append(around.paths[rows, around.begins])
+        theres.append(around.paths[rows, around.ends])
+    if config.second_intersection:
+        closest = jax.vmap(lambda b: closest_inner_pair(graph, pairs.best, b))(pairs.others)
+        heres.append(pairs.best[closest[0]])
+        theres.append(pairs.others[jnp.arange(num_pairs), closest[1]])
+    if not heres:
+        return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
+    paths, costs, calls = connect_all(key, graph, jnp.concatenate(heres),
+                                      jnp.concatenate(theres), params, swarm=setup.local,
+                                      iterations=config.local_iterations)
+    if improve_first:
+        offspring = _improved_at_joints(graph, offspring, around, crossing, paths[:2 * num_pairs],
+                                        costs[:2 * num_pairs], calls[:2 * num_pairs])
+    if config.second_intersection:
+        offspring = _with_second_children(graph, pairs, crossing, offspring, closest,
+                                          paths[-num_pairs:], calls[-num_pairs:])
+    return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
+
+
+def _first_children(graph: Graph, pairs: _Pairs, *, on: bool):
+    """The first operator's children of the pairs: ``(offspring, joints i32[P, 2], crossing
+    bool[P])``, the children (cost inf unless the operator is ``on`` and the pair is present and
+    shares an inner node: it crosses) with two fitness calls per crossing pair, and the position
+    in each child where the other parent's part begins."""
+    first = jax.vmap(lambda b: first_intersection(graph, pairs.best, b))(pairs.others)
+    crossing = (jnp.isfinite(first.costs[:, 0]) & pairs.present if on
+                else jnp.zeros((pairs.others.shape[0],), bool))
+    offspring = _Offspring(paths=first.paths,
+                           costs=jnp.where(crossing[:, None], first.costs, jnp.inf),
+                           evaluations=2 * jnp.sum(crossing, dtype=jnp.int32))
+    return offspring, first.joints, crossing
+
+
+def _around_joints(paths: jax.Array, joints: jax.Array, span: int) -> _Spans:
+    """The children ``paths`` (i32[P, 2, L]) in 2P rows, each with its sub-path from ``span``
+    moves before to ``span`` moves after its joint (``joints`` i32[P, 2]), within the path."""
+    flat = paths.reshape((-1,) + paths.shape[-1:])
+    begins = jnp.maximum(joints.reshape(-1) - span, 0)
+    ends = jnp.minimum(joints.reshape(-1) + span, jax.vmap(last_position)(flat))
+    return _Spans(paths=flat, begins=begins, ends=ends)
+
+
+def _improved_at_joints(graph: Graph, offspring: _Offspring, around: _Spans, crossing, middles,
+                        middle_costs, calls) -> _Offspring:
+    """The children with the local searches' paths ``middles`` (i32[2P, L], of lengths
+    ``middle_costs`` f32[2P]) spliced in where they are shorter than the sub-paths ``around``
+    their joints. The searches' fitness calls (``calls`` i32[2P]) and one per spliced path count
+    for the crossing pairs (``crossing`` bool[P]); the others keep no child."""
+    improved, improved_costs, spliced = jax.vmap(
+        lambda p, b, e, m, c: splice_if_shorter(graph, p, b, e, m, c))(
+        around.paths, around.begins, around.ends, middles, middle_costs)
+    used = jnp.repeat(crossing, 2)
+    evaluations = offspring.evaluations + jnp.sum(jnp.where(used, calls + spliced, 0))
+    return _Offspring(paths=improved.reshape(offspring.paths.shape),
+                      costs=jnp.where(crossing[:, None],
+                                      improved_costs.reshape(offspring.costs.shape), jnp.inf),
+                      evaluations=evaluations)
+
+
+def _with_second_children(graph: Graph, pairs: _Pairs, crossing, offspring: _Offspring,
+                          closest, connections, calls) -> _Offspring:
+    """The children, where a present pair does not cross (``crossing`` bool[P]), replaced by
+    the second operator's across ``connections`` (i32[P, L]: the local searches' paths between
+    the pair's closest inner nodes, at positions ``closest``, two i32[P]). Those pairs' searches'
+    fitness calls (``calls`` i32[P]) count, and two per pair with children."""
+    apart = pairs.present & ~crossing
+    i, j = closest
+    second = jax.vmap(lambda b, i, j, c: second_intersection(graph, pairs.best, b, i, j, c))(
+        pairs.others, i, j, connections)
+    evaluations = offspring.evaluations + jnp.sum(jnp.where(apart, calls, 0))
+    evaluations += 2 * jnp.sum(apart & jnp.isfinite(second.costs[:, 0]), dtype=jnp.int32)
+    return _Offspring(paths=jnp.where(apart[:, None, None], second.paths, offspring.paths),
+                      costs=jnp.where(apart[:, None], second.costs, offspring.costs),
+                      evaluations=evaluations)
+
+
 def _replace_parents(memory: Memory, paths, costs) -> Memory:
     """The memory after children ``paths`` (i32[M - 1, 2, L]) of lengths ``costs`` (f32[M - 1,
     2]) of the pairs (0, q), q = 1..M-1: path q is replaced by its child (column 1) when that is
@@ -135,154 +354,68 @@ def _replace_parents(memory: Memory, paths, costs) -> Memory:
     return Memory(paths=new_paths, costs=new_costs)
 
 
+def _section_search(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
+    """Local search on one section's sub-path of each remembered path, the sections split
+    along an axis drawn at random: ``(memory, evaluations i32[])``, each path replaced by its
+    improvement where that is shorter."""
+    config = setup.config
+    axis_key, section_key, search_key = jax.random.split(key, 3)
+    axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
+    present = jnp.isfinite(memory.costs)
+    section = _draw_sections(section_key, graph, memory.paths, present, axis, config)
+    begins, ends = _section_spans(graph, memory.paths, section, axis, config.sections)
+    paths, costs, evals = jax.vmap(lambda k, p, b, e: improve_between(
+        k, graph, p, b, e, params, swarm=setup.local, iterations=config.local_iterations))(
+        jax.random.split(search_key, config.memory_size), memory.paths, begins, ends)
+    better = present & (costs < memory.costs)
+    return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
+                   costs=jnp.where(better, costs, memory.costs)),
+            jnp.sum(jnp.where(present, evals, 0)))
+
+
+def _draw_sections(key, graph: Graph, paths, present, axis, config: IWDPGConfig) -> jax.Array:
+    """i32[M]: for each path (i32[M, L]; ``present`` bool[M]), the one of ``sections`` sections
+    along ``axis`` (i32[], 0 for x, 1 for y) that its local search works in, drawn among those
+    it enters with weight ``1 - score`` of the fuzzy section scores (``fuzzy``) or uniformly."""
+    lengths = jax.vmap(lambda p: fuzzy.section_lengths(graph, p, axis, config.sections))(paths)
+    enters = lengths > 0
+    if config.fuzzy:
+        weight = 1.0 - fuzzy.section_scores(lengths, present)
+    else:
+        weight = jnp.ones_like(lengths)
+    # A section every path enters with score 1 still gets a small chance.
+    weight = jnp.where(enters, jnp.maximum(weight, 1e-3), 0.0)
+    keys = jax.random.split(key, config.memory_size)
+    return jax.vmap(lambda k, w: jax.random.categorical(k, jnp.log(w)))(keys, weight)
+
+
+def _section_spans(graph: Graph, paths, section, axis, sections: int):
+    """``(begins, ends)`` i32[M]: the first and last positions of each path's (i32[M, L]) nodes
+    inside its ``section`` (i32[M]) along ``axis``; (0, 0) for a path with none there."""
+    node_section = fuzzy.section_of(graph, graph.xy[jnp.maximum(paths, 0), axis], axis,
+                                    sections)
+    inside = (node_section == section[:, None]) & (paths >= 0)
+    position = jnp.arange(paths.shape[1])
+    begins = jnp.min(jnp.where(inside, position, paths.shape[1]), axis=1)
+    ends = jnp.maximum(jnp.max(jnp.where(inside, position, -1), axis=1), 0)
+    return jnp.minimum(begins, ends), ends
+
+
+def _adapt(state: IWDPGState, before: Graph, after: Graph, old: Task, new: Task,
+           params: IWDParams) -> IWDPGState:
+    """IWD_PG's rule for a change of the map or the goal: the soil as IWD keeps it
+    (:func:`~.iwd.soil_rule`), the memory emptied (its paths may cross the change)."""
+    return dataclasses.replace(soil_rule(state, before, after, old, new, params),
+                               memory=empty_memory(*state.memory.paths.shape),
+                               stale=jnp.int32(0))
+
+
 def build_iwd_pg(config: IWDPGConfig) -> Swarm:
-    """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams`."""
+    """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams`: its init, step
+    and change rule, the step's stages sharing one local-search swarm."""
     local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps))
-    size = config.memory_size
-
-    def init(key, graph: Graph, task: Task, params: IWDParams) -> IWDPGState:
-        length = step_budget(graph, config.max_steps) + 1
-        return IWDPGState(key=key,
-                          soil=initial_soil(graph, params),
-                          memory=empty_memory(size, length), stale=jnp.int32(0))
-
-    def connect_all(key, graph, heres, theres, params):
-        """Small IWD runs (one batch through the walker) from ``heres`` to ``theres``
-        (i32[B]): ``(paths i32[B, L], costs f32[B], evaluations i32[B])``."""
-        keys = jax.random.split(key, heres.shape[0])
-        return jax.vmap(lambda k, here, there: connect(
-            k, graph, here, there, params, swarm=local,
-            iterations=config.local_iterations))(keys, heres, theres)
-
-    def intersections(key, graph, memory: Memory, params):
-        """The intersection operators on the pairs (0, q): ``(memory, evaluations)``. Their
-        local searches (around the first operator's joints, and the second's connections) run
-        as one batch."""
-        a, others = memory.paths[0], memory.paths[1:]
-        pairs = others.shape[0]
-        pair = jnp.isfinite(memory.costs[0]) & jnp.isfinite(memory.costs[1:])
-        first = jax.vmap(lambda b: first_intersection(graph, a, b))(others)
-        crossing = (jnp.isfinite(first.costs[:, 0]) & pair if config.first_intersection
-                    else jnp.zeros((pairs,), bool))
-        kids_paths = first.paths
-        kids_costs = jnp.where(crossing[:, None], first.costs, jnp.inf)
-        evaluations = 2 * jnp.sum(crossing, dtype=jnp.int32)
-        heres, theres = [], []
-        improve_first = config.first_intersection and config.local_search
-        if improve_first:
-            flat = kids_paths.reshape((-1,) + a.shape)
-            begins = jnp.maximum(first.joints.reshape(-1) - config.local_span, 0)
-            ends = jnp.minimum(first.joints.reshape(-1) + config.local_span,
-                               jax.vmap(last_position)(flat))
-            rows = jnp.arange(flat.shape[0])
-            heres.append(flat[rows, begins])
-            theres.append(flat[rows, ends])
-        if config.second_intersection:
-            i, j = jax.vmap(lambda b: closest_inner_pair(graph, a, b))(others)
-            heres.append(a[i])
-            theres.append(others[jnp.arange(pairs), j])
-        if not heres:
-            return _replace_parents(memory, kids_paths, kids_costs), evaluations
-        paths, costs, calls = connect_all(key, graph, jnp.concatenate(heres),
-                                          jnp.concatenate(theres), params)
-        if improve_first:
-            improved, improved_costs, spliced = jax.vmap(
-                lambda p, b, e, m, c: splice_if_shorter(graph, p, b, e, m, c))(
-                flat, begins, ends, paths[:2 * pairs], costs[:2 * pairs])
-            used = jnp.repeat(crossing, 2)
-            evaluations += jnp.sum(jnp.where(used, calls[:2 * pairs] + spliced, 0))
-            kids_paths = improved.reshape(kids_paths.shape)
-            kids_costs = jnp.where(crossing[:, None], improved_costs.reshape(kids_costs.shape),
-                                   jnp.inf)
-        if config.second_intersection:
-            apart = pair & ~crossing
-            second = jax.vmap(lambda b, i, j, c: second_intersection(graph, a, b, i, j, c))(
-                others, i, j, paths[-pairs:])
-            evaluations += jnp.sum(jnp.where(apart, calls[-pairs:], 0))
-            evaluations += 2 * jnp.sum(apart & jnp.isfinite(second.costs[:, 0]), dtype=jnp.int32)
-            kids_paths = jnp.where(apart[:, None, None], second.paths, kids_paths)
-            kids_costs = jnp.where(apart[:, None], second.costs, kids_costs)
-        return _replace_parents(memory, kids_paths, kids_costs), evaluations
-
-    def section_search(key, graph, memory: Memory, params):
-        """Local search on one section's sub-path of each remembered path: ``(memory,
-        evaluations)``."""
-        axis_key, section_key, search_key = jax.random.split(key, 3)
-        axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
-        lengths = jax.vmap(lambda p: fuzzy.section_lengths(graph, p, axis, config.sections))(
-            memory.paths)
-        present = jnp.isfinite(memory.costs)
-        enters = lengths > 0
-        if config.fuzzy:
-            weight = 1.0 - fuzzy.section_scores(lengths, present)
-        else:
-            weight = jnp.ones_like(lengths)
-        # A section every path enters with score 1 still gets a small chance.
-        weight = jnp.where(enters, jnp.maximum(weight, 1e-3), 0.0)
-        keys = jax.random.split(section_key, size)
-        section = jax.vmap(lambda k, w: jax.random.categorical(k, jnp.log(w)))(keys, weight)
-        node_section = fuzzy.section_of(graph, graph.xy[jnp.maximum(memory.paths, 0), axis],
-                                        axis, config.sections)
-        inside = (node_section == section[:, None]) & (memory.paths >= 0)
-        position = jnp.arange(memory.paths.shape[1])
-        begins = jnp.min(jnp.where(inside, position, memory.paths.shape[1]), axis=1)
-        ends = jnp.max(jnp.where(inside, position, -1), axis=1)
-        begins = jnp.minimum(begins, jnp.maximum(ends, 0))
-        paths, costs, evals = jax.vmap(lambda k, p, b, e: improve_between(
-            k, graph, p, b, e, params, swarm=local, iterations=config.local_iterations))(
-            jax.random.split(search_key, size), memory.paths, begins, jnp.maximum(ends, 0))
-        better = present & (costs < memory.costs)
-        return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
-                       costs=jnp.where(better, costs, memory.costs)),
-                jnp.sum(jnp.where(present, evals, 0)))
-
-    def operators(key, graph, memory: Memory, params):
-        intersection_key, section_key = jax.random.split(key)
-        evaluations = jnp.int32(0)
-        if config.first_intersection or config.second_intersection:
-            memory, count = intersections(intersection_key, graph, memory, params)
-            evaluations += count
-        if config.local_search:
-            memory, count = section_search(section_key, graph, memory, params)
-            evaluations += count
-        # Sorted again, duplicates dropped.
-        return remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs), \
-            evaluations
-
-    def step(state: IWDPGState, graph: Graph, task: Task, params: IWDParams):
-        key, walk_key, operator_key = jax.random.split(state.key, 3)
-        drops = drop_walk(walk_key, graph, task, state.soil, params,
-                          num_agents=config.num_agents, max_steps=config.max_steps)
-        paths = drops.path
-        if config.smooth:
-            # Every drop's path is smoothed (under vmap a cond would run both sides anyway); a
-            # drop that did not arrive keeps its path.
-            smoothed = jax.vmap(lambda p: smooth_path(graph, p))(paths)
-            paths = jnp.where(drops.arrived[:, None], smoothed, paths)
-        lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
-                            drops.length)
-        _, _, info = keep_best(drops._replace(path=paths, length=lengths), state.best_path,
-                               state.best_cost)
-        costs = jnp.where(drops.arrived, lengths, jnp.inf)
-        soil = soil_after_best(graph, drops, paths, costs, params)
-        memory = remember(state.memory, paths, costs)
-        stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
-        run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
-        walked = memory
-        memory, extra = jax.lax.cond(
-            run_operators, lambda m: operators(operator_key, graph, m, params),
-            lambda m: (m, jnp.int32(0)), memory)
-        stale = jnp.where(memory.costs[0] < state.best_cost, 0, stale)
-        # Drops that all took one path have converged only if the operators found nothing.
-        converged = info.converged & ~(memory.costs[0] < walked.costs[0])
-        return (IWDPGState(key=key, soil=soil, memory=memory, stale=stale),
-                info._replace(evaluations=info.evaluations + extra, converged=converged))
-
-    def adapt(state, before, after, old, new, params):
-        return dataclasses.replace(soil_rule(state, before, after, old, new, params),
-                                   memory=empty_memory(*state.memory.paths.shape),
-                                   stale=jnp.int32(0))
-
-    return Swarm(name="iwd_pg", config=config, init=jax.jit(init), step=jax.jit(step),
-                 best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd,
-                 memory=soil_per_node, memory_label=SOIL_LABEL, adapt=adapt)
+    setup = _Setup(config=config, local=local)
+    return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
+                 step=jax.jit(functools.partial(_step, setup)), best=best_solution,
+                 default_params=DEFAULT_IWD, check_params=check_iwd, memory=soil_per_node,
+                 memory_label=SOIL_LABEL, adapt=_adapt)

@@ -1,10 +1,12 @@
-"""IWD_PG's local search: a small IWD run between two nodes of a path, spliced in when shorter.
+"""IWD_PG's local search: a small IWD run between two nodes of a path, spliced in when shorter
+(:func:`connect_all` runs a batch of them as one).
 
 The run is the ``iwd`` swarm itself with fewer drops and iterations and a memory of its own
 (fresh soil, no IWD_PG memory), through the engine's run loop; its fitness calls count.
 """
 from __future__ import annotations
 
+import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.core import Swarm, Task, run
@@ -20,6 +22,15 @@ def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations:
     state, trace = run(swarm, key, graph, Task(start=here, goal=there), params,
                        iterations=iterations)
     return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
+
+
+def connect_all(key, graph: Graph, heres, theres, params, *, swarm: Swarm, iterations: int):
+    """Small IWD runs (one batch through the walker) from the nodes ``heres`` to ``theres``
+    (i32[B]), each with its own key split from ``key``: ``(paths i32[B, L], costs f32[B],
+    evaluations i32[B])`` as :func:`connect` gives them."""
+    keys = jax.random.split(key, heres.shape[0])
+    return jax.vmap(lambda k, here, there: connect(
+        k, graph, here, there, params, swarm=swarm, iterations=iterations))(keys, heres, theres)
 
 
 def splice_if_shorter(graph: Graph, path, begin, end, middle, middle_cost):

@@ -33,7 +33,6 @@ paper's 50 x 50 and 100 x 100 maps the paper's RFD* converged to long paths with
 iterations for every setting we tried. With these defaults ``rfd_graded`` reaches the Dijkstra
 optimum in at least 19 of 20 seeds on each of the nine paper maps (``sweeps/rfd_static.py``,
 ``tests/test_rfd_quality.py``), and in 59 of 60 runs on Moving AI maps it was never tuned on.
-Until jaxswarm 0.2.0 this law was registered as ``rfd_star`` (see CHANGELOG.md).
 """
 from __future__ import annotations
 
@@ -154,8 +153,8 @@ def settle(graph: Graph, altitude, params: GradedParams):
     which no filled node is a pit, whatever the order of the sweeps.
 
     Under ``vmap`` (a sweep) the runs settle one at a time
-    (:func:`~jaxswarm.runtime.batching.one_at_a_time`): most need one sweep, a few dozens, and settled
-    together each paid for the slowest."""
+    (:func:`~jaxswarm.runtime.batching.one_at_a_time`): most need one sweep, a few dozens, and
+    settled together each paid for the slowest."""
     rise = jnp.where(graph.valid_edges(), params.repose * graph.cost, jnp.inf)
 
     def raise_pits(here, lowest):  # lowest is inf for a node without edges

@@ -1,8 +1,8 @@
 """The walker shared by every swarm: the loop of queued agents over busy lanes (:mod:`.loop`),
-its random streams (:mod:`.streams`), the masked sampler (:mod:`.sampler`), packed visited sets
-(:mod:`.bits`), what algorithms hand it (:mod:`.tables`: edge tables, safe neighbour gathers
-and values, the goal heuristic, the step budget) and the per-step hook for memory that changes
-while the agents walk (:mod:`.hooks`)."""
+one lockstep step of the lanes (:mod:`.lanes`), its random streams (:mod:`.streams`), the masked
+sampler (:mod:`.sampler`), packed visited sets (:mod:`.bits`), what algorithms hand it
+(:mod:`.tables`: edge tables, safe neighbour gathers and values, the goal heuristic, the step
+budget) and the per-step hook for memory that changes while the agents walk (:mod:`.hooks`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, STEPS_PER_REFILL, Walk,
                                          visited_nodes, walk)

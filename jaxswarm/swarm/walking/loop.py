@@ -8,6 +8,8 @@ walk; on grids and path maps the neighbours are the node plus fixed slot offsets
 log-weights are gathered), and draws one slot through the masked sampler (:mod:`.sampler`; a
 greedy agent takes its most likely slot instead, ties drawn at random). An agent stops when it
 reaches the goal, when it has no admissible neighbour ("stuck"), or when its step budget runs out.
+That step of every lane is :func:`.lanes.step`; this module holds the queue that hands agents to
+lanes, the loop over blocks of steps, the results it writes and the batching rule.
 
 Agents do not each keep a lane until the slowest one finishes. The loop steps a fixed number of
 lanes (at most ``LANES``) ``STEPS_PER_REFILL`` moves at a time; then up to a quarter of the lanes
@@ -49,11 +51,10 @@ import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.swarm.walking import bits
-from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, StepHook, edge_groups
-from jaxswarm.swarm.walking.sampler import sample_masked
-from jaxswarm.swarm.walking.streams import uniforms
+from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
+from jaxswarm.swarm.walking.lanes import Lanes, WalkInputs, initial_state, start_visited, step
 from jaxswarm.world.graph import NO_NODE, Graph
-from jaxswarm.world.lattice import ORTHOGONAL_SLOTS, lattice_length, slot_offsets, total_length
+from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
 LANES = 1024
 """Lanes of one walk loop (fewer when the walk has fewer agents). Measured on maze100 on a 2-core
@@ -84,8 +85,8 @@ class Walk(NamedTuple):
       slots: i8[A, L - 1] (i16 on graphs of more than 127 slots) neighbour slot of each move
         (``path[a, t + 1] = nbr[path[a, t], slot]``), -1 after the agent stopped.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
-        counted by kind (:func:`jaxswarm.world.lattice.lattice_length`), so the same moves in any order
-        give the same float; on general graphs the edge costs are summed.
+        counted by kind (:func:`jaxswarm.world.lattice.lattice_length`), so the same moves in any
+        order give the same float; on general graphs the edge costs are summed.
       arrived: bool[A] reached the goal.
       stuck: bool[A] stopped with no admissible neighbour (before arriving).
       position: i32[A] the node each agent stopped at.
@@ -199,35 +200,6 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
     return walk_runs
 
 
-class Lanes(NamedTuple):
-    """The state of the loop's lanes (a pytree; leading axis ``l``, the lanes).
-
-    Attributes:
-      agent: i32[l] the lane's agent, as its row in the loop's results; the number of rows
-        when the lane holds none.
-      run: i32[l] the run (of a batch of walks) the agent belongs to.
-      position: i32[l] the node the agent is at.
-      visited: u32[l, ceil(N / 32)] the nodes on its path (:mod:`.bits`).
-      moves: i32[l] moves made.
-      diagonal: i32[l] diagonal moves among them (grids and path maps).
-      walking: bool[l] still moving.
-      arrived: bool[l] reached the goal.
-      stuck: bool[l] stopped with no admissible neighbour.
-      state: f32[l, E] the agent's own state (with a hook; else None).
-    """
-
-    agent: jax.Array
-    run: jax.Array
-    position: jax.Array
-    visited: jax.Array
-    moves: jax.Array
-    diagonal: jax.Array
-    walking: jax.Array
-    arrived: jax.Array
-    stuck: jax.Array
-    state: Any = None
-
-
 class Results(NamedTuple):
     """What each agent of a loop did (leading axis: its agents), written as it walks (``path``,
     ``slots``) and when it stops (the rest); the fields are the :class:`Walk`'s."""
@@ -241,6 +213,24 @@ class Results(NamedTuple):
     arrived: jax.Array
     stuck: jax.Array
     state: Any = None
+
+
+class Queue(NamedTuple):
+    """The agents of one loop (its results' rows: agent ``f`` is agent ``f % num_agents`` of
+    run ``f // num_agents``) and the order in which they take a lane.
+
+    Attributes:
+      count: the number of rows (static).
+      run_of_row: i32[count] each row's run.
+      order: i32[count] the rows that walk (their run does not start at its goal) first, in
+        row order, then the others.
+      live: i32[] how many rows walk: the queue's entries ``0 .. live - 1``.
+    """
+
+    count: int
+    run_of_row: jax.Array
+    order: jax.Array
+    live: jax.Array
 
 
 class Loop(NamedTuple):
@@ -262,9 +252,13 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
     """The walks of R runs on one map through one queue (leading axis R on every input; the
     table's and the hook params' may be 1, shared by every run)."""
     runs = start.shape[0]
-    results, lane_steps, memory = _walk_agents(
-        runs * num_agents, seed, graph, log_weights, start, goal, memory, hook_params,
-        num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents, hook=hook)
+    inputs = WalkInputs(
+        graph=graph, log_weights=log_weights, seed=seed, start=start, goal=goal, hook=hook,
+        hook_params=hook_params, num_agents=num_agents, max_steps=max_steps,
+        greedy_agents=greedy_agents,
+        slot_dtype=jnp.int8 if graph.max_degree <= 127 else jnp.int16,
+        offsets=jnp.asarray(slot_offsets(graph)) if graph.is_grid else None)
+    results, lane_steps, memory = _walk_agents(inputs, runs * num_agents, memory)
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
     else:
@@ -277,198 +271,173 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
                 lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
 
 
-def _walk_agents(count: int, seed, graph: Graph, log_weights, start, goal, memory, hook_params,
-                 *, num_agents: int, max_steps: int, greedy_agents: int,
-                 hook: StepHook | None):
-    """Walk the ``count`` agents of a batch of runs (agent ``f`` is agent ``f % num_agents`` of
-    run ``f // num_agents``) in one loop: the agents of runs with somewhere to go are queued,
-    the others keep their initial results.
+def _walk_agents(inputs: WalkInputs, count: int, memory):
+    """Walk the ``count`` agents of a batch of runs in one loop: the agents of runs with
+    somewhere to go are queued, the others keep their initial results. The lanes take queued
+    agents until the queue is empty and at most ``lanes // COMPACT_SHARE`` of them walk; those
+    then go on in that many lanes.
+
+    Args:
+      inputs: the walk's inputs (R runs).
+      count: R times the agents per run (static).
+      memory: the hook's memory before the walk, leading axis R (None without a hook).
 
     Returns:
-      ``(Results, lane_steps i32[], memory)``, the results' rows in agent order.
+      ``(Results, lane_steps i32[], memory)``, the results' rows in agent order (agent ``f`` is
+      agent ``f % num_agents`` of run ``f // num_agents``) and the memory after the walk.
     """
-    n = graph.num_nodes
-    words = (n + 31) // 32
+    queue = _queue(inputs, count)
+    initial = _initial_results(inputs, queue)
     num_lanes = min(LANES, count)
-    slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
-    offsets = jnp.asarray(slot_offsets(graph)) if graph.is_grid else None
-    rows = jnp.arange(count, dtype=jnp.int32)
-    run_of_row = rows // num_agents
-    live_row = start[run_of_row] != goal[run_of_row]
-    queue = jnp.argsort(~live_row, stable=True).astype(jnp.int32)  # rows that walk first
-    live = jnp.sum(live_row)
-
-    def start_visited(nodes):
-        return bits.mark(jnp.zeros((nodes.shape[0], words), jnp.uint32),
-                         jnp.arange(nodes.shape[0]), nodes)
-
-    def params_of(run):
-        """The hook params of runs ``run`` (i32[l]), f32[l] leaves."""
-        return jax.tree_util.tree_map(
-            lambda p: p[run] if p.shape[0] > 1 else jnp.broadcast_to(p[0], run.shape),
-            hook_params)
-
-    def initial_state(run):
-        """f32[l, E] the hook's state of agents starting in runs ``run`` (None without one)."""
-        if hook is None:
-            return None
-        return jax.vmap(hook.initial_state)(params_of(run))
-
-    here = start[run_of_row]
-    results = Results(
-        path=jnp.full((count, max_steps + 1), NO_NODE, jnp.int32),  # the start goes in last
-        slots=jnp.full((count, max_steps), -1, slot_dtype),
-        position=here, visited=start_visited(here),
-        moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
-        arrived=here == goal[run_of_row], stuck=jnp.zeros((count,), bool),
-        state=initial_state(run_of_row))
-
-    def fresh_lanes(queued):
-        """Lanes holding the queue's entries ``queued`` (i32[l]; ``>= live``: none), at the
-        start node."""
-        holds = queued < live
-        agent = jnp.where(holds, queue[jnp.minimum(queued, count - 1)], count)
-        run = run_of_row[jnp.minimum(agent, count - 1)]
-        zeros = jnp.zeros(queued.shape, jnp.int32)
-        return Lanes(agent=agent, run=run, position=start[run], visited=start_visited(start[run]),
-                     moves=zeros, diagonal=zeros, walking=holds,
-                     arrived=jnp.zeros(queued.shape, bool), stuck=jnp.zeros(queued.shape, bool),
-                     state=initial_state(run))
-
-    def neighbours_of(here):
-        """i32[l, K] each lane's neighbours, clamped into the map: the slot offsets on grids
-        (no gather), ``nbr`` otherwise. A slot without a neighbour yields some node there,
-        never used: its log-weight is -inf."""
-        if graph.is_grid:
-            return jnp.clip(here[:, None] + offsets, 0, n - 1)
-        return jnp.maximum(graph.nbr[here], 0)
-
-    def one_step(lanes: Lanes, memory, claims):
-        here = lanes.position
-        neighbours = neighbours_of(here)
-        row = log_weights[lanes.run if log_weights.shape[0] > 1 else 0, here]
-        seen = bits.is_marked(lanes.visited, neighbours)
-        admissible = (row > -jnp.inf) & ~seen & lanes.walking[:, None]
-        if hook is not None:
-            params = params_of(lanes.run)
-            rows = jax.tree_util.tree_map(lambda m: m[lanes.run, here], memory)
-            row = row + hook.log_weights(params, rows, admissible)
-        within_run = lanes.agent % num_agents
-        uniform = uniforms(seed[lanes.run], within_run, lanes.moves)
-        greedy = within_run < greedy_agents if greedy_agents else None
-        choice, has_choice = sample_masked(uniform, row, admissible, greedy)
-        moving = lanes.walking & has_choice
-        target = jnp.take_along_axis(neighbours, jnp.maximum(choice, 0)[:, None], axis=1)[:, 0]
-        there = jnp.where(moving, target, here)
-        moves = lanes.moves + moving
-        arrived_now = moving & (there == goal[lanes.run])
-        if hook is not None:
-            slot = jnp.where(moving, choice, -1)
-            groups, claims = edge_groups(lanes.run, here, slot, moving, claims, n,
-                                         graph.max_degree)
-            memory, state = hook.update(params, memory, Move(
-                run=lanes.run, agent=lanes.agent, here=here, slot=slot, moving=moving,
-                state=lanes.state, groups=groups), graph)
-            lanes = lanes._replace(state=state)
-        lanes = lanes._replace(
-            position=there,
-            visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there),
-            moves=moves,
-            diagonal=lanes.diagonal + (moving & (choice >= ORTHOGONAL_SLOTS)),
-            walking=moving & ~arrived_now & (moves < max_steps),
-            arrived=lanes.arrived | arrived_now,
-            stuck=lanes.stuck | (lanes.walking & ~has_choice))
-        return (lanes, memory, claims, jnp.where(moving, choice, -1).astype(slot_dtype),
-                jnp.where(moving, there, NO_NODE))
-
-    def block(loop: Loop) -> Loop:
-        """``STEPS_PER_REFILL`` moves of every lane; the moves go to small step-major blocks
-        (one contiguous row per step), written into the results as one window per lane
-        (columns past the budget are dropped)."""
-        lanes = loop.lanes
-        width = lanes.agent.shape[0]
-
-        def step_into_blocks(i, inner):
-            lanes, memory, claims, slots, nodes = inner
-            lanes, memory, claims, slot, node = one_step(lanes, memory, claims)
-            return lanes, memory, claims, slots.at[i].set(slot), nodes.at[i].set(node)
-
-        first_move = lanes.moves
-        slots = jnp.full((STEPS_PER_REFILL, width), -1, slot_dtype)
-        nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
-        lanes, memory, claims, slots, nodes = jax.lax.fori_loop(
-            0, STEPS_PER_REFILL, step_into_blocks,
-            (lanes, loop.memory, loop.claims, slots, nodes))
-        row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
-        column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
-        results = loop.results._replace(
-            slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
-            path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
-        return loop._replace(lanes=lanes, results=results, memory=memory, claims=claims,
-                             lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
-
-    def retire(results: Results, lanes: Lanes, which) -> Results:
-        """``results`` with the agents of lanes ``which`` (i32[r], ``>= l`` for none) stored."""
-        width = lanes.agent.shape[0]
-        held = jnp.minimum(which, width - 1)
-        row = jnp.where(which < width, lanes.agent[held], count)
-        kept = ("position", "visited", "moves", "diagonal", "arrived", "stuck") + (
-            ("state",) if hook is not None else ())
-        return results._replace(**{
-            name: getattr(results, name).at[row].set(getattr(lanes, name)[held], mode="drop")
-            for name in kept})
-
-    def stopped(lanes: Lanes):
-        return (lanes.agent < count) & ~lanes.walking
-
-    def refill(loop: Loop) -> Loop:
-        """Up to ``l // REFILL_SHARE`` lanes whose agent stopped store it and take the next
-        (or are emptied when the queue is)."""
-        lanes = loop.lanes
-        width = lanes.agent.shape[0]
-        which = jnp.nonzero(stopped(lanes), size=max(width // REFILL_SHARE, 1),
-                            fill_value=width)[0]
-        results = retire(loop.results, lanes, which)
-        taken = which < width
-        fresh = fresh_lanes(jnp.where(taken, loop.next_queued + jnp.cumsum(taken) - 1, count))
-        lanes = jax.tree_util.tree_map(
-            lambda old, new: old.at[jnp.where(taken, which, width)].set(new, mode="drop"),
-            lanes, fresh)
-        return loop._replace(lanes=lanes, results=results,
-                             next_queued=jnp.minimum(loop.next_queued + jnp.sum(taken), live))
-
-    def walking_count(loop: Loop):
-        return jnp.sum(loop.lanes.walking)
-
-    def flush(loop: Loop) -> Loop:
-        """Every stopped agent still in a lane stored, its lane emptied."""
-        lanes = loop.lanes
-        width = lanes.agent.shape[0]
-        done = stopped(lanes)
-        results = retire(loop.results, lanes, jnp.where(done, jnp.arange(width), width))
-        return loop._replace(results=results,
-                             lanes=lanes._replace(agent=jnp.where(done, count, lanes.agent)))
-
-    claims = None if hook is None else jnp.full((start.shape[0] * n,), UNCLAIMED, jnp.int32)
-    loop = Loop(lanes=fresh_lanes(jnp.arange(num_lanes)), results=results,
-                next_queued=jnp.minimum(jnp.int32(num_lanes), live), lane_steps=jnp.int32(0),
-                memory=memory, claims=claims)
+    claims = None if inputs.hook is None else jnp.full(
+        (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
+    loop = Loop(lanes=_fresh_lanes(inputs, queue, jnp.arange(num_lanes)), results=initial,
+                next_queued=jnp.minimum(jnp.int32(num_lanes), queue.live),
+                lane_steps=jnp.int32(0), memory=memory, claims=claims)
     few = num_lanes // COMPACT_SHARE
-
-    def keep_queueing(loop: Loop):
-        return (loop.next_queued < live) | (walking_count(loop) > few)
-
-    loop = flush(jax.lax.while_loop(keep_queueing, lambda loop: refill(block(loop)), loop))
+    loop = _flush(inputs, queue, jax.lax.while_loop(
+        functools.partial(_keeps_queueing, queue, few),
+        lambda loop: _refill(inputs, queue, _block(inputs, loop)), loop))
     if few:
-        # The queue is empty and at most ``few`` agents still walk: they go on in ``few`` lanes.
-        which = jnp.nonzero(loop.lanes.walking, size=few, fill_value=num_lanes)[0]
-        lanes = jax.tree_util.tree_map(lambda x: x[jnp.minimum(which, num_lanes - 1)],
-                                       loop.lanes)
-        lanes = lanes._replace(walking=lanes.walking & (which < num_lanes),
-                               agent=jnp.where(which < num_lanes, lanes.agent, count))
-        loop = flush(jax.lax.while_loop(lambda loop: walking_count(loop) > 0, block,
-                                        loop._replace(lanes=lanes)))
-    # Written into the loop's output in place; set in the initial buffer, the start column made
-    # XLA fill the whole buffer element by element (a third of a large walk's time).
-    results = loop.results._replace(path=loop.results.path.at[:, 0].set(here))
+        loop = _flush(inputs, queue, jax.lax.while_loop(
+            lambda loop: _walking_count(loop.lanes) > 0, functools.partial(_block, inputs),
+            _compact(queue, loop, few)))
+    # The start column goes into the loop's output, in place: set in the initial buffer, it
+    # makes XLA fill the whole buffer element by element (a third of a large walk's time).
+    results = loop.results._replace(path=loop.results.path.at[:, 0].set(initial.position))
     return results, loop.lane_steps, loop.memory
+
+
+def _queue(inputs: WalkInputs, count: int) -> Queue:
+    """The loop's ``count`` rows (static) in the order they take a lane: the agents of runs
+    whose start is not their goal (``inputs.start``, ``inputs.goal`` i32[R]) first."""
+    rows = jnp.arange(count, dtype=jnp.int32)
+    run_of_row = rows // inputs.num_agents
+    live_row = inputs.start[run_of_row] != inputs.goal[run_of_row]
+    return Queue(count=count, run_of_row=run_of_row,
+                 order=jnp.argsort(~live_row, stable=True).astype(jnp.int32),
+                 live=jnp.sum(live_row))
+
+
+def _initial_results(inputs: WalkInputs, queue: Queue) -> Results:
+    """Every row's results before it walks: at its run's start, which it has visited, no move,
+    arrived when the start is the goal; ``path`` i32[count, max_steps + 1] and ``slots``
+    ``slot_dtype[count, max_steps]`` all -1 (the start column is written after the loop)."""
+    count, run_of_row = queue.count, queue.run_of_row
+    here = inputs.start[run_of_row]
+    return Results(
+        path=jnp.full((count, inputs.max_steps + 1), NO_NODE, jnp.int32),
+        slots=jnp.full((count, inputs.max_steps), -1, inputs.slot_dtype),
+        position=here, visited=start_visited(inputs, here),
+        moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
+        arrived=here == inputs.goal[run_of_row], stuck=jnp.zeros((count,), bool),
+        state=initial_state(inputs, run_of_row))
+
+
+def _fresh_lanes(inputs: WalkInputs, queue: Queue, queued: jax.Array) -> Lanes:
+    """Lanes holding the queue's entries ``queued`` (i32[l]; ``>= queue.live``: none, the lane
+    empty and not walking), at their run's start."""
+    count = queue.count
+    holds = queued < queue.live
+    agent = jnp.where(holds, queue.order[jnp.minimum(queued, count - 1)], count)
+    run = queue.run_of_row[jnp.minimum(agent, count - 1)]
+    zeros = jnp.zeros(queued.shape, jnp.int32)
+    return Lanes(agent=agent, run=run, position=inputs.start[run],
+                 visited=start_visited(inputs, inputs.start[run]), moves=zeros, diagonal=zeros,
+                 walking=holds, arrived=jnp.zeros(queued.shape, bool),
+                 stuck=jnp.zeros(queued.shape, bool), state=initial_state(inputs, run))
+
+
+def _block(inputs: WalkInputs, loop: Loop) -> Loop:
+    """``STEPS_PER_REFILL`` lockstep moves of every lane (:func:`.lanes.step`). The moves go to
+    small step-major blocks (``slot_dtype`` and i32 ``[STEPS_PER_REFILL, l]``, one contiguous
+    row per step), written into the results' ``slots`` and ``path`` as one window per lane
+    (columns past the budget and rows of empty lanes are dropped)."""
+    lanes = loop.lanes
+    width = lanes.agent.shape[0]
+
+    def step_into_blocks(i, inner):
+        lanes, memory, claims, slots, nodes = inner
+        lanes, memory, claims, slot, node = step(inputs, lanes, memory, claims)
+        return lanes, memory, claims, slots.at[i].set(slot), nodes.at[i].set(node)
+
+    first_move = lanes.moves
+    slots = jnp.full((STEPS_PER_REFILL, width), -1, inputs.slot_dtype)
+    nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
+    lanes, memory, claims, slots, nodes = jax.lax.fori_loop(
+        0, STEPS_PER_REFILL, step_into_blocks, (lanes, loop.memory, loop.claims, slots, nodes))
+    row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
+    column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
+    results = loop.results._replace(
+        slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
+        path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
+    return loop._replace(lanes=lanes, results=results, memory=memory, claims=claims,
+                         lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
+
+
+def _stopped(queue: Queue, lanes: Lanes) -> jax.Array:
+    """bool[l] the lanes holding an agent that no longer walks."""
+    return (lanes.agent < queue.count) & ~lanes.walking
+
+
+def _walking_count(lanes: Lanes) -> jax.Array:
+    """i32[] how many lanes walk."""
+    return jnp.sum(lanes.walking)
+
+
+def _keeps_queueing(queue: Queue, few: int, loop: Loop) -> jax.Array:
+    """bool[]: the queue holds agents still, or more than ``few`` (static) lanes walk."""
+    return (loop.next_queued < queue.live) | (_walking_count(loop.lanes) > few)
+
+
+def _retire(inputs: WalkInputs, queue: Queue, results: Results, lanes: Lanes,
+            which: jax.Array) -> Results:
+    """``results`` with the agents of lanes ``which`` (i32[r], ``>= l`` for none) stored: their
+    position, visited set, moves, diagonal moves, arrival, stop and (with a hook) state."""
+    width = lanes.agent.shape[0]
+    held = jnp.minimum(which, width - 1)
+    row = jnp.where(which < width, lanes.agent[held], queue.count)
+    kept = ("position", "visited", "moves", "diagonal", "arrived", "stuck") + (
+        ("state",) if inputs.hook is not None else ())
+    return results._replace(**{
+        name: getattr(results, name).at[row].set(getattr(lanes, name)[held], mode="drop")
+        for name in kept})
+
+
+def _refill(inputs: WalkInputs, queue: Queue, loop: Loop) -> Loop:
+    """Up to ``l // REFILL_SHARE`` lanes whose agent stopped store it and take the queue's next
+    entries (or are emptied when the queue is); ``loop.next_queued`` (i32[]) moves past them."""
+    lanes = loop.lanes
+    width = lanes.agent.shape[0]
+    which = jnp.nonzero(_stopped(queue, lanes), size=max(width // REFILL_SHARE, 1),
+                        fill_value=width)[0]
+    results = _retire(inputs, queue, loop.results, lanes, which)
+    taken = which < width
+    fresh = _fresh_lanes(inputs, queue,
+                         jnp.where(taken, loop.next_queued + jnp.cumsum(taken) - 1, queue.count))
+    lanes = jax.tree_util.tree_map(
+        lambda old, new: old.at[jnp.where(taken, which, width)].set(new, mode="drop"),
+        lanes, fresh)
+    return loop._replace(lanes=lanes, results=results,
+                         next_queued=jnp.minimum(loop.next_queued + jnp.sum(taken), queue.live))
+
+
+def _flush(inputs: WalkInputs, queue: Queue, loop: Loop) -> Loop:
+    """Every stopped agent still in a lane stored, its lane emptied."""
+    lanes = loop.lanes
+    width = lanes.agent.shape[0]
+    done = _stopped(queue, lanes)
+    results = _retire(inputs, queue, loop.results, lanes, jnp.where(done, jnp.arange(width), width))
+    return loop._replace(results=results,
+                         lanes=lanes._replace(agent=jnp.where(done, queue.count, lanes.agent)))
+
+
+def _compact(queue: Queue, loop: Loop, few: int) -> Loop:
+    """The loop with its ``l`` lanes narrowed to ``few`` (static), holding the agents that still
+    walk (at most ``few``: the queue is empty); the spare ones are empty."""
+    num_lanes = loop.lanes.agent.shape[0]
+    which = jnp.nonzero(loop.lanes.walking, size=few, fill_value=num_lanes)[0]
+    lanes = jax.tree_util.tree_map(lambda x: x[jnp.minimum(which, num_lanes - 1)], loop.lanes)
+    lanes = lanes._replace(walking=lanes.walking & (which < num_lanes),
+                           agent=jnp.where(which < num_lanes, lanes.agent, queue.count))
+    return loop._replace(lanes=lanes)

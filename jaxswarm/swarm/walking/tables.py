@@ -54,6 +54,7 @@ def edge_table(graph: Graph, log_weights: jax.Array) -> jax.Array:
     """f32[N, K]: ``log_weights`` where the edge is valid on the current map, else ``-inf``.
 
     Algorithms build their per-edge log-weights (any finite values, ``FORCED`` for must-take
-    moves, ``-inf`` to exclude) and pass them through this before :func:`walk`.
+    moves, ``-inf`` to exclude) and pass them through this before
+    :func:`~jaxswarm.swarm.walking.loop.walk`.
     """
     return jnp.where(graph.valid_edges(), log_weights, -jnp.inf)
