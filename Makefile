@@ -3,7 +3,11 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
-PYTEST := $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile
+# Compiled programs (JAX's and numba's) are kept outside the clone, so a second run, the slow
+# checks after the default ones and the scripts and notebooks the tests start reuse them
+# (jaxswarm.runtime.cache); CACHE= (empty) runs without.
+CACHE ?= $(HOME)/.cache/jaxswarm
+PYTEST := JAXSWARM_CACHE=$(CACHE) $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile --durations=25
 
 .PHONY: demo test test-slow docs bench performance reproduce reproduce-quick clean
 
@@ -58,17 +62,17 @@ IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-com
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
-TABLE1_QUICK := --maps mosaic20,maze20 --seeds 2 --iterations 5 --agents 32
-RFD_QUICK := --maps maze20 --seeds 2 --iterations 5 --agents 32
-PATHMAPS_QUICK := --sizes 10x10 --runs 2 --ants 50 --max-ants 500 --patience 20
-EXACT_QUICK := --sizes 10:20:5 --grids 5
-DYNAMIC_QUICK := --maps mosaic20 --tables 2,3 --seeds 2 --iterations 5 --patience 5 --agents 32
-ROBOT_QUICK := --maps pathmap10x10,maze20 --seeds 2 --iterations 10 --patience 5 --max-plans 8
-IWD_QUICK := --maps maze20 --seeds 2 --iterations 5 --patience 5
-IWD_PG_QUICK := --experiments 1,4 --runs-smooth 2 --runs 2 --iterations 5 --drops 20
-BEES_QUICK := --tables 1,6 --runs 2
-BEES_INVERSE_QUICK := --maps map1 --seeds 2 --grid 2x2x1 --pairs 1
-MAPF_QUICK := --maps random-32-32-10,room-32-32-4 --agents 5,10 --seeds 1 --cbs-time-limit 2
+TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
+RFD_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
+PATHMAPS_QUICK := --sizes 10x10 --runs 2 --max-ants 200
+EXACT_QUICK := --sizes 10 --grids 2
+DYNAMIC_QUICK := --maps alley20 --tables 2 --seeds 1 --iterations 2 --patience 1 --agents 8
+ROBOT_QUICK := --maps pathmap10x10 --seeds 1 --iterations 3 --patience 2 --max-plans 4
+IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8
+IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
+BEES_QUICK := --tables 6 --runs 1
+BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
+MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 155 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1

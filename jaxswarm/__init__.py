@@ -47,9 +47,14 @@ contract in ``pyproject.toml``, checked by the tests):
 kept until 0.6.0: they forward to the new homes with a ``DeprecationWarning``.
 
 Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can
-still be called after it.
+still be called after it. When ``JAXSWARM_CACHE`` names a folder, importing it keeps compiled
+programs there (:mod:`jaxswarm.runtime.cache`).
 """
 import importlib.metadata
+
+from jaxswarm.runtime import cache
+
+cache.from_environment()  # before jaxswarm.exact imports numba, which reads its cache folder then
 
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, replanner
 from jaxswarm.maps.movingai import load_map

@@ -11,6 +11,12 @@ os.environ.setdefault("JAXSWARM_MOVINGAI", str(MOVINGAI))
 # The golden records hold bit for bit only for one set of vector instructions (golden/isa.py); the
 # scripts and notebooks the tests start inherit the setting.
 cap_isa()
+# Each pytest-xdist worker gets its share of the cores for XLA's thread pool (by default each
+# would take one thread per core, and the workers' threads would take turns on the same cores);
+# the scripts and notebooks a worker starts inherit it.
+if "PYTEST_XDIST_WORKER_COUNT" in os.environ:
+    os.environ.setdefault("PJRT_NPROC", str(max(
+        1, (os.cpu_count() or 1) // int(os.environ["PYTEST_XDIST_WORKER_COUNT"]))))
 
 
 @pytest.fixture(scope="session")

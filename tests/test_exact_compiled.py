@@ -1,12 +1,13 @@
 """The compiled planners against the readable heapq ones (same paths, same work), and batches."""
+import numba
 import numpy as np
 import pytest
 
+from graphs import geometric_graph
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
-                            reference, shortest_lengths, warm_up)
+                            dstar_lite, kernels, reference, shortest_lengths, warm_up)
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.search import workspace
-from graphs import geometric_graph
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.world.graph import grid_graph, path_map_graph
 
@@ -116,4 +117,13 @@ def test_labels_are_cleared_when_the_stamps_run_out():
 
 
 def test_warm_up_compiles_every_planner():
-    assert warm_up() >= 0.0
+    """Every compiled search loop of the exact planners (numba dispatchers not inlined into
+    another) has a compiled signature once ``warm_up`` returns."""
+    seconds = warm_up()
+    loops = {f"{module.__name__}.{name}": dispatcher
+             for module in (kernels, dstar_lite) for name, dispatcher in vars(module).items()
+             if isinstance(dispatcher, numba.core.dispatcher.Dispatcher)
+             and dispatcher.targetoptions.get("inline") != "always"}
+    assert len(loops) >= 6, sorted(loops)
+    assert not [name for name, loop in loops.items() if not loop.signatures]
+    assert 0.0 < seconds < 600.0

@@ -17,6 +17,7 @@ import shutil
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import jax
 import numpy as np
@@ -33,41 +34,28 @@ from jaxswarm.studies.timing import compile_then_time, median_milliseconds, seed
 pathmaps = load_script("sweeps/aco_pathmaps.py")
 robot_study = load_script("sweeps/robot_study.py")
 
-# Folder -> (script, tiny arguments): the quick reproduction, smaller still than the Makefile's.
-# Both RFD tables run alley20 with the same sizes, so rfd_static reuses compiled runs.
-TINY = {
-    "rfd_paper_table1": ("sweeps/rfd_paper_static.py",
-                         ["--maps", "alley20", "--seeds", "1", "--iterations", "2",
-                          "--agents", "8"]),
-    "rfd_static": ("sweeps/rfd_static.py",
-                   ["--maps", "alley20", "--seeds", "1", "--iterations", "2", "--agents", "8"]),
-    "aco_pathmaps": ("sweeps/aco_pathmaps.py",
-                     ["--sizes", "10x10", "--runs", "2", "--max-ants", "200"]),
-    "rfd_paper_dynamic": ("sweeps/rfd_paper_dynamic.py",
-                          ["--maps", "alley20", "--tables", "2", "--seeds", "1",
-                           "--iterations", "2", "--patience", "1", "--agents", "8"]),
-    "robot_study": ("sweeps/robot_study.py",
-                    ["--maps", "pathmap10x10", "--seeds", "1", "--iterations", "3",
-                     "--patience", "2", "--max-plans", "4"]),
-    "iwd_paper_maps": ("sweeps/iwd_paper_maps.py",
-                       ["--maps", "maze20", "--seeds", "2", "--iterations", "3",
-                        "--patience", "2", "--drops", "8"]),
-    "iwd_pg_experiments": ("sweeps/iwd_pg_experiments.py",
-                           ["--experiments", "1", "--runs-smooth", "1", "--iterations", "2",
-                            "--drops", "8"]),
-    "bees_tables": ("sweeps/bees_tables.py", ["--tables", "6", "--runs", "1"]),
-    "bees_inverse": ("sweeps/bees_inverse.py",
-                     ["--maps", "map1", "--seeds", "1", "--grid", "2x1x1", "--pairs", "1"]),
-    "exact_study": ("sweeps/exact_study.py", ["--sizes", "10", "--grids", "2"]),
-    "mapf_study": ("sweeps/mapf_study.py",
-                   ["--maps", "random-32-32-10", "--agents", "5", "--seeds", "1",
-                    "--cbs-time-limit", "1"]),
-}
-SLOW_TINY = ("bees_tables", "bees_inverse")
-"""Scripts whose tiny run compiles the bees' programs (about 45 s): run with the slow checks."""
-OWN_TESTS = ("mapf_study",)
-"""Scripts whose tiny run has its own test file (tests/test_mapf_study.py), not run here again."""
-QUICK = {name: run for name, run in TINY.items() if name not in SLOW_TINY + OWN_TESTS}
+
+def make_commands(target: str, *variables: str) -> list[list[str]]:
+    """The script commands ``make -n TARGET`` would run (the venv set-up lines left out), each
+    as [script, arguments...]."""
+    if shutil.which("make") is None:
+        pytest.skip("make is not installed")
+    done = subprocess.run(["make", "-n", target, *variables], cwd=ROOT, capture_output=True,
+                          text=True, check=True, timeout=60)
+    commands = [shlex.split(line) for line in done.stdout.splitlines() if " sweeps/" in line]
+    return [words[1:] for words in commands]  # without the interpreter
+
+
+def out_folders(commands: list[list[str]]) -> list[str]:
+    """The --out of each table command and the folder the last one (the index) is given."""
+    *tables, index = commands
+    assert index[0] == "sweeps/index_results.py"
+    return [words[words.index("--out") + 1] for words in tables] + [index[1]]
+
+TABLES = ["rfd_paper_table1", "rfd_static", "aco_pathmaps", "rfd_paper_dynamic", "robot_study",
+          "iwd_paper_maps", "iwd_pg_experiments", "bees_tables", "bees_inverse", "exact_study",
+          "mapf_study"]
+"""The folders of results/, in the order ``make reproduce`` writes them."""
 
 
 def git_head() -> str | None:
@@ -79,31 +67,23 @@ def git_head() -> str | None:
         return None
 
 
-def tiny_results(folder, scripts: dict) -> dict:
-    """Run each of ``scripts`` (as :data:`TINY`) at its tiny size into ``folder``, then index
-    it; each script's wall time as measured here."""
-    seconds = {}
-    for name, (script, argv) in scripts.items():
-        began = time.perf_counter()
-        assert load_script(script).main([*argv, "--out", str(folder / name)]) == 0
-        seconds[name] = time.perf_counter() - began
-    assert provenance.main([str(folder)]) == 0
-    return seconds
-
-
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
-    """A results folder written by the table scripts of :data:`QUICK`, then indexed (about two
-    minutes: the tests that read it are slow checks)."""
+    """``make reproduce-quick`` into a scratch folder, each command as make would run it (the
+    tiny sizes of the Makefile's ``*_QUICK`` variables), once for every test that reads a table:
+    ``(folder, {table: (script, arguments)}, {table: seconds measured here})``. About three
+    minutes: the tests that read it are slow checks."""
     folder = tmp_path_factory.mktemp("results")
-    return folder, tiny_results(folder, QUICK)
-
-
-@pytest.fixture(scope="module")
-def bees_quick(tmp_path_factory):
-    """The same for the bees' scripts (:data:`SLOW_TINY`)."""
-    folder = tmp_path_factory.mktemp("bees_results")
-    return folder, tiny_results(folder, {name: TINY[name] for name in SLOW_TINY})
+    commands = make_commands("reproduce-quick", f"QUICK_OUT={folder}")
+    runs, seconds = {}, {}
+    for script, *argv in commands:
+        began = time.perf_counter()
+        assert load_script(script).main(argv) == 0, script
+        if script != "sweeps/index_results.py":
+            name = Path(argv[argv.index("--out") + 1]).name
+            runs[name] = (script, argv)
+            seconds[name] = time.perf_counter() - began
+    return folder, runs, seconds
 
 
 def read_csv(path) -> list[dict]:
@@ -152,14 +132,15 @@ def test_git_state_names_the_checkout_commit():
     assert "2 paths differ" in provenance.describe_tree(["a.py", "b.py"])
 
 
-@pytest.mark.slow  # the quick fixture runs eight table scripts: about two minutes
+@pytest.mark.slow  # the quick fixture runs the eleven table scripts: about three minutes
 def test_every_table_starts_with_its_provenance(quick):
-    folder, seconds = quick
+    folder, runs, seconds = quick
     commit = git_head()
-    for name, (script, argv) in QUICK.items():
+    assert list(runs) == TABLES
+    for name, (script, argv) in runs.items():
         text = (folder / name / "table.md").read_text(encoding="utf-8")
         record = json.loads((folder / name / "provenance.json").read_text(encoding="utf-8"))
-        command = shlex.join(["python", script, *argv, "--out", str(folder / name)])
+        command = shlex.join(["python", script, *argv])
         assert record["command"] == command
         assert text.startswith(f"# {record['title']}\n\nGenerated by `{command}`"), name
         header = text.split("\n\n")[2]  # the provenance table, right under the command
@@ -174,11 +155,11 @@ def test_every_table_starts_with_its_provenance(quick):
 
 @pytest.mark.slow
 def test_index_lists_every_table_in_the_order_they_ran(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     text = (folder / "README.md").read_text(encoding="utf-8")
     sections = [line for line in text.splitlines() if line.startswith("## ")]
-    assert [line.split("`")[1] for line in sections] == [f"{name}/" for name in QUICK]
-    records = [provenance.load(folder / name) for name in QUICK]
+    assert [line.split("`")[1] for line in sections] == [f"{name}/" for name in TABLES]
+    records = [provenance.load(folder / name) for name in TABLES]
     for record in records:
         assert f"* command: `{record['command']}`" in text
     total = sum(record["seconds"] for record in records)
@@ -196,7 +177,7 @@ def test_index_of_a_folder_without_tables_is_an_error(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_path_map_ratios_are_to_ant_system(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     rows = read_csv(folder / "aco_pathmaps" / "results.csv")
     assert [(r["map"], r["algorithm"]) for r in rows] == [
         ("10x10", label) for label in pathmaps.ALGORITHMS]
@@ -214,7 +195,7 @@ def test_path_map_ratios_are_to_ant_system(quick):
 
 @pytest.mark.slow
 def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     rows = read_csv(folder / "robot_study" / "runs.csv")
     labels = [row.label for row in robot_study.ROWS]
     assert [r["algorithm"] for r in rows] == labels
@@ -232,7 +213,7 @@ def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
 
 @pytest.mark.slow
 def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     rows = read_csv(folder / "iwd_paper_maps" / "runs.csv")
     assert [(r["map"], r["seed"]) for r in rows] == [("maze20", "0"), ("maze20", "1")]
     for r in rows:
@@ -245,7 +226,7 @@ def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
 
 @pytest.mark.slow
 def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     rows = read_csv(folder / "iwd_pg_experiments" / "runs.csv")
     assert [(r["experiment"], r["variant"], r["seed"]) for r in rows] == [
         ("1", "IWD + memory", "0"), ("1", "+ smoothing", "0")]
@@ -258,8 +239,8 @@ def test_iwd_pg_experiment_compares_both_sides_with_the_same_seeds(quick):
 
 
 @pytest.mark.slow
-def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(bees_quick):
-    folder, _ = bees_quick
+def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
+    folder, _, _ = quick
     rows = read_csv(folder / "bees_tables" / "runs.csv")
     assert [(r["variant"], r["cycles"]) for r in rows] == [
         (variant, cycles) for variant in ("cabc", "cabc, forbid_crossing")
@@ -277,8 +258,8 @@ def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(bees_qui
 
 
 @pytest.mark.slow
-def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(bees_quick):
-    folder, _ = bees_quick
+def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(quick):
+    folder, _, _ = quick
     landscape = read_csv(folder / "bees_inverse" / "landscape.csv")
     search = read_csv(folder / "bees_inverse" / "search.csv")
     fresh = read_csv(folder / "bees_inverse" / "fresh.csv")
@@ -299,7 +280,7 @@ def test_the_inverse_problem_spends_equal_budgets_and_rescores_on_fresh_seeds(be
 
 @pytest.mark.slow
 def test_path_map_table_has_the_papers_values_beside_ours(quick):
-    folder, _ = quick
+    folder, _, _ = quick
     rows = {(r["map"], r["algorithm"]): r for r in read_csv(folder / "aco_pathmaps" /
                                                             "results.csv")}
     improved = rows["10x10", "Improved Max-Min ACO"]
@@ -357,30 +338,11 @@ def test_a_script_run_from_the_root_finds_the_helper(tmp_path):
                                             "--grids", "1", "--out", str(tmp_path)])
 
 
-def make_commands(target: str, *variables: str) -> list[list[str]]:
-    """The script commands ``make -n TARGET`` would run (the venv set-up lines left out), each
-    as [script, arguments...]."""
-    if shutil.which("make") is None:
-        pytest.skip("make is not installed")
-    done = subprocess.run(["make", "-n", target, *variables], cwd=ROOT, capture_output=True,
-                          text=True, check=True, timeout=60)
-    commands = [shlex.split(line) for line in done.stdout.splitlines() if " sweeps/" in line]
-    return [words[1:] for words in commands]  # without the interpreter
-
-
-def out_folders(commands: list[list[str]]) -> list[str]:
-    """The --out of each table command and the folder the last one (the index) is given."""
-    *tables, index = commands
-    assert index[0] == "sweeps/index_results.py"
-    return [words[words.index("--out") + 1] for words in tables] + [index[1]]
-
-
 def test_reproduce_writes_results_and_the_quick_target_never_does():
     full, quick = make_commands("reproduce"), make_commands("reproduce-quick")
-    assert [words[0] for words in full] == [words[0] for words in quick] == [
-        *(script for script, _ in TINY.values()), "sweeps/index_results.py"]
-    assert out_folders(full) == [*(f"results/{name}" for name in TINY), "results"]
-    assert out_folders(quick) == [*(f"out/reproduce-quick/{name}" for name in TINY),
+    assert [words[0] for words in full] == [words[0] for words in quick]
+    assert out_folders(full) == [*(f"results/{name}" for name in TABLES), "results"]
+    assert out_folders(quick) == [*(f"out/reproduce-quick/{name}" for name in TABLES),
                                   "out/reproduce-quick"]
     # The full target spells out the paper-size arguments it runs.
     assert full[0][1:full[0].index("--out")] == ["--maps", "all", "--seeds", "20",
@@ -388,15 +350,12 @@ def test_reproduce_writes_results_and_the_quick_target_never_does():
 
 
 @pytest.mark.slow
-def test_the_quick_target_runs(tmp_path):
-    # Each command of make reproduce-quick, as make would run it, into a scratch folder.
-    commands = make_commands("reproduce-quick", f"QUICK_OUT={tmp_path}")
-    for script, *argv in commands:
-        assert load_script(script).main(argv) == 0, script
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*TINY, "README.md"])
-    for name in TINY:
-        assert provenance.load(tmp_path / name)["seconds"] > 0
-        assert (tmp_path / name / "table.md").read_text(encoding="utf-8").startswith("# ")
+def test_the_quick_target_writes_every_table_and_the_index(quick):
+    folder, _, seconds = quick
+    assert sorted(p.name for p in folder.iterdir()) == sorted([*TABLES, "README.md"])
+    for name in TABLES:
+        assert 0 < provenance.load(folder / name)["seconds"] <= seconds[name] + 1
+        assert (folder / name / "table.md").read_text(encoding="utf-8").startswith("# ")
 
 
 def test_no_function_of_a_script_is_longer_than_60_lines():

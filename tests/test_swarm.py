@@ -6,6 +6,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import sizes
 
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra, optimal_length
@@ -13,20 +14,20 @@ from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
-from jaxswarm.swarm.testing import (check_compiles_once, check_reproducible,
+from jaxswarm.swarm.testing import (Compilations, check_compiles_once, check_reproducible,
                                     check_valid_results)
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution
 from jaxswarm.world.plane import Plane, make_plane
 
-ITERATIONS = 8
-SMALL = dict(num_agents=32)
+SMALL = sizes.CONFIG
+ITERATIONS = sizes.ITERATIONS
 
 
 @pytest.fixture(scope="module")
 def maze():
-    chosen = paper_map("maze20")
+    chosen = paper_map(sizes.MAP)
     graph = chosen.graph()
     return graph, make_task(graph, chosen.start, chosen.goal), optimal_length(
         graph, chosen.start, chosen.goal)
@@ -46,39 +47,24 @@ def world_of(name, maze, field):
     return field if make(name).world is Plane else maze
 
 
-SLOW_CONFORMANCE = {"rfd", "ant_system", "max_min_aco", "improved_max_min_aco", "iwd",
-                    "iwd_pg"}
-"""Swarms whose heavier conformance checks (reproducible under vmap, compiled once for a sweep)
-run with the slow checks (their compiles are the default suite's longest); rfd_star,
-rfd_graded and aco_star's, and every swarm's validity check but IWD_PG's, stay in it."""
-
-SLOW_VALIDITY = {"iwd_pg"}
-"""Swarms whose validity check runs with the slow checks too: IWD_PG compiles its local
-searches (IWD runs inside its iteration) for most of a minute; tests/test_iwd_pg.py checks
-its results in the default suite on a smaller map."""
-
-
-def conformance(names, slow=SLOW_CONFORMANCE):
-    return [pytest.param(name, marks=pytest.mark.slow) if name in slow else name
-            for name in names]
-
-
-@pytest.mark.parametrize("name", conformance(swarms.registered()))
+@pytest.mark.parametrize("name", swarms.registered())
 def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze, field):
     world, task, _ = world_of(name, maze, field)
-    check_reproducible(make(name, **SMALL), world, task, iterations=ITERATIONS)
+    check_reproducible(make(name, **SMALL), world, task, iterations=ITERATIONS,
+                       runs=sizes.RUNS)
 
 
-@pytest.mark.parametrize("name", conformance(swarms.registered(), SLOW_VALIDITY))
+@pytest.mark.parametrize("name", swarms.registered())
 def test_results_are_valid_and_never_beat_the_optimum(name, maze, field):
     world, task, optimum = world_of(name, maze, field)
     check_valid_results(make(name, **SMALL), world, task, optimum, iterations=ITERATIONS)
 
 
-@pytest.mark.parametrize("name", conformance(swarms.registered()))
-def test_a_sweep_over_sixteen_params_compiles_once(name, maze, field):
+@pytest.mark.parametrize("name", swarms.registered())
+def test_a_batch_over_params_compiles_once(name, maze, field):
     world, task, _ = world_of(name, maze, field)
-    check_compiles_once(make(name, **SMALL), world, task)
+    check_compiles_once(make(name, **SMALL), world, task, iterations=ITERATIONS,
+                        runs=sizes.RUNS)
 
 
 @pytest.mark.slow  # about 25 s
@@ -103,11 +89,12 @@ def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once(maze):
     grid = swarm.default_params._replace(p_base=p_base.ravel(), alpha=alpha.ravel())
     grid = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (16,)), grid)
     compiled = jax.jit(jax.vmap(lambda p: run(swarm, jax.random.key(1), graph, task, p,
-                                              iterations=4)[1].best_cost))
-    before = compiled._cache_size()
-    compiled(grid)
-    compiled(jax.tree_util.tree_map(lambda x: x * 1.01, grid))
-    assert compiled._cache_size() - before == 1
+                                              iterations=ITERATIONS)[1].best_cost))
+    other = jax.tree_util.tree_map(lambda x: x * 1.01, grid)
+    with Compilations() as built:
+        compiled(grid)
+        compiled(other)
+    assert built.count == 1, built.names
 
 
 @pytest.mark.parametrize("law", ["linear", "exponential"])

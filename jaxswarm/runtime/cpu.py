@@ -23,15 +23,20 @@ from pathlib import Path
 
 import jax
 
+from jaxswarm.runtime.cache import enable as enable_cache
+
 THREADS_VARIABLE = "PJRT_NPROC"
 """The environment variable XLA:CPU reads for the size of its intra-op thread pool."""
 
 
-def configure(*, devices: int | None = None, threads: int | None = None) -> None:
-    """Split the CPU into ``devices`` JAX devices and give XLA ``threads`` intra-op threads.
+def configure(*, devices: int | None = None, threads: int | None = None,
+              cache: str | os.PathLike | None = None) -> None:
+    """Split the CPU into ``devices`` JAX devices, give XLA ``threads`` intra-op threads and keep
+    compiled programs in ``cache``.
 
     Call it before JAX's first computation (importing jaxswarm's modules does not start JAX):
-    JAX reads both settings when it starts its CPU client. None leaves a setting as it is.
+    JAX reads the device count and the thread pool size when it starts its CPU client. None
+    leaves a setting as it is.
 
     Args:
       devices: JAX CPU devices (``jax.devices()``), at least 1; several devices let
@@ -39,9 +44,13 @@ def configure(*, devices: int | None = None, threads: int | None = None) -> None
         what ``--xla_force_host_platform_device_count`` in ``XLA_FLAGS`` asks for).
       threads: XLA:CPU intra-op threads, at least 1 (raised to the device count by XLA if
         lower). None: XLA's default (one per core, or ``$PJRT_NPROC`` if set).
+      cache: a folder for compiled programs, kept between processes
+        (:func:`jaxswarm.runtime.cache.enable`; setting ``JAXSWARM_CACHE`` before jaxswarm is
+        imported does the same for every process that inherits it). None: no cache, or the
+        one ``JAXSWARM_CACHE`` named.
 
     Raises:
-      ValueError: ``devices`` or ``threads`` below 1.
+      ValueError: ``devices`` or ``threads`` below 1, or ``cache`` is not a folder.
       RuntimeError: JAX has already started its backends.
     """
     for name, value in (("devices", devices), ("threads", threads)):
@@ -55,6 +64,8 @@ def configure(*, devices: int | None = None, threads: int | None = None) -> None
         jax.config.update("jax_num_cpu_devices", devices)
     if threads is not None:
         os.environ[THREADS_VARIABLE] = str(threads)
+    if cache is not None:
+        enable_cache(cache)
 
 
 def _backends_started() -> bool:

@@ -27,17 +27,13 @@ import platform
 import shlex
 import subprocess
 import sys
+import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 
 import jax
 import jaxlib
 import numpy as np
-
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    import tomli as tomllib
 
 from jaxswarm.runtime.atomic import write_atomically
 from jaxswarm.runtime.cpu import cpu_model

@@ -13,12 +13,18 @@ Each check raises ``AssertionError`` naming what failed:
 * :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
   and new values of the same shapes do not compile again.
 
+The three checks share two programs per swarm: one run, and one batch of ``runs`` runs with
+their keys and params batched (:func:`run_batch`), so a suite pays each swarm's compile twice.
+:class:`Compilations` counts the programs JAX builds while it is open, for checks of one's own
+(a change of the map that must not recompile, a grid of params).
+
 Use a small map every agent reaches within a few iterations (the project's own suite uses the
-RFD paper's maze20 with 32 agents and 8 iterations, and for the bees a 6 x 6 plane).
+RFD paper's maze20 with 16 agents and 8 iterations, and for the bees a 6 x 6 plane).
 """
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import jax
 import jax.numpy as jnp
@@ -27,6 +33,60 @@ import numpy as np
 from jaxswarm.swarm.core import Swarm, Task, World, run
 from jaxswarm.world.paths import is_valid_path, path_length
 from jaxswarm.world.plane import Plane, in_plane, trajectory_length, violations
+
+
+COMPILE_EVENT = "/jax/core/compile/jaxpr_to_mlir_module_duration"
+"""The ``jax.monitoring`` event JAX records each time it lowers a program for XLA."""
+
+
+class Compilations:
+    """A context that counts the programs JAX builds while it is open: one per call of a jitted
+    function with static arguments, shapes or dtypes it has not seen (nested jitted functions are
+    part of their caller's program). A program the persistent compilation cache holds still
+    counts: JAX lowers it to look it up. Eager operations count too (each primitive on new shapes
+    is a small program), so run them before the context opens::
+
+        with Compilations() as built:
+            sweep(grid)
+            sweep(other_grid)
+        assert built.count == 1, built.names
+
+    Attributes:
+      count: programs built so far.
+      names: the name of each program's function, in order.
+    """
+
+    def __init__(self):
+        self.count = 0
+        self.names: list[str] = []
+
+    def _listen(self, event: str, duration: float, **metadata) -> None:
+        del duration
+        if event == COMPILE_EVENT:
+            self.count += 1
+            self.names.append(str(metadata.get("fun_name", "?")))
+
+    def __enter__(self) -> Compilations:
+        jax.monitoring.register_event_duration_secs_listener(self._listen)
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        jax.monitoring.unregister_event_duration_listener(self._listen)
+
+
+@functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
+def run_batch(swarm: Swarm, keys: jax.Array, graph: World, task: Task, params, *,
+              iterations: int):
+    """``vmap`` of :func:`~jaxswarm.swarm.core.run` over ``keys`` (key[N]) and ``params`` (a
+    Params tuple of f32[N] leaves) on one world and task: ``(state, trace)`` with a leading axis
+    N on every leaf. The batch the checks share (one program per swarm, N and iterations)."""
+    return jax.vmap(lambda key, p: run(swarm, key, graph, task, p, iterations=iterations))(
+        keys, params)
+
+
+def batched_params(params, runs: int):
+    """``params`` (a Params tuple of scalars) repeated ``runs`` times: f32[runs] leaves."""
+    return jax.tree_util.tree_map(lambda x: jnp.full((runs,), x, jnp.float32), params)
 
 
 def leaves_equal(a, b) -> bool:
@@ -51,15 +111,17 @@ def outcome(result):
 
 
 def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
-                       keys: int = 3) -> None:
-    """Same key, same result; ``vmap`` over ``keys`` keys equals the loop (see :func:`outcome`);
-    keys differ."""
-    split = jax.random.split(jax.random.key(7), keys)
+                       keys: int = 3, runs: int = 8) -> None:
+    """Same key, same result; the first ``keys`` rows of a batch of ``runs`` runs
+    (:func:`run_batch`, every run another key) equal those runs one at a time (see
+    :func:`outcome`); keys differ."""
+    split = jax.random.split(jax.random.key(7), runs)
     params = swarm.default_params
-    one = [run(swarm, k, graph, task, params, iterations=iterations) for k in split]
+    one = [run(swarm, k, graph, task, params, iterations=iterations) for k in split[:keys]]
     again = run(swarm, split[0], graph, task, params, iterations=iterations)
     assert leaves_equal(key_data(one[0]), key_data(again)), f"{swarm.name}: same key differs"
-    batch = jax.vmap(lambda k: run(swarm, k, graph, task, params, iterations=iterations))(split)
+    batch = run_batch(swarm, split, graph, task, batched_params(params, runs),
+                      iterations=iterations)
     for i in range(keys):
         assert leaves_equal(outcome(jax.tree_util.tree_map(lambda x: x[i], batch)),
                             outcome(one[i])), f"{swarm.name}: vmap row {i} differs from run"
@@ -121,25 +183,26 @@ def _check_trajectory(swarm: Swarm, plane: Plane, task: Task, solution) -> None:
         f"{swarm.name}: cost is not the trajectory's length")
 
 
-def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: int = 4,
-                        runs: int = 16) -> None:
-    """A ``vmap`` of ``runs`` runs over valid values of the first param traces the swarm's step
-    once, and new values of the same shapes do not trace it again."""
-    traces = []
-    counted = type(swarm)(**{**swarm.__dict__,
-                             "step": lambda *a: (traces.append(1), swarm.step(*a))[1]})
+def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
+                        runs: int = 8) -> None:
+    """A batch of ``runs`` runs (:func:`run_batch`) over valid values of the first param builds
+    at most one program (none if an earlier check built it), and new values of the same shapes
+    build none."""
     first = swarm.default_params._fields[0]
     values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, runs)
     for value in values:  # valid values: every run of the sweep is one the swarm accepts
         swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
-    grid = jax.tree_util.tree_map(lambda x: jnp.full((runs,), x), counted.default_params)
+    grid = batched_params(swarm.default_params, runs)
     grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
-    sweep = jax.jit(jax.vmap(lambda p: swarm.best(run(counted, jax.random.key(0), graph, task, p,
-                                                      iterations=iterations)[0]).cost))
-    costs = sweep(grid)
-    sweep(grid._replace(**{first: grid[0] * 0.9}))  # new values, same shapes: no retrace
-    assert costs.shape == (runs,)
-    assert len(traces) == 1, f"{swarm.name}: traced {len(traces)} times"
+    other = grid._replace(**{first: jnp.asarray(values * 0.9, jnp.float32)})
+    keys = jax.random.split(jax.random.key(0), runs)
+    with Compilations() as built:
+        state, _ = run_batch(swarm, keys, graph, task, grid, iterations=iterations)
+    assert built.count <= 1, f"{swarm.name}: one batch built {built.names}"
+    with Compilations() as rebuilt:
+        run_batch(swarm, keys, graph, task, other, iterations=iterations)
+    assert rebuilt.count == 0, f"{swarm.name}: new values built {rebuilt.names}"
+    assert jax.vmap(swarm.best)(state).cost.shape == (runs,)
 
 
 def check_swarm(swarm: Swarm, graph: World, task: Task, optimum: float) -> None:

@@ -35,16 +35,11 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import sys
+import tomllib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 from jaxswarm.swarm import registry as swarm_registry
 from jaxswarm.sweep.maps import check_map_entry, entry_world

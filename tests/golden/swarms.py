@@ -20,6 +20,7 @@ from pathlib import Path
 import jax
 import numpy as np
 
+import sizes
 from golden.isa import cap_isa
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, registered, run
@@ -27,10 +28,12 @@ from jaxswarm.swarm.testing import key_data
 from jaxswarm.world.plane import make_plane
 
 GOLDEN = Path(__file__).parent / "swarms.json"
-GRAPH_CASES = [dict(world=world, config=dict(num_agents=16), iterations=6, patience=3)
-               for world in ("maze20", "alley20")]
-"""Two 20 x 20 maps with one run length: one compiled program per swarm."""
-PLANE_CASES = [dict(world="plane6", config=dict(), iterations=12, patience=3)]
+SIZE = dict(config=sizes.CONFIG, iterations=sizes.ITERATIONS, patience=None)
+"""The tests' shared size (``tests/sizes.py``): a record replays the program the conformance
+checks compile for their single runs."""
+GRAPH_CASES = [dict(world=world, **SIZE) for world in (sizes.MAP, "alley20")]
+"""Two 20 x 20 maps: one compiled program per swarm."""
+PLANE_CASES = [dict(world="plane6", **SIZE)]
 SEEDS = (0, 3)
 
 
@@ -53,7 +56,8 @@ def replay(record: dict) -> dict:
                        iterations=record["iterations"], patience=record["patience"])
     leaves = jax.tree_util.tree_leaves_with_path(key_data((state, trace)))
     digests = {jax.tree_util.keystr(where): hashlib.sha256(
-        np.ascontiguousarray(np.asarray(leaf)).tobytes()).hexdigest()[:16] for where, leaf in leaves}
+        np.ascontiguousarray(np.asarray(leaf)).tobytes()).hexdigest()[:16]
+        for where, leaf in leaves}
     return dict(digests=digests, best_cost=float(swarm.best(state).cost),
                 ran=int(trace.iterations))
 

@@ -1,0 +1,16 @@
+"""The sizes the tests share. Every new combination of a swarm, a map shape, an agent count and
+an iteration count is a new XLA program (seconds to a minute of compiling), so a test that does
+not need sizes of its own takes these, and varies a run's length through ``run``'s traced
+``budget`` rather than its static ``iterations``."""
+
+MAP = "maze20"
+"""The RFD paper's 20 x 20 maze: every swarm finds a path on it within a few iterations."""
+AGENTS = 32
+"""Drops, ants or bees of one iteration (with 16, IWD finds no path on maze20 within
+:data:`ITERATIONS` iterations)."""
+ITERATIONS = 8
+"""The static iteration budget T of a run."""
+RUNS = 8
+"""Runs of a vmapped batch (keys or params)."""
+CONFIG = dict(num_agents=AGENTS)
+"""The swarm options of the shared size: ``make(name, **CONFIG)``."""
