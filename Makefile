@@ -3,9 +3,9 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 INSTALLED := $(VENV)/.installed
-# Compiled programs (JAX's and numba's) are kept outside the clone, so a second run, the slow
-# checks after the default ones and the scripts and notebooks the tests start reuse them
-# (jaxswarm.runtime.cache); CACHE= (empty) runs without.
+# Compiled programs (JAX's and numba's) are kept outside the clone, so a second demo or test
+# run, the slow checks after the default ones and the scripts and notebooks the tests start reuse
+# them (jaxswarm.runtime.cache); CACHE= (empty) runs without.
 CACHE ?= $(HOME)/.cache/jaxswarm
 PYTEST := JAXSWARM_CACHE=$(CACHE) $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile --durations=25
 
@@ -18,7 +18,7 @@ $(INSTALLED): pyproject.toml
 	touch $(INSTALLED)
 
 demo: $(INSTALLED)  ## plan on mosaic50 with every planner, print a table, write out/demo_mosaic50*.png
-	$(BIN)/jaxswarm demo
+	JAXSWARM_CACHE=$(CACHE) $(BIN)/jaxswarm demo
 
 test: $(INSTALLED)  ## the default test suite (minutes)
 	$(PYTEST)

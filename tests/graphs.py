@@ -3,6 +3,7 @@ from typing import NamedTuple
 
 import jax
 import numpy as np
+import sizes
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
@@ -31,10 +32,11 @@ class Solved(NamedTuple):
     state: object
 
 
-def solved_paper_map(name: str, swarm_name: str, *, agents: int, iterations: int,
-                     seed: int = 0) -> Solved:
+def solved_paper_map(name: str, swarm_name: str, *, agents: int = sizes.AGENTS,
+                     iterations: int = sizes.ITERATIONS, seed: int = 0) -> Solved:
     """``swarm_name`` with ``agents`` agents run for ``iterations`` on paper map ``name`` from
-    ``jax.random.key(seed)``."""
+    ``jax.random.key(seed)`` (the tests' shared sizes by default: the program the conformance
+    checks compile)."""
     chosen = paper_map(name)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)

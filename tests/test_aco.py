@@ -3,6 +3,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import sizes
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
@@ -39,11 +40,11 @@ def test_pheromone_is_symmetric_and_max_min_stays_in_its_bounds():
     task = make_task(graph, chosen.start, chosen.goal)
     for name, options in (("ant_system", {}), ("max_min_aco", {}),
                           ("max_min_aco", dict(upper_bound=True))):
-        swarm = make(name, num_agents=64, **options)
+        swarm = make(name, **sizes.CONFIG, **options)
         params = swarm.default_params
         if name == "max_min_aco":  # a cap below tau0: only the upper_bound switch applies it
             params = params._replace(tau_max=np.float32(0.1))
-        state, _ = run(swarm, jax.random.key(1), graph, task, params, iterations=15)
+        state, _ = run(swarm, jax.random.key(1), graph, task, params, iterations=sizes.ITERATIONS)
         tau, nbr, rev = map(np.asarray, (state.pheromone, graph.nbr, graph.rev))
         rows, slots = np.nonzero(nbr >= 0)
         np.testing.assert_allclose(tau[rows, slots], tau[nbr[rows, slots], rev[rows, slots]],

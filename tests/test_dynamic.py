@@ -6,7 +6,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-
+import sizes
 from graphs import solved_paper_map
 from jaxswarm.dynamic.events import (apply_event, change, check_events, first_iteration_at,
                                      make_event, memory_frames, replan)
@@ -113,8 +113,7 @@ def test_invalid_best_path_is_forgotten_and_a_valid_one_kept():
 
 
 def test_vmap_over_events_equals_a_loop():
-    _, graph, task, swarm, params, state = solved_paper_map("mosaic20", "rfd_graded",
-                                                             agents=16, iterations=10, seed=1)
+    _, graph, task, swarm, params, state = solved_paper_map("mosaic20", "rfd_graded", seed=1)
     free = np.nonzero(np.asarray(graph.free))[0]
     events = [make_event(graph, goal=int(free[i]), block=[int(free[i + 50])], size=1)
               for i in (40, 120, 200)]
@@ -122,7 +121,8 @@ def test_vmap_over_events_equals_a_loop():
 
     def changed_run(event, key):
         s, g, t = change(swarm, state, event, graph, task, params)
-        return run(swarm, key, g, t, params, iterations=5, state=s)[1].best_cost
+        return run(swarm, key, g, t, params, iterations=sizes.ITERATIONS,
+                   state=s)[1].best_cost
 
     keys = jax.random.split(jax.random.key(2), 3)
     together = jax.jit(jax.vmap(changed_run))(batch, keys)
@@ -131,11 +131,12 @@ def test_vmap_over_events_equals_a_loop():
 
 
 def test_continuing_uses_the_given_key_and_events_do_not_recompile():
-    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_star", agents=16,
-                                                             iterations=5)
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_star")
     other = dataclasses.replace(state, key=jax.random.key(99))  # the state's own key is ignored
-    a, trace_a = run(swarm, jax.random.key(3), graph, task, params, iterations=5, state=state)
-    b, trace_b = run(swarm, jax.random.key(3), graph, task, params, iterations=5, state=other)
+    a, trace_a = run(swarm, jax.random.key(3), graph, task, params, iterations=sizes.ITERATIONS,
+                     state=state)
+    b, trace_b = run(swarm, jax.random.key(3), graph, task, params, iterations=sizes.ITERATIONS,
+                     state=other)
     np.testing.assert_array_equal(a.altitude, b.altitude)
     assert float(trace_a.best_cost[-1]) <= float(state.best_cost)  # memory kept: never worse
     free = np.nonzero(np.asarray(graph.free))[0]
@@ -145,7 +146,7 @@ def test_continuing_uses_the_given_key_and_events_do_not_recompile():
         check_events(graph, task, event)
         with Compilations() as built:
             s, g, t = change(swarm, state, event, graph, task, params)
-            run(swarm, jax.random.key(4), g, t, params, iterations=5, state=s)
+            run(swarm, jax.random.key(4), g, t, params, iterations=sizes.ITERATIONS, state=s)
         assert i == 0 or built.count == 0, f"a change of the map built {built.names}"
 
 
@@ -170,8 +171,7 @@ def test_bad_events_are_named_before_anything_is_applied():
 
 
 def test_memory_frames_and_their_gif(tmp_path):
-    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded", agents=8,
-                                                             iterations=3)
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded")
     after, frames = jax.jit(memory_frames, static_argnums=(0, 5))(swarm, state, graph, task,
                                                                    params, 4)
     assert frames.shape == (5, graph.num_nodes)
@@ -185,13 +185,14 @@ def test_memory_frames_and_their_gif(tmp_path):
 
 
 def test_replan_is_change_then_run_and_first_iteration_at_reads_the_trace():
-    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded", agents=16,
-                                                             iterations=5)
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded")
     event = make_event(graph, block=[int(np.nonzero(np.asarray(graph.free))[0][60])])
     key = jax.random.key(5)
-    _, together = replan(swarm, key, state, event, graph, task, params, iterations=8)
+    _, together = replan(swarm, key, state, event, graph, task, params,
+                         iterations=sizes.ITERATIONS)
     changed, edited, new_task = change(swarm, state, event, graph, task, params)
-    _, apart = run(swarm, key, edited, new_task, params, iterations=8, state=changed)
+    _, apart = run(swarm, key, edited, new_task, params, iterations=sizes.ITERATIONS,
+                   state=changed)
     np.testing.assert_array_equal(together.best_cost, apart.best_cost)
     trace = dataclasses.replace(together, best_cost=jnp.array([np.inf, 12.0, 10.0005, 10.0]),
                                 iterations=jnp.int32(4))

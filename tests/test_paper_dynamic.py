@@ -2,6 +2,7 @@
 import jax
 import numpy as np
 import pytest
+import sizes
 
 from graphs import solved_paper_map
 from jaxswarm.dynamic.events import apply_event, change, check_events
@@ -72,13 +73,12 @@ def test_unknown_map_or_table():
 
 
 def test_budget_replays_a_run_up_to_an_iteration():
-    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded", agents=32,
-                                                             iterations=20)
+    _, graph, task, swarm, params, state = solved_paper_map("maze20", "rfd_graded")
     scenario = paper_scenario("maze20", 5)  # a major change: the run goes on for a while
     changed, edited, new_task = change(swarm, state, scenario.event(graph), graph, task, params)
-    _, full = run(swarm, jax.random.key(1), edited, new_task, params, iterations=20,
-                  state=changed)
-    _, short = run(swarm, jax.random.key(1), edited, new_task, params, iterations=20,
-                   state=changed, budget=3)
+    _, full = run(swarm, jax.random.key(1), edited, new_task, params,
+                  iterations=sizes.ITERATIONS, state=changed)
+    _, short = run(swarm, jax.random.key(1), edited, new_task, params,
+                   iterations=sizes.ITERATIONS, state=changed, budget=3)
     assert int(full.iterations) > 3 and int(short.iterations) == 3
     np.testing.assert_array_equal(short.best_cost[:3], full.best_cost[:3])
