@@ -19,7 +19,8 @@ their keys and params batched (:func:`run_batch`), so a suite pays each swarm's 
 (a change of the map that must not recompile, a grid of params).
 
 Use a small map every agent reaches within a few iterations (the project's own suite uses the
-RFD paper's maze20 with 16 agents and 8 iterations, and for the bees a 6 x 6 plane).
+RFD paper's maze20 with 32 agents, 8 iterations and batches of 8 runs, and for the bees a 6 x 6
+plane).
 """
 from __future__ import annotations
 
@@ -75,12 +76,13 @@ class Compilations:
 
 
 @functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
-def run_batch(swarm: Swarm, keys: jax.Array, graph: World, task: Task, params, *,
+def run_batch(swarm: Swarm, keys: jax.Array, world: World, task: Task, params, *,
               iterations: int):
     """``vmap`` of :func:`~jaxswarm.swarm.core.run` over ``keys`` (key[N]) and ``params`` (a
-    Params tuple of f32[N] leaves) on one world and task: ``(state, trace)`` with a leading axis
-    N on every leaf. The batch the checks share (one program per swarm, N and iterations)."""
-    return jax.vmap(lambda key, p: run(swarm, key, graph, task, p, iterations=iterations))(
+    Params tuple of f32[N] leaves) in one world (a Graph or a Plane) and task: ``(state,
+    trace)`` with a leading axis N on every leaf. The batch the checks share (one program per
+    swarm, N and iterations)."""
+    return jax.vmap(lambda key, p: run(swarm, key, world, task, p, iterations=iterations))(
         keys, params)
 
 
