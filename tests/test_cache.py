@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from jaxswarm.runtime.cache import VARIABLE, enable
+from jaxswarm.runtime.cache import VARIABLE, enable, from_environment
 
 PROBE = """
 import json, jax, jax.numpy as jnp, numba
@@ -51,3 +51,13 @@ def test_a_file_is_not_a_cache_folder(tmp_path):
     path.write_text("")
     with pytest.raises(ValueError, match=f"{VARIABLE}: .*a file is not a folder"):
         enable(path)
+
+
+def test_an_unusable_folder_in_the_variable_is_a_warning_and_no_cache(tmp_path, monkeypatch):
+    path = tmp_path / "a file"
+    path.write_text("")
+    monkeypatch.setenv(VARIABLE, str(path))
+    with pytest.warns(RuntimeWarning, match=f"{VARIABLE}=.*is not used: .*not a folder"):
+        assert from_environment() is None
+    monkeypatch.setenv(VARIABLE, "")
+    assert from_environment() is None

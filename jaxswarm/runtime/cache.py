@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import jax
@@ -60,10 +61,18 @@ def enable(folder: str | os.PathLike) -> Path:
 
 
 def from_environment() -> Path | None:
-    """:func:`enable` the folder ``$JAXSWARM_CACHE`` names, if it is set and not empty.
+    """:func:`enable` the folder ``$JAXSWARM_CACHE`` names, if it is set and not empty. Runs when
+    jaxswarm is imported, so a folder it cannot use is a warning (naming the variable and the
+    reason), not an error: jaxswarm then compiles as without a cache.
 
     Returns:
       The enabled folder, or None.
     """
     folder = os.environ.get(VARIABLE, "")
-    return enable(folder) if folder else None
+    if not folder:
+        return None
+    try:
+        return enable(folder)
+    except (OSError, ValueError) as error:
+        warnings.warn(f"{VARIABLE}={folder!r} is not used: {error}", RuntimeWarning, stacklevel=2)
+        return None
