@@ -3,6 +3,7 @@ from pathlib import Path
 
 import pytest
 from golden.isa import cap_isa
+from jaxswarm.runtime.cpu import THREADS_VARIABLE
 
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
@@ -15,7 +16,7 @@ cap_isa()
 # would take one thread per core, and the workers' threads would take turns on the same cores);
 # the scripts and notebooks a worker starts inherit it.
 if "PYTEST_XDIST_WORKER_COUNT" in os.environ:
-    os.environ.setdefault("PJRT_NPROC", str(max(
+    os.environ.setdefault(THREADS_VARIABLE, str(max(
         1, (os.cpu_count() or 1) // int(os.environ["PYTEST_XDIST_WORKER_COUNT"]))))
 
 

@@ -2,6 +2,7 @@
 an iteration count is a new XLA program (seconds to a minute of compiling), so a test that does
 not need sizes of its own takes these, and varies a run's length through ``run``'s traced
 ``budget`` rather than its static ``iterations``."""
+from jaxswarm.world.plane import Plane, make_plane
 
 MAP = "maze20"
 """The RFD paper's 20 x 20 maze: every swarm finds a path on it within a few iterations."""
@@ -14,3 +15,9 @@ RUNS = 8
 """Runs of a vmapped batch (keys or params)."""
 CONFIG = dict(num_agents=AGENTS)
 """The swarm options of the shared size: ``make(name, **CONFIG)``."""
+
+
+def plane() -> tuple[Plane, tuple[float, float], tuple[float, float]]:
+    """``(plane, start, goal)``: the bees' shared world, a 6 x 6 plane with one rectangle beside
+    the straight way from start to goal."""
+    return make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0)), (0.5, 2.5), (5.5, 2.5)

@@ -19,7 +19,7 @@ from jaxswarm.swarm.testing import (Compilations, check_compiles_once, check_rep
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution
-from jaxswarm.world.plane import Plane, make_plane
+from jaxswarm.world.plane import Plane
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
@@ -35,10 +35,8 @@ def maze():
 
 @pytest.fixture(scope="module")
 def field():
-    """A 6 x 6 plane with a rectangle beside the straight way from start to goal, for the
-    bees."""
-    plane = make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0))
-    start, goal = (0.5, 2.5), (5.5, 2.5)
+    """The bees' shared plane (:func:`sizes.plane`), its task and its optimum."""
+    plane, start, goal = sizes.plane()
     return plane, make_task(plane, start, goal), shortest_path(plane, start, goal)[0]
 
 

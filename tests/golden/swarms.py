@@ -25,7 +25,6 @@ from golden.isa import cap_isa
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, registered, run
 from jaxswarm.swarm.testing import key_data
-from jaxswarm.world.plane import make_plane
 
 GOLDEN = Path(__file__).parent / "swarms.json"
 SIZE = dict(config=sizes.CONFIG, iterations=sizes.ITERATIONS, patience=None)
@@ -38,11 +37,11 @@ SEEDS = (0, 3)
 
 
 def world(name: str):
-    """``(world, task)`` of a record: a paper map by name, or ``plane6``, a 6 x 6 plane with
-    one rectangle beside the straight way from start to goal."""
+    """``(world, task)`` of a record: a paper map by name, or ``plane6``, the bees' shared
+    6 x 6 plane (:func:`sizes.plane`)."""
     if name == "plane6":
-        plane = make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0))
-        return plane, make_task(plane, (0.5, 2.5), (5.5, 2.5))
+        plane, start, goal = sizes.plane()
+        return plane, make_task(plane, start, goal)
     chosen = paper_map(name)
     graph = chosen.graph()
     return graph, make_task(graph, chosen.start, chosen.goal)
