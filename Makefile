@@ -56,7 +56,8 @@ PATHMAPS_FULL := --sizes 10x10,20x20,40x25 --runs 10 --ants 50 --max-ants 5000 -
 EXACT_FULL := --sizes 10:100:5 --grids 1000
 DYNAMIC_FULL := --maps all --seeds 20 --iterations 100 --patience 30 --agents 256
 ROBOT_FULL := --maps all --seeds 20 --blocks 2 --iterations 100 --patience 30 --max-plans 8
-IWD_FULL := --maps all --seeds 20 --drops 50 --iterations 100 --patience 30
+IWD_FULL := --maps all --variants all --seeds 20 --movingai-seeds 6 --drops 50 --iterations 100 \
+	--patience 30
 IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-complex 15 \
 	--iterations 50 --drops 50
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
@@ -68,7 +69,7 @@ PATHMAPS_QUICK := --sizes 10x10 --runs 2 --max-ants 200
 EXACT_QUICK := --sizes 10 --grids 2
 DYNAMIC_QUICK := --maps alley20 --tables 2 --seeds 1 --iterations 2 --patience 1 --agents 8
 ROBOT_QUICK := --maps pathmap10x10 --seeds 1 --iterations 3 --patience 2 --max-plans 4
-IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8
+IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8 --movingai none
 IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
 BEES_QUICK := --tables 6 --runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1

@@ -63,7 +63,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import statistics
 import sys
 import time
@@ -78,7 +77,7 @@ from jaxswarm.multiagent import (Instance, cbs, load_instance, lower_bound, prio
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts
-from jaxswarm.sweep.maps import MOVINGAI_DATA
+from jaxswarm.studies.problems import movingai_folder
 
 
 MAPS = ("empty-32-32", "random-32-32-10", "room-32-32-4", "maze-32-32-2", "den312d")
@@ -120,14 +119,6 @@ LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (give
 
 class InvalidPlan(RuntimeError):
     """A planner's solved plan breaks a rule (validate, the lower bound or CBS's optimality)."""
-
-
-def default_data() -> Path:
-    """The folder of the MAPF maps and scenarios (see the module docstring)."""
-    named = os.environ.get(MOVINGAI_DATA)
-    if named:
-        return Path(named) / "mapf"
-    return provenance.ROOT.parent / "shared" / "benchdata" / "movingai" / "mapf"
 
 
 def parse_maps(text: str) -> list[str]:
@@ -402,7 +393,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="runs of the random priority order, seeds 0.. (default 5)")
     parser.add_argument("--cbs-time-limit", type=float, default=30.0,
                         help="CBS's seconds per instance (default 30)")
-    parser.add_argument("--data", type=Path, default=default_data(),
+    parser.add_argument("--data", type=Path, default=movingai_folder(),
                         help="the folder of the MAPF .map and .scen files (default "
                              "$JAXSWARM_MOVINGAI/mapf, else ../shared/benchdata/movingai/mapf)")
     add_out_argument(parser, "mapf_study")

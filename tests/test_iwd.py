@@ -1,5 +1,7 @@
 """Intelligent Water Drops: each equation against a hand computation, the soil updates of drops
-that share an edge in one step applied in lane order, bit-identically, and the walker hook."""
+that arrived applied after the walk in agent order, the soil updates of drops that share an edge
+in one step applied in lane order (``while_walking``), bit-identically, the walker hook, and
+drops that back out of dead ends."""
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -7,7 +9,9 @@ import pytest
 
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
-from jaxswarm.swarm.iwd.soil import SOIL, choice_log_weights, goal_log_desirability
+from jaxswarm.swarm.iwd.iwd import drop_walk
+from jaxswarm.swarm.iwd.soil import (SOIL, arrived_updates, choice_log_weights,
+                                     goal_log_desirability, walked_soil)
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, edge_groups
 from jaxswarm.world.graph import grid_graph
@@ -37,13 +41,105 @@ def test_choice_shifts_negative_soil_and_weighs_the_goal_by_inverse_distance():
     assert h[0, EAST] == pytest.approx(-np.log(np.hypot(1, 2)))  # (1, 0) is sqrt 5 away
 
 
-def test_velocity_and_soil_taken_are_eqs_4_and_5():
+def test_velocity_and_soil_taken_eq_4():
     v = float(velocity_after(P, jnp.float32(200.0), jnp.float32(3.0)))
     assert v == pytest.approx(200 + 1 / (0.01 + 9))
     taken = float(soil_taken(P, jnp.float32(np.sqrt(2)), jnp.float32(4.0)))
     assert taken == pytest.approx(1 / (0.01 + (np.sqrt(2) / 4) ** 2), rel=1e-6)
     slow = float(soil_taken(P, jnp.float32(1.0), jnp.float32(0.0)))  # eps_v keeps time finite
     assert slow == pytest.approx(1 / (0.01 + (1 / 1e-4) ** 2), rel=1e-5)
+
+
+def test_hud_scale_makes_the_soil_taken_depend_on_the_edge_length():
+    # HUD = 1 x length: time^2 = 2.5e-5 (straight) or 5e-5 (diagonal) against b_s = 0.01.
+    straight, diagonal = (float(soil_taken(P, jnp.float32(n), jnp.float32(200.0)))
+                          for n in (1.0, np.sqrt(2)))
+    assert straight == pytest.approx(1 / (0.01 + 2.5e-5), rel=1e-5)
+    assert diagonal / straight > 0.997  # the length hardly matters
+    # HUD = 20 x length: time = 0.1 or 0.141, soil taken 1 / 0.02 = 50 and 1 / 0.03 = 33.3.
+    scaled = P._replace(hud_scale=jnp.float32(20.0))
+    straight, diagonal = (float(soil_taken(scaled, jnp.float32(n), jnp.float32(200.0)))
+                          for n in (1.0, np.sqrt(2)))
+    assert straight == pytest.approx(50.0, rel=1e-5)
+    assert diagonal == pytest.approx(100 / 3, rel=1e-5)
+
+
+def test_walked_soil_is_the_velocity_update_and_eq_4_along_a_path():
+    graph = grid_graph(np.zeros((1, 3), bool))  # 0 - 1 - 2
+    soil = jnp.full(graph.nbr.shape, 10.0).at[1, EAST].set(2.0)
+    path = jnp.array([[0, 1, 2], [0, 1, -1]])
+    slots = jnp.array([[EAST, EAST], [EAST, -1]], jnp.int8)
+    taken, velocity = walked_soil(graph, soil, path, slots, P)
+    v1 = 200 + 1 / (0.01 + 100)  # the velocity after 0 -> 1 (soil 10)
+    v2 = v1 + 1 / (0.01 + 4)  # after 1 -> 2 (soil 2)
+    np.testing.assert_allclose(np.asarray(taken[0]),
+                               [1 / (0.01 + (1 / v1) ** 2), 1 / (0.01 + (1 / v2) ** 2)],
+                               rtol=1e-6)
+    assert float(taken[1, 1]) == 0.0
+    np.testing.assert_allclose(np.asarray(velocity), [v2, v1], rtol=1e-6)
+
+
+def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
+    graph = grid_graph(np.zeros((1, 3), bool))  # 0 - 1 - 2
+    soil = jnp.full(graph.nbr.shape, 1000.0)
+    path = jnp.array([[0, 1, 2], [0, 1, -1], [0, 1, 2]])
+    slots = jnp.array([[EAST, EAST], [EAST, -1], [EAST, EAST]], jnp.int8)
+    taken = jnp.array([[10.0, 20.0], [40.0, 0.0], [30.0, 50.0]])
+    arrived = jnp.array([True, False, True])
+    after = np.asarray(arrived_updates(graph, soil, path, slots, taken, arrived, P))
+    # Drop 1 did not arrive: nothing of it is kept. Drop 0, then drop 2 (eq. 5 twice):
+    first = 0.1 * 1000 - 0.9 * 10
+    assert after[0, EAST] == pytest.approx(0.1 * first - 0.9 * 30, rel=1e-6)
+    second = 0.1 * 1000 - 0.9 * 20
+    assert after[1, EAST] == pytest.approx(0.1 * second - 0.9 * 50, rel=1e-6)
+    untouched = np.ones(after.shape, bool)
+    untouched[[0, 1], EAST] = False
+    assert np.all(after[untouched] == 1000.0)
+    # The other order gives another soil: the order is part of the rule.
+    swapped = np.asarray(arrived_updates(graph, soil, path[::-1], slots[::-1], taken[::-1],
+                                         arrived[::-1], P))
+    assert swapped[0, EAST] != pytest.approx(after[0, EAST])
+
+
+def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
+    # A dead end above the corridor's middle: drops that enter it get stuck.
+    free = np.zeros((2, 5), bool)
+    free[1, [0, 2, 4]] = True  # blocked: the row below is a comb
+    graph = grid_graph(free)
+    table_soil = jnp.full(graph.nbr.shape, 10_000.0)
+    task = make_task(graph, (0, 0), (4, 0))
+    drops = drop_walk(jax.random.key(1), graph, task, table_soil, P, num_agents=32,
+                      max_steps=None)
+    assert drops.arrived.any() and (~drops.arrived).any()
+    changed = np.asarray(drops.memory) != 10_000.0
+    rows, slots = np.nonzero(changed)
+    arrived_moves = {(int(n), int(k)) for a in np.flatnonzero(np.asarray(drops.arrived))
+                     for n, k in zip(np.asarray(drops.path[a, :-1]), np.asarray(drops.slots[a]))
+                     if k >= 0}
+    assert set(zip(rows.tolist(), slots.tolist())) == arrived_moves
+    carried = np.asarray(drops.state[:, 1])
+    assert np.all(carried[np.asarray(drops.arrived)] > 0)
+
+
+def test_backtracking_drops_back_out_of_dead_ends():
+    free = np.zeros((2, 5), bool)
+    free[1, [0, 2, 4]] = True
+    graph = grid_graph(free)
+    task = make_task(graph, (0, 0), (4, 0))
+    soil = jnp.full(graph.nbr.shape, 10_000.0)
+    drops = drop_walk(jax.random.key(1), graph, task, soil, P, num_agents=32, max_steps=None,
+                      backtrack=True)
+    assert drops.arrived.all()
+    paths = np.asarray(drops.path)
+    for path, moves in zip(paths, np.asarray(drops.moves)):
+        nodes = path[path >= 0]
+        assert nodes[0] == 0 and nodes[-1] == 4 and len(set(nodes)) == len(nodes)
+        assert moves >= len(nodes) - 1  # back-outs count as moves
+    assert np.asarray(drops.moves).max() > (paths >= 0).sum(axis=1).max() - 1  # one backed out
+    with pytest.raises(ValueError, match="backtrack=True needs local_updates='arrived'"):
+        make("iwd", backtrack=True, local_updates="while_walking")
+    with pytest.raises(ValueError, match="unknown local_updates 'all'"):
+        make("iwd", local_updates="all")
 
 
 def step_groups(run, here, slot, moving, runs, graph):
@@ -103,7 +199,7 @@ def test_drops_on_one_edge_in_one_step_update_it_in_lane_order():
     assert np.array_equal(np.asarray(kept), np.asarray(move.state))
 
 
-def test_two_drops_down_a_corridor_by_hand_and_bit_identically():
+def test_two_drops_down_a_corridor_while_walking_by_hand_and_bit_identically():
     graph = grid_graph(np.zeros((1, 3), bool))  # 0 - 1 - 2, goal 2
     table = edge_table(graph, goal_log_desirability(graph, 2))
     soil = jnp.full(graph.nbr.shape, 10_000.0)
@@ -118,7 +214,7 @@ def test_two_drops_down_a_corridor_by_hand_and_bit_identically():
     assert first.arrived.all() and np.asarray(first.path)[:, :3].tolist() == [[0, 1, 2]] * 2
     v1 = 200 + 1 / (0.01 + 1e8)
     d1 = 1 / (0.01 + (1 / v1) ** 2)
-    # Both drops cross 0 -> 1 in the first step and 1 -> 2 in the second (eq. 6 twice a step).
+    # Both drops cross 0 -> 1 in the first step and 1 -> 2 in the second (eq. 5 twice a step).
     want = 0.01 * 10_000 - 0.09 * d1 - 0.9 * d1  # ~1.25: float32 cancels digits of 100 - 98.75
     assert float(first.memory[0, EAST]) == pytest.approx(want, abs=1e-3)
     assert float(first.memory[1, EAST]) == pytest.approx(want, abs=1e-3)

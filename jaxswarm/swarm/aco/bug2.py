@@ -3,11 +3,9 @@
 The paper replicates Bug2 (head along the line to the goal, follow an obstacle's edge until the
 line is free again) with an ant whose heuristic weight is high (5) and which "knows its old
 positions": it never enters a node it has been to, and backs out of a dead end to the node
-before and tries another way. On a graph that is a depth-first walk: at each node the ant draws
-one admissible unvisited neighbour by the colony's transition weights (or, ``greedy``, takes the
-most likely one), and pops back when it has none. It reaches the goal whenever a path exists,
-entering each node at most once, and its path is what remains on the stack: the way it went,
-without the dead ends it backed out of. On thin-wall path maps an obstacle is a closed edge.
+before and tries another way. That is the walker's depth-first walk
+(:mod:`jaxswarm.swarm.walking.backtrack`) over the colony's transition weights. On thin-wall path
+maps an obstacle is a closed edge.
 """
 from __future__ import annotations
 
@@ -16,8 +14,9 @@ import functools
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.walking import heads, sample_masked
-from jaxswarm.world.graph import NO_NODE, Graph
+from jaxswarm.swarm.walking import heads
+from jaxswarm.swarm.walking.backtrack import depth_first_walk
+from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
 
 
@@ -34,7 +33,8 @@ def direction_cosine(graph: Graph, goal) -> jax.Array:
 @functools.partial(jax.jit, static_argnames="greedy")
 def first_ant_path(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *,
                    greedy: bool = False):
-    """The first ant's depth-first walk from ``start`` to ``goal`` (node indices, may be traced).
+    """The first ant's depth-first walk from ``start`` to ``goal`` (node indices, may be traced;
+    :func:`~jaxswarm.swarm.walking.backtrack.depth_first_walk` over a fixed table).
 
     Args:
       key: PRNG key of its draws (unused when ``greedy``).
@@ -47,38 +47,10 @@ def first_ant_path(key: jax.Array, graph: Graph, log_weights: jax.Array, start, 
       ``(path i32[N], cost f32[], found bool[])``: the path without its backed-out dead ends,
       -1 padded (all -1 and cost inf when the goal cannot be reached).
     """
-    n = graph.num_nodes
-    stack = jnp.full((n,), NO_NODE, jnp.int32).at[0].set(start)
-    visited = jnp.zeros((n,), bool).at[start].set(True)
-
-    def searching(carry):
-        stack, _, depth, _ = carry
-        return (depth > 0) & (stack[jnp.maximum(depth - 1, 0)] != goal)
-
-    def advance(carry):
-        stack, visited, depth, move = carry
-        here = stack[depth - 1]
-        heads = jnp.where(graph.nbr[here] >= 0, graph.nbr[here], 0)
-        options = jnp.where(visited[heads], -jnp.inf, log_weights[here])
-        if greedy:
-            best = jnp.argmax(options)
-            can_move = options[best] > -jnp.inf
-        else:
-            uniform = jax.random.uniform(jax.random.fold_in(key, move), (1,))
-            choice, has_choice = sample_masked(uniform, options[None], jnp.ones_like(
-                options, bool)[None])
-            best, can_move = jnp.maximum(choice[0], 0), has_choice[0]
-        there = heads[best]
-        stack = jnp.where(can_move, stack.at[depth].set(there, mode="drop"),
-                          stack.at[depth - 1].set(NO_NODE))
-        visited = visited.at[there].set(visited[there] | can_move)
-        return stack, visited, jnp.where(can_move, depth + 1, depth - 1), move + 1
-
-    stack, _, depth, _ = jax.lax.while_loop(
-        searching, advance, (stack, visited, jnp.int32(1), jnp.int32(0)))
-    found = depth > 0
-    path = jnp.where(found, stack, NO_NODE)
-    return path, jnp.where(found, path_length(graph, path), jnp.inf), found
+    walked = depth_first_walk(key, graph, lambda here, unvisited: log_weights[here], start,
+                              goal, max_nodes=graph.num_nodes, greedy=greedy)
+    return (walked.path, jnp.where(walked.found, path_length(graph, walked.path), jnp.inf),
+            walked.found)
 
 
 def bug2_path(graph: Graph, start, goal):

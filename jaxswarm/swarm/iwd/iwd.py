@@ -2,11 +2,19 @@
 
 Each iteration ``num_agents`` drops leave the start with the initial velocity and no soil, and
 walk to the goal never revisiting a node (the visited set VC). At every step each drop chooses by
-the soil it finds and the goal's nearness, speeds up, takes soil from the edge it crosses and
-carries it (:mod:`.soil`, through the walker's per-step hook: the soil changes while the drops
-walk). After the iteration the path of its best drop gets the global update, and the best path so
-far is kept. The paper's nodes sit at cell corners with 8 moves and Euclidean lengths; on our
-grids the cells are the nodes, the same kind of graph.
+the soil it finds and the goal's nearness (eqs. 1-3), speeds up, takes soil from the edge it
+crosses and carries it (eqs. 4-6, :mod:`.soil`). After the iteration the path of its best drop
+gets the global update, and the best path so far is kept. The paper's nodes sit at cell corners
+with 8 moves and Euclidean lengths; on our grids the cells are the nodes, the same kind of graph.
+
+Which drops change the soil is a reading (``IWDConfig.local_updates``). The IWD_PG paper:
+"feasible solution removes some soil of graph and therefore guides next generation drops", and
+of its reference [24]: it "obtains better solutions in early iteration by using a repair
+mechanism for infeasible solutions". So by default only the drops that reach the goal change the
+soil, after the walk (``"arrived"``). Most drops on a maze get stuck in a dead end; when they
+too take soil as they go (``"while_walking"``), each leaves a trail of soil near -100 beside
+edges near 10,000 (choice odds of about 10^5 : 1), and later drops re-walk the old dead ends.
+``backtrack`` (ours, off) is a repair: a stuck drop backs out of its dead end.
 """
 from __future__ import annotations
 
@@ -19,16 +27,48 @@ import numpy as np
 
 from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
                                  default_params, keep_best)
-from jaxswarm.swarm.iwd.soil import CARRIED, SOIL, global_update, goal_log_desirability
+from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_updates,
+                                     choice_log_weights, global_update, goal_log_desirability,
+                                     walked_soil)
 from jaxswarm.swarm.walking import Walk, edge_table, step_budget, walk
+from jaxswarm.swarm.walking.backtrack import backtracking_walk
 from jaxswarm.world.graph import Graph
+
+
+LOCAL_UPDATES = ("arrived", "while_walking")
+"""When the drops' local soil updates (eqs. 4-6) apply: see :class:`IWDConfig`."""
 
 
 @dataclasses.dataclass(frozen=True)
 class IWDConfig(SwarmConfig):
-    """Static sizes of IWD: ``num_agents`` drops per iteration (50 by default)."""
+    """Static sizes and switches of IWD (the defaults are the paper's algorithm).
+
+    Attributes:
+      num_agents: drops per iteration (50).
+      local_updates: ``"arrived"``: only the drops that reach the goal change the soil, after
+        the walk (the IWD_PG paper: "feasible solution removes some soil of graph and therefore
+        guides next generation drops"), each arrived drop's moves applied in agent order, then
+        move order, over the soil the drops met; ``"while_walking"``: every drop changes the
+        soil at every move, stuck ones too, and the drops of an iteration read each other's
+        changes (Shah-Hosseini's TSP drops, which all complete a tour).
+      backtrack: ours: a drop with no admissible unvisited neighbour backs out to the node it
+        came from and tries another way (the Improved Max-Min paper's first ant,
+        :mod:`jaxswarm.swarm.walking.backtrack`) instead of stopping; its path is the way
+        without the dead ends. Needs ``local_updates="arrived"``.
+    """
 
     num_agents: int = 50
+    local_updates: str = "arrived"
+    backtrack: bool = False
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.local_updates not in LOCAL_UPDATES:
+            raise ValueError(f"unknown local_updates {self.local_updates!r}; "
+                             f"choose one of {', '.join(LOCAL_UPDATES)}")
+        if self.backtrack and self.local_updates != "arrived":
+            raise ValueError("backtrack=True needs local_updates='arrived' (backing-out drops "
+                             "walk one after another over the soil as it was)")
 
 
 class IWDParams(NamedTuple):
@@ -45,6 +85,7 @@ class IWDParams(NamedTuple):
       rho_n: the local update's weight (0.9).
       rho_iwd: the global update's weight (0.9).
       initial_soil: every edge's soil at the start (10,000).
+      hud_scale: ours: HUD(i, j) is this times the edge's length (1; see :mod:`.soil`).
     """
 
     alpha: jax.Array
@@ -61,13 +102,15 @@ class IWDParams(NamedTuple):
     rho_n: jax.Array
     rho_iwd: jax.Array
     initial_soil: jax.Array
+    hud_scale: jax.Array
 
 
 DEFAULT_IWD = default_params(IWDParams, alpha=1.0, beta=1.0, eps_s=0.01, a_v=1.0, b_v=0.01,
                              c_v=1.0, initial_velocity=200.0, a_s=1.0, b_s=0.01, c_s=1.0,
-                             eps_v=1e-4, rho_n=0.9, rho_iwd=0.9, initial_soil=10_000.0)
-"""Shah-Hosseini's standard values, which the paper cites; ``eps_v`` is ours (the paper's text
-lost it)."""
+                             eps_v=1e-4, rho_n=0.9, rho_iwd=0.9, initial_soil=10_000.0,
+                             hud_scale=1.0)
+"""Shah-Hosseini's standard values, which the paper cites; ``eps_v`` and ``hud_scale`` are ours
+(the paper's text lost the one and leaves the other open)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -107,7 +150,7 @@ def check_iwd(params: IWDParams) -> None:
     """
     for name in ("alpha", "beta", "a_v", "c_v", "a_s", "c_s", "initial_soil"):
         check_positive(name, getattr(params, name), allow_zero=True)
-    for name in ("eps_s", "b_v", "initial_velocity", "b_s", "eps_v", "rho_n"):
+    for name in ("eps_s", "b_v", "initial_velocity", "b_s", "eps_v", "rho_n", "hud_scale"):
         check_positive(name, getattr(params, name))
     check_positive("rho_iwd", params.rho_iwd, allow_zero=True)
     for name in ("rho_n", "rho_iwd"):
@@ -121,13 +164,44 @@ def initial_soil(graph: Graph, params: IWDParams) -> jax.Array:
 
 
 def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_agents: int,
-              max_steps: int | None) -> Walk:
-    """One iteration's drops walking from ``task.start`` over ``soil`` (f32[N, K]), which they
-    change as they go (the walker's soil hook); the Walk's ``memory`` is the soil after them."""
+              max_steps: int | None, local_updates: str = "arrived",
+              backtrack: bool = False) -> Walk:
+    """One iteration's drops walking from ``task.start`` over ``soil`` (f32[N, K]) with their
+    local updates (``local_updates`` and ``backtrack`` as in :class:`IWDConfig`).
+
+    Returns:
+      The :class:`~jaxswarm.swarm.walking.Walk`, its ``memory`` the soil after the local
+      updates and its ``state`` f32[A, 2] each drop's velocity and carried soil at its end.
+    """
     table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
-    return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
-                max_steps=step_budget(graph, max_steps), hook=SOIL, memory=soil,
-                hook_params=params)
+    budget = step_budget(graph, max_steps)
+    if local_updates == "while_walking":
+        return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
+                    max_steps=budget, hook=SOIL, memory=soil, hook_params=params)
+    if backtrack:
+        drops = backtracking_walk(key, graph, soil_choice(graph, table, soil, params),
+                                  task.start, task.goal, num_agents=num_agents, max_steps=budget)
+    else:
+        drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
+                     max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params)
+    taken, velocity = walked_soil(graph, soil, drops.path, drops.slots, params)
+    return drops._replace(
+        memory=arrived_updates(graph, soil, drops.path, drops.slots, taken, drops.arrived,
+                               params),
+        state=jnp.stack([velocity, jnp.sum(taken, axis=1)], axis=-1))
+
+
+def soil_choice(graph: Graph, table, soil, params: IWDParams):
+    """The drops' transition rule (eqs. 1-3) over fixed ``soil`` (f32[N, K]) and ``table``
+    (f32[N, K], the goal term) as a :data:`~jaxswarm.swarm.walking.backtrack.ChoiceRule`."""
+    one_lane = jax.tree_util.tree_map(lambda p: jnp.asarray(p)[None], params)
+
+    def choice(here, unvisited):
+        row = table[here]
+        admissible = unvisited & (row > -jnp.inf)
+        return row + choice_log_weights(one_lane, soil[here][None], admissible[None])[0]
+
+    return choice
 
 
 def soil_after_best(graph: Graph, drops: Walk, paths, costs, params: IWDParams) -> jax.Array:
@@ -161,7 +235,8 @@ def build_iwd(config: IWDConfig) -> Swarm:
     def step(state: IWDState, graph: Graph, task: Task, params: IWDParams):
         key, walk_key = jax.random.split(state.key)
         drops = drop_walk(walk_key, graph, task, state.soil, params,
-                          num_agents=config.num_agents, max_steps=config.max_steps)
+                          num_agents=config.num_agents, max_steps=config.max_steps,
+                          local_updates=config.local_updates, backtrack=config.backtrack)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
         soil = soil_after_best(graph, drops, drops.path, costs, params)

@@ -1,26 +1,42 @@
 """The equations of Intelligent Water Drops (Shah-Hosseini's IWD, as the IWD_PG paper uses it).
 
 Soil lives on directed edge slots (``f32[N, K]``). A drop carries a velocity and the soil it has
-taken. Moving ``i -> j`` (all drops of a lockstep step read the soil as it was at its start):
+taken. Moving ``i -> j``, numbered as the IWD_PG paper numbers them:
 
 * choice (eqs. 1-3): ``p(i, j)`` proportional to ``f(soil(i, j))^alpha * h(j)^beta`` over the
-  admissible unvisited ``j``, ``f(s) = 1 / (eps_s + g(s))``, ``g(s) = s`` when the smallest soil
-  among the choices is ``>= 0``, else ``s - min``;
-* velocity (eq. 4): ``vel += a_v / (b_v + c_v * soil(i, j)^2)``;
-* soil taken (eq. 5): ``dsoil = a_s / (b_s + c_s * time^2)``, ``time = HUD(i, j) / max(eps_v,
-  vel)`` with the velocity after the move and HUD the edge's length;
-* local update (eq. 6): ``soil(i, j) = (1 - rho_n) * soil(i, j) - rho_n * dsoil``; the drop's
-  soil ``+= dsoil``. Drops crossing one edge in one step apply their updates one after another
-  in the order of the walker's lanes (:mod:`~jaxswarm.swarm.walking.hooks`): with ``c`` of
-  them, ``soil = (1 - rho_n)^c soil - rho_n * sum_r (1 - rho_n)^(c - 1 - r) dsoil_r`` over
-  their ranks ``r``;
-* global update of the iteration-best path (``N_IB`` nodes, its drop's soil ``soil_IB``), on its
-  edges: ``soil = (1 + rho_IWD) * soil - rho_IWD * soil_IB / (N_IB - 1)``.
+  admissible unvisited ``j`` (eq. 1), ``f(s) = 1 / (eps_s + g(s))`` (eq. 2), ``g(s) = s`` when
+  the smallest soil among the choices is ``>= 0``, else ``s - min`` (eq. 3);
+* velocity (Shah-Hosseini's update; the IWD_PG paper does not number it): ``vel += a_v / (b_v +
+  c_v * soil(i, j)^2)``;
+* soil taken (eq. 4, "depends on speed of IWDs and heuristic functions"): ``dsoil = a_s / (b_s
+  + c_s * time^2)``, ``time = HUD(i, j) / max(eps_v, vel)`` with the velocity after the move;
+* local update (eqs. 5 and 6): the edge's ``soil(i, j) = (1 - rho_n) * soil(i, j) - rho_n *
+  dsoil`` (eq. 5), the drop's ``soil += dsoil`` (eq. 6);
+* global update of the iteration-best path (Shah-Hosseini's, unnumbered in the paper; ``N_IB``
+  nodes, its drop's soil ``soil_IB``), on its edges: ``soil = (1 + rho_IWD) * soil - rho_IWD *
+  soil_IB / (N_IB - 1)``.
 
-``h(j)``, the goal-distance desirability, is not written out in the paper ("the closest node to
-the destination will be selected with more probability"): ours is ``1 / d_j``, ``d_j`` the
-straight-line distance from ``j`` to the goal, so a drop next to the goal moves into it (as
-ACO*'s ants do).
+When the local updates apply is :mod:`.iwd`'s choice (``local_updates``): after the walk, for
+the drops that arrived only (:func:`arrived_updates`; the drops read the soil as it was at the
+start of the iteration), or while the drops walk (:data:`SOIL`, the walker's per-step hook: all
+drops of a lockstep step read the soil as it was at its start, and drops crossing one edge in
+one step apply their updates one after another in the order of the walker's lanes, ``soil =
+(1 - rho_n)^c soil - rho_n * sum_r (1 - rho_n)^(c - 1 - r) dsoil_r`` over their ranks ``r``).
+
+Two functions the paper leaves open, and ours:
+
+* ``HUD(i, j)``, the heuristic undesirability of the move (Shah-Hosseini: the distance between
+  the cities), is ``hud_scale`` times the edge's length. With the standard constants and
+  ``hud_scale = 1`` (a cell's side is one unit), ``time^2`` is 2.5e-5 to 5e-5, far below
+  ``b_s = 0.01``: every edge loses 99.5-99.75 soil whatever its length, and only the global
+  update prefers short paths. The length matters once ``time`` nears ``sqrt(b_s / c_s) = 0.1``:
+  with ``hud_scale = 20`` (the map in units of a twentieth of a cell) a straight move at the
+  initial velocity 200 takes 50 soil and a diagonal one 33, so the soil removed per unit of
+  length falls with the edge's length. That is a reading of the units, within the standard
+  equations.
+* ``h(j)``, the goal desirability ("the closest node to the destination will be selected with
+  more probability"), is ``1 / d_j``, ``d_j`` the straight-line distance from ``j`` to the goal,
+  so a drop next to the goal moves into it (as ACO*'s ants do).
 """
 from __future__ import annotations
 
@@ -46,14 +62,20 @@ def choice_log_weights(params, soil_rows, admissible) -> jax.Array:
     return jnp.where(admissible, params.alpha[:, None] * log_f, 0.0)
 
 
+def velocity_gain(params, soil):
+    """The velocity a drop gains crossing an edge with ``soil`` (the unnumbered update)."""
+    return params.a_v / (params.b_v + params.c_v * soil ** 2)
+
+
 def velocity_after(params, velocity, soil):
-    """Eq. 4: the velocity after crossing an edge with ``soil``."""
-    return velocity + params.a_v / (params.b_v + params.c_v * soil ** 2)
+    """The velocity after crossing an edge with ``soil``."""
+    return velocity + velocity_gain(params, soil)
 
 
 def soil_taken(params, length, velocity):
-    """Eq. 5: the soil a drop at ``velocity`` takes from an edge of ``length`` (its HUD)."""
-    time = length / jnp.maximum(params.eps_v, velocity)
+    """Eq. 4: the soil a drop at ``velocity`` takes from an edge of ``length``, whose HUD is
+    ``hud_scale * length``."""
+    time = params.hud_scale * length / jnp.maximum(params.eps_v, velocity)
     return params.a_s / (params.b_s + params.c_s * time ** 2)
 
 
@@ -63,8 +85,8 @@ def initial_state(params) -> jax.Array:
 
 
 def local_update(params, soil, move: Move, graph: Graph):
-    """Eqs. 4-6 for one lockstep step: ``(soil f32[R, N, K], states f32[l, 2])`` after the
-    moves of ``move`` (``params`` per lane)."""
+    """The velocity update and eqs. 4-6 for one lockstep step: ``(soil f32[R, N, K], states
+    f32[l, 2])`` after the moves of ``move`` (``params`` per lane)."""
     slot = jnp.maximum(move.slot, 0)
     # Gathered anew rather than picked from the rows the choice read: XLA then fuses a one-float
     # gather here instead of the choice's whole row gather.
@@ -86,7 +108,58 @@ def local_update(params, soil, move: Move, graph: Graph):
 
 SOIL = StepHook(state_width=2, initial_state=initial_state, log_weights=choice_log_weights,
                 update=local_update)
-"""The walker hook of water drops: soil memory ``f32[N, K]`` per run, eqs. 1-6."""
+"""The walker hook of drops that change the soil as they walk: soil memory ``f32[N, K]`` per
+run, eqs. 1-6."""
+
+
+def _keep_memory(params, soil, move: Move, graph: Graph):
+    """A step that writes nothing: the memory and the lanes' (empty) states as they were."""
+    return soil, move.state
+
+
+SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,), jnp.float32),
+                       log_weights=choice_log_weights, update=_keep_memory)
+"""The walker hook of drops that read the soil and leave it as it is during the walk (eqs. 1-3;
+their updates come after it, :func:`arrived_updates`)."""
+
+
+def walked_soil(graph: Graph, soil, path, slots, params):
+    """The velocity update and eq. 4 along whole walks over ``soil`` (f32[N, K], as the drops
+    met it): ``(taken f32[A, L - 1], velocity f32[A])``, the soil each move took (0 where
+    ``slots``, i8/i16/i32[A, L - 1], is -1) and each drop's velocity at its end, for paths
+    ``path`` (i32[A, L])."""
+    moved = slots >= 0
+    here = jnp.where(moved, path[:, :-1], 0)
+    slot = jnp.maximum(slots, 0).astype(jnp.int32)
+    gained = jnp.where(moved, velocity_gain(params, soil[here, slot]), 0.0)
+    velocity = params.initial_velocity + jnp.cumsum(gained, axis=1)
+    taken = jnp.where(moved, soil_taken(params, move_lengths(graph, here, slots), velocity), 0.0)
+    return taken, velocity[:, -1]
+
+
+def arrived_updates(graph: Graph, soil, path, slots, taken, arrived, params):
+    """Eq. 5 for the moves of the drops that arrived, applied after the walk: f32[N, K] soil
+    after drop 0's moves, then drop 1's, ... (agent order, then move order; a drop crosses a
+    directed edge at most once), whatever lanes the drops walked in.
+
+    Args:
+      graph: the map.
+      soil: f32[N, K] the soil before.
+      path: i32[A, L] the drops' paths; slots: i8/i16/i32[A, L - 1] their moves' slots.
+      taken: f32[A, L - 1] the soil each move took (:func:`walked_soil`).
+      arrived: bool[A] which drops' updates are kept.
+      params: the IWD params (scalars).
+    """
+    keep = 1.0 - params.rho_n
+    rows = jnp.where((slots >= 0) & arrived[:, None], path[:, :-1], graph.num_nodes)
+    columns = jnp.maximum(slots, 0).astype(jnp.int32)
+
+    def one_drop(soil, drop):
+        row, column, amount = drop
+        before = soil[jnp.minimum(row, graph.num_nodes - 1), column]
+        return soil.at[row, column].set(keep * before - params.rho_n * amount, mode="drop"), None
+
+    return jax.lax.scan(one_drop, soil, (rows, columns, taken))[0]
 
 
 def goal_log_desirability(graph: Graph, goal) -> jax.Array:

@@ -26,3 +26,12 @@ def union(bits: jax.Array, num_nodes: int, which: jax.Array | None = None) -> ja
     merged = jax.lax.reduce(words, jnp.uint32(0), jax.lax.bitwise_or, (0,))
     per_node = (merged[:, None] >> jnp.arange(32, dtype=jnp.uint32)) & 1
     return per_node.reshape(-1)[:num_nodes].astype(bool)
+
+
+def pack(mask: jax.Array) -> jax.Array:
+    """u32[A, ceil(N / 32)] the sets of ``mask`` (bool[A, N]: node ``n`` is in set ``a``)."""
+    num_sets, num_nodes = mask.shape
+    words = (num_nodes + 31) // 32
+    padded = jnp.zeros((num_sets, words * 32), jnp.uint32).at[:, :num_nodes].set(mask)
+    shifted = padded.reshape(num_sets, words, 32) << jnp.arange(32, dtype=jnp.uint32)
+    return jax.lax.reduce(shifted, jnp.uint32(0), jax.lax.bitwise_or, (2,))

@@ -182,7 +182,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
             """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
             if not batched:
                 x = jnp.broadcast_to(x, (axis_size,) + x.shape)
-            return x.reshape((-1,) + x.shape[2:])
+            return x.reshape((x.shape[0] * x.shape[1],) + x.shape[2:])
 
         seed, start, goal = fold(seed, seed_b), fold(start, start_b), fold(goal, goal_b)
         # One table for the whole batch stays one table (the walk reads it for every run).
@@ -192,9 +192,9 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         # Numbers shared by the batch stay one run's (the lanes then need no gather of them).
         hook_params = jax.tree_util.tree_map(lambda p, b: fold(p, b) if b else p, hook_params,
                                              params_b)
-        out = jax.tree_util.tree_map(lambda x: x.reshape((axis_size, -1) + x.shape[1:]),
-                                     walk_runs(seed, graph, log_weights, start, goal, memory,
-                                               hook_params))
+        out = jax.tree_util.tree_map(  # sizes spelled out: a hook's state may be empty
+            lambda x: x.reshape((axis_size, x.shape[0] // axis_size) + x.shape[1:]),
+            walk_runs(seed, graph, log_weights, start, goal, memory, hook_params))
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return walk_runs
