@@ -1,6 +1,6 @@
 """The package's shape: the import contract of ``pyproject.toml`` (``lint-imports``: imports only
-go down the rooms' layers, no import cycles inside a sub-package, the deprecation shims import
-only ``jaxswarm.runtime``), a short package root, short functions and a light top level."""
+go down the rooms' layers, no import cycles inside a sub-package), a short package root, short
+functions and a light top level."""
 from __future__ import annotations
 
 import ast

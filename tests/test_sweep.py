@@ -281,13 +281,13 @@ def test_a_store_records_the_swarms_definition_and_refuses_another(finished, tmp
         run_sweep(spec, copy, progress=False)
 
 
-def test_a_store_of_0_2_0_is_not_resumed(finished, tmp_path):
+def test_a_store_of_0_5_0_is_not_resumed(finished, tmp_path):
     spec, out, _ = finished
     old = tmp_path / "old"
     shutil.copytree(out, old)
-    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.2.0"))  # same definition, older walks
-    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.2\.0, whose walks drew "
-                                                 r"other random numbers"):
+    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.5.0"))  # same definition, older results
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.5\.0, whose swarms "
+                                                 r"computed otherwise \(results changed in 0\.6\.0"):
         run_sweep(spec, old, progress=False)
 
 

@@ -1,5 +1,4 @@
 """How jaxswarm runs: XLA:CPU devices and threads (:mod:`~jaxswarm.runtime.cpu`), compiled
 programs kept between processes (:mod:`~jaxswarm.runtime.cache`), files written whole or not at
-all (:mod:`~jaxswarm.runtime.atomic`), a vmap rule for loops whose trip count differs between
-batch members (:mod:`~jaxswarm.runtime.batching`) and the old import paths of moved names
-(:mod:`~jaxswarm.runtime.moved`)."""
+all (:mod:`~jaxswarm.runtime.atomic`) and a vmap rule for loops whose trip count differs
+between batch members (:mod:`~jaxswarm.runtime.batching`)."""

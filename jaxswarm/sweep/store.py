@@ -92,9 +92,10 @@ def _differences(before: dict, after: dict) -> list[str]:
     return sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
 
 
-SAME_RESULTS_SINCE = (0, 3)
-"""The jaxswarm release since which a run's results are the same: 0.3.0's walker draws other
-random numbers than 0.2.0's, so a store of an older release is not resumed."""
+SAME_RESULTS_SINCE = (0, 6)
+"""The jaxswarm release since which a run's results are the same: 0.6.0 reads the papers again
+where IWD, IWD_PG, RFD*, Ant System, ACO* and cABC computed otherwise (see CHANGELOG.md), so a
+store of an older release is not resumed."""
 
 
 def _older_release(version: str | None) -> bool:
@@ -117,9 +118,9 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
     stored = existing.get("swarm")
     if stored is not None and _older_release(existing.get("jaxswarm")):
         raise StoreMismatchError(
-            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose walks drew other "
-            f"random numbers (every result changed in 0.3.0, see CHANGELOG.md); choose another "
-            "--out or delete it")
+            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose swarms computed "
+            f"otherwise (results changed in 0.{SAME_RESULTS_SINCE[1]}.0, see CHANGELOG.md); "
+            "choose another --out or delete it")
     if stored == swarm:
         return
     if stored is None:
