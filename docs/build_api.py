@@ -44,11 +44,9 @@ import pdoc.render_helpers
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = "jaxswarm"
-SHIMS = frozenset({"jaxswarm.graph", "jaxswarm.robot", "jaxswarm.maps.plane"})
-"""0.4.0's module paths, forwarding to the new homes with a DeprecationWarning until 0.6.0."""
-SPECS = (PACKAGE, *(f"!{re.escape(name)}$" for name in sorted(SHIMS)), r"!.*\._")
-"""pdoc's module specifications: the package and all its modules, less the shims and the
-private modules (``!`` drops the names the pattern matches)."""
+SPECS = (PACKAGE, r"!.*\._")
+"""pdoc's module specifications: the package and all its modules, less the private modules
+(``!`` drops the names the pattern matches)."""
 DOCFORMAT = "google"
 ROLE = re.compile(r"(?::py)?:(mod|func|data|const|class|meth|attr|exc|obj):`(~?)([^`]+)`")
 """A Sphinx cross-reference role, as pdoc's reStructuredText conversion reads it."""
@@ -117,10 +115,9 @@ def _child_modules(module) -> dict[str, pkgutil.ModuleInfo]:
 
 
 def _documented_submodules(module: pdoc.doc.Module) -> list[pdoc.doc.Module]:
-    """The submodules a package's page lists: the public ones, less the shims (never imported)."""
+    """The submodules a package's page lists: the public ones."""
     return [pdoc.doc.Module.from_name(info.name)
-            for short, info in _child_modules(module.obj).items()
-            if not short.startswith("_") and info.name not in SHIMS]
+            for short, info in _child_modules(module.obj).items() if not short.startswith("_")]
 
 
 def module_names() -> list[str]:

@@ -43,9 +43,6 @@ contract in ``pyproject.toml``, checked by the tests):
 * :mod:`jaxswarm.studies`: what the table scripts of ``sweeps/`` share (provenance records).
 * :mod:`jaxswarm.cli`: the ``jaxswarm`` command.
 
-``jaxswarm.graph``, ``jaxswarm.robot`` and ``jaxswarm.maps.plane`` are 0.4.0's module paths,
-kept until 0.6.0: they forward to the new homes with a ``DeprecationWarning``.
-
 Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can
 still be called after it. When ``JAXSWARM_CACHE`` names a folder, importing it keeps compiled
 programs there (:mod:`jaxswarm.runtime.cache`).
