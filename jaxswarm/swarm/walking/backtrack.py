@@ -29,8 +29,9 @@ from jaxswarm.world.lattice import total_length
 from jaxswarm.world.paths import step_slots
 
 ChoiceRule = Callable[[jax.Array, jax.Array], jax.Array]
-"""``(here i32[], unvisited bool[K]) -> f32[K]``: the log-weights of the moves out of ``here``
-(``-inf``: not admissible), given which slots lead to an existing neighbour not yet visited."""
+"""``(here i32[], unvisited bool[K]) -> f32[K]``: the log-weights of the moves out of ``here``,
+``-inf`` where a move is not admissible (as in an edge table: at least every edge not valid on the
+current map), given which slots lead to a neighbour the agent has not visited."""
 
 
 class DepthFirstWalk(NamedTuple):
