@@ -1,8 +1,8 @@
 """IWD_PG (``iwd_pg``): the paper's generalised IWD on a partitioned graph.
 
-Each iteration is an IWD iteration (:mod:`.iwd`: the drops walk and change the soil as they go)
-followed by IWD_PG's stages, each a static switch of :class:`IWDPGConfig` so that experiments
-can turn it off:
+Each iteration is an IWD iteration (:mod:`.iwd`: the drops walk, and those that reach the goal
+change the soil, or another of IWD's readings) followed by IWD_PG's stages, each a static switch
+of :class:`IWDPGConfig` so that experiments can turn it off:
 
 1. ``smooth``: every drop's path through the global smooth operator (:mod:`.smooth`) before it
    is measured; the iteration's best (smoothed) path gets the global soil update;
@@ -43,7 +43,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, best_solution, keep_best
+from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.iwd import fuzzy
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
                                           second_intersection)
@@ -59,11 +59,12 @@ from jaxswarm.world.paths import path_length
 
 
 @dataclasses.dataclass(frozen=True)
-class IWDPGConfig(SwarmConfig):
-    """Static sizes and switches of IWD_PG (every operator on by default).
+class IWDPGConfig(IWDConfig):
+    """Static sizes and switches of IWD_PG (every operator on by default); the drops' own
+    (``num_agents``, ``local_updates``, ``backtrack``) are IWD's (:class:`~.iwd.IWDConfig`), and
+    the local searches' drops follow them too.
 
     Attributes:
-      num_agents: drops per iteration (50).
       smooth, first_intersection, second_intersection, local_search, fuzzy: the stages (see the
         module docstring).
       memory_size: paths the memory holds (at least 2).
@@ -73,7 +74,6 @@ class IWDPGConfig(SwarmConfig):
       operator_patience: iterations without progress before the memory operators run.
     """
 
-    num_agents: int = 50
     smooth: bool = True
     first_intersection: bool = True
     second_intersection: bool = True
@@ -190,14 +190,15 @@ def _init(config: IWDPGConfig, key, graph: Graph, task: Task, params: IWDParams)
 
 
 def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IWDParams):
-    """One IWD_PG iteration: the drops walk (changing the soil), their paths are smoothed and
+    """One IWD_PG iteration: the drops walk (and change the soil), their paths are smoothed and
     measured, the best of them gets the global soil update, all are offered to the memory, and
     the memory operators run once the best has not improved for ``operator_patience``
     iterations. Returns ``(state, StepInfo)``."""
     config = setup.config
     key, walk_key, operator_key = jax.random.split(state.key, 3)
     drops = drop_walk(walk_key, graph, task, state.soil, params,
-                      num_agents=config.num_agents, max_steps=config.max_steps)
+                      num_agents=config.num_agents, max_steps=config.max_steps,
+                      local_updates=config.local_updates, backtrack=config.backtrack)
     paths, lengths = _measured_paths(graph, drops, smooth=config.smooth)
     _, _, info = keep_best(drops._replace(path=paths, length=lengths), state.best_path,
                            state.best_cost)
@@ -413,7 +414,9 @@ def _adapt(state: IWDPGState, before: Graph, after: Graph, old: Task, new: Task,
 def build_iwd_pg(config: IWDPGConfig) -> Swarm:
     """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams`: its init, step
     and change rule, the step's stages sharing one local-search swarm."""
-    local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps))
+    local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps,
+                                local_updates=config.local_updates,
+                                backtrack=config.backtrack))
     setup = _Setup(config=config, local=local)
     return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, setup)), best=best_solution,
