@@ -59,7 +59,7 @@ ROBOT_FULL := --maps all --seeds 20 --blocks 2 --iterations 100 --patience 30 --
 IWD_FULL := --maps all --seeds 20 --drops 50 --iterations 100 --patience 30
 IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-complex 15 \
 	--iterations 50 --drops 50
-BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
+BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20 --cycle-runs 30
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
 TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
@@ -70,7 +70,7 @@ DYNAMIC_QUICK := --maps alley20 --tables 2 --seeds 1 --iterations 2 --patience 1
 ROBOT_QUICK := --maps pathmap10x10 --seeds 1 --iterations 3 --patience 2 --max-plans 4
 IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8
 IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
-BEES_QUICK := --tables 6 --runs 1
+BEES_QUICK := --tables 6 --runs 1 --cycle-runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
 MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
 
