@@ -46,7 +46,7 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # limited to 30 s an instance. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with
 # other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
 # 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables
-# 7 min and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
+# 20 min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
 # 155 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
