@@ -46,7 +46,7 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # limited to 30 s an instance. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with
 # other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
 # 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables
-# 7 min and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
+# 20 min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
 # 155 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
@@ -60,7 +60,7 @@ IWD_FULL := --maps all --variants all --seeds 20 --movingai-seeds 6 --drops 50 -
 	--patience 30
 IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-complex 15 \
 	--iterations 50 --drops 50
-BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20
+BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20 --cycle-runs 30
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
 TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
@@ -71,7 +71,7 @@ DYNAMIC_QUICK := --maps alley20 --tables 2 --seeds 1 --iterations 2 --patience 1
 ROBOT_QUICK := --maps pathmap10x10 --seeds 1 --iterations 3 --patience 2 --max-plans 4
 IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8 --movingai none
 IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
-BEES_QUICK := --tables 6 --runs 1
+BEES_QUICK := --tables 6 --runs 1 --cycle-runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
 MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
 

@@ -14,7 +14,7 @@ from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.bees.colony import (deb_best, deb_better, fitness, onlooker_probabilities,
                                         search)
 from jaxswarm.swarm.bees.guided import (constraint_violations, goal_distance, guided, pushback,
-                                        revisits, turn_degrees)
+                                        revisits, turn_angle)
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.plane import make_plane, violations
 
@@ -51,12 +51,41 @@ def test_f2_sees_along_both_axes_and_takes_the_nearest():
     assert float(value[0]) == pytest.approx(0.5 + 0.5)
 
 
-def test_f3_is_the_turn_in_degrees():
+@pytest.mark.parametrize("turn_unit, scale", [("degrees", 1.0), ("radians", math.pi / 180)])
+def test_f3_is_the_turn_in_the_declared_unit(turn_unit, scale):
+    # The last move is (0, 0) -> (1, 0), along +x. Going on to (2, 0) turns by 0; to (2, 1), by
+    # 45 degrees (pi / 4); to (1, 1), 90 (pi / 2); back to (0, 0), 180 (pi); staying at (1, 0)
+    # is no move and no turn. Under the other unit the 90 degree turn would read 1.5708 or 5157.
     previous, here = f32([0, 0]), f32([1, 0])
     points = f32([[2, 0], [2, 1], [1, 1], [0, 0], [1, 0]])
-    assert turn_degrees(points, here, previous, jnp.array(True)).tolist() == pytest.approx(
-        [0.0, 45.0, 90.0, 180.0, 0.0])  # the last stays put: no turn
-    assert turn_degrees(points, here, previous, jnp.array(False)).tolist() == [0.0] * 5
+    turns = turn_angle(points, here, previous, jnp.array(True), turn_unit=turn_unit)
+    assert turns.tolist() == pytest.approx([0.0, 45.0 * scale, 90.0 * scale, 180.0 * scale, 0.0])
+    assert turn_angle(points, here, previous, jnp.array(False),
+                      turn_unit=turn_unit).tolist() == [0.0] * 5
+
+
+def test_a_swarm_of_either_unit_scores_a_turn_in_it():
+    # From (1, 0), having come from (0, 0), with w = (0, 0, 0.03): a 90 degree turn to (1, 1)
+    # costs 0.03 x 90 = 2.7 in degrees and 0.03 x pi / 2 = 0.0471 in radians.
+    plane = make_plane([(3, 0, 4, 10)], (10, 10))
+    args = (plane, f32([9, 9]), f32([1, 0]), f32([0, 0]), jnp.array(True), f32([0, -1]),
+            f32([2, 1]), jnp.float32(1))
+    weights = f32([0.0, 0.0, 0.03])
+    assert float(guided(f32([[1, 1]]), weights, *args, turn_unit="degrees")[0]) == (
+        pytest.approx(2.7))
+    assert float(guided(f32([[1, 1]]), weights, *args, turn_unit="radians")[0]) == (
+        pytest.approx(0.03 * math.pi / 2))
+
+
+@pytest.mark.parametrize("build", [
+    lambda: make("cabc", turn_unit="grads"),
+    lambda: turn_angle(f32([[1, 1]]), f32([1, 0]), f32([0, 0]), jnp.array(True),
+                       turn_unit="grads"),
+])
+def test_an_unknown_turn_unit_is_named(build):
+    with pytest.raises(ValueError, match="unknown turn_unit 'grads'; choose one of degrees, "
+                                         "radians"):
+        build()
 
 
 def test_phi_is_the_weighted_sum_of_eq_4():
@@ -64,7 +93,7 @@ def test_phi_is_the_weighted_sum_of_eq_4():
     points = f32([[2, 5], [2, 6]])
     args = (plane, f32([2, 9]), f32([1, 5]), f32([0, 5]), jnp.array(True), f32([0, 3]),
             f32([3.5, 7]), jnp.float32(2))
-    phi = guided(points, f32([0.5, 2.0, 0.1]), *args)
+    phi = guided(points, f32([0.5, 2.0, 0.1]), *args, turn_unit="degrees")
     f1 = np.hypot([0, 0], [4, 3])
     f3 = np.asarray([0.0, 45.0])
     assert phi.tolist() == pytest.approx(0.5 * f1 + 2.0 * 1.0 + 0.1 * f3)

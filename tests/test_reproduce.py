@@ -247,13 +247,16 @@ def test_bees_tables_put_both_variants_beside_the_paper_and_the_optimum(quick):
         for cycles in ("0", "1", "2", "5", "8", "10")]
     for r in rows:
         assert (r["map"], (r["w1"], r["w2"], r["w3"])) == ("map1", ("1.0", "0.2", "0.03"))
+        assert r["turn_unit"] == "degrees"
         assert float(r["optimum"]) == pytest.approx(63.3667, abs=1e-4)
         assert float(r["length"]) >= float(r["optimum"])  # inf when not reached
         assert (r["reached"] == "True") == math.isfinite(float(r["length"]))
         assert int(r["evaluations"]) >= 20 * int(r["steps"]) and float(r["seconds"]) > 0
         assert r["clipped"] == "False" or r["variant"] == "cabc"
     table = (folder / "bees_tables" / "table.md").read_text()
-    assert "| 0 | paper | 34 | 137 | 30 |" in table and "| 10 | cabc, forbid_crossing |" in table
+    # Table 6 read as (stdP, avgP, target): the paper's best is 2 cycles, as its text says.
+    assert "| 0 | paper | 30 | 137 | 34 |" in table and "| 10 | cabc, forbid_crossing |" in table
+    assert "the paper's 2 cycles (target 30, avgP 126; tied on target with 0 cycles" in table
     assert (folder / "bees_tables" / "map1.png").is_file()
 
 

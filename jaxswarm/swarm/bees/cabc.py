@@ -13,7 +13,8 @@ appended to its trajectory, so the path length is the length of a trajectory fro
 window of side 2, so that a move shifts each coordinate by at most 1, less than the thinnest wall of
 our maps (2): the vehicle cannot hop over an obstacle, only clip a corner (the paper's vehicle
 checks only where it lands, and its map #2 traps it, which a vehicle that hops over walls would not
-notice); a tolerance of 0.5.
+notice); a tolerance of 0.5. f3 measures the turn in degrees by default (``turn_unit``; why:
+:mod:`.guided`).
 
 The module holds cABC's config, params and state, the vehicle's arrival test, the colony's pick
 in the sensor window, and the swarm's init, step and change rule, which :func:`build_cabc` binds
@@ -30,7 +31,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.swarm.bees.colony import Best, search
-from jaxswarm.swarm.bees.guided import constraint_violations, guided, revisits
+from jaxswarm.swarm.bees.guided import check_turn_unit, constraint_violations, guided, revisits
 from jaxswarm.swarm.core import StepInfo, Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.world.paths import Solution
 from jaxswarm.world.plane import Plane, crossings, trajectory_length
@@ -47,15 +48,19 @@ class CABCConfig(SwarmConfig):
         whose vehicle only checks where it lands: a move may then clip an obstacle's corner).
       remember: the vehicle remembers the windows it has seen and adds ``w4 f4`` to Phi
         (:func:`~jaxswarm.swarm.bees.guided.revisits`; the paper's future work, off).
+      turn_unit: f3's unit, one of :data:`~jaxswarm.swarm.bees.guided.TURN_UNITS` (the text
+        lost it; see :mod:`.guided` for the choice).
     """
 
     num_agents: int = 20
     max_steps: int = 200
     forbid_crossing: bool = False
     remember: bool = False
+    turn_unit: str = "degrees"
 
     def __post_init__(self):
         super().__post_init__()
+        check_turn_unit(self.turn_unit)
         if self.num_agents < 2:
             raise ValueError(f"cabc needs num_agents >= 2 (a bee moves relative to another), "
                              f"got {self.num_agents}")
@@ -185,7 +190,7 @@ def colony_pick(config: CABCConfig, key: jax.Array, state: CABCState, plane: Pla
     def evaluate(candidates):
         """``(phi f32[C], violations i32[C])`` of the candidate points f32[C, 2]."""
         phi = guided(candidates, weights, plane, goal, here, previous,
-                     state.count >= 2, lower, upper, half)
+                     state.count >= 2, lower, upper, half, turn_unit=config.turn_unit)
         if config.remember:
             phi = phi + params.w4 * revisits(candidates, state.waypoints, state.count, half)
         return phi, constraint_violations(candidates, plane, here,

@@ -11,10 +11,22 @@ which stands at ``here`` and came from ``previous``:
   sensor sees). A ray that meets an obstacle at distance ``d`` adds ``reach - d``; one that meets
   nothing adds 0. So ``f2 = 4 reach - (sum of the four minimum distances)``, in ``[0, 4 reach]``:
   the paper's sum with the sign that makes minimising ``Phi`` push the vehicle away.
-* ``f3`` (smoothness): the turn, in degrees, between the last move (``previous`` to ``here``) and
-  the candidate move (``here`` to ``x``); 0 before the first move. Degrees, because the paper's
-  weights (``w3`` = 0.03 to 0.2 beside ``w1`` near 1) would make a turn in radians worth less
-  than a fifth of a unit of distance, and its tables show ``w3`` changing the outcome.
+* ``f3`` (smoothness): the turn between the last move (``previous`` to ``here``) and the candidate
+  move (``here`` to ``x``), 0 to 180 degrees or 0 to pi radians; 0 before the first move. The text
+  lost the formula ("f3 defines the trajectory smoothness by preserving the smooth of the angle
+  between subsequent segments of movement") and with it the unit, which ``turn_unit`` (one of
+  :data:`TURN_UNITS`) declares. Degrees are cABC's default, the unit whose outcomes move as the
+  paper's text says f3 moves them (``results/bees_tables``, Tables 2-5, 20 runs a row, both units).
+  The text needs f3 to matter: on map #2, f1 and f2 alone "did not reach the target during all
+  experimental runs" (ours, Table 1's weights on map #2: 0 of 40 runs each), and with f3 the vehicle
+  leaves the trap "because the other two functions 'balance' the first one" (Tables 3 and 5: 1 to 16
+  of 20). In radians a turn weighs at most ``pi w3`` (0.03 to 0.6 for the paper's ``w3``), less than
+  one step's gain towards the goal (up to ``1.41 w1``), and f3 changes nothing: every row of map #2
+  reaches the goal in 0 of 20 runs, every row of map #1 in 20 of 20 with the path lengths of
+  ``w3 = 0`` (65 to 66). In degrees the vehicle leaves the trap of map #2 in 1 to 8 of 20 runs, the
+  fewest (1) at the paper's fewest (1, ``w3 = 0.01``); on map #1 f3 then costs more than the
+  paper's (1 to 6 of 20 against its 3 to 17) and, as in radians, the targets do not fall as ``w3``
+  grows within a table as the paper's do.
 
 The paper's future work, a vehicle that remembers the regions where it has been, adds
 ``w4 f4`` (:func:`revisits`): ``f4`` counts the sensor windows of the vehicle's earlier positions
@@ -75,18 +87,41 @@ def pushback(points: jax.Array, plane: Plane, lower: jax.Array, upper: jax.Array
     return jnp.sum(reach - ray_distances(points, boxes, seen, reach), axis=-1)
 
 
-def turn_degrees(points: jax.Array, here: jax.Array, previous: jax.Array,
-                 has_turn: jax.Array) -> jax.Array:
-    """f3: f32[N], the angle in degrees (0 to 180) between the move ``previous -> here`` and each
-    move ``here -> point``; 0 where ``has_turn`` is False or a move has no length."""
+TURN_UNITS = ("degrees", "radians")
+"""The units f3 may measure the turn in (the option ``turn_unit``)."""
+
+
+def check_turn_unit(turn_unit: str) -> None:
+    """Host-side check of the option ``turn_unit``.
+
+    Raises:
+      ValueError: naming ``turn_unit`` when it is not one of :data:`TURN_UNITS`.
+    """
+    if turn_unit not in TURN_UNITS:
+        raise ValueError(f"unknown turn_unit {turn_unit!r}; choose one of {', '.join(TURN_UNITS)}")
+
+
+def turn_angle(points: jax.Array, here: jax.Array, previous: jax.Array, has_turn: jax.Array, *,
+               turn_unit: str) -> jax.Array:
+    """f3: f32[N], the angle (0 to 180 degrees or 0 to pi radians, by ``turn_unit``) between the
+    move ``previous -> here`` (f32[2] each) and each move ``here -> point`` (f32[N, 2]); 0 where
+    ``has_turn`` (bool[]) is False or a move has no length.
+
+    Raises:
+      ValueError: ``turn_unit`` is not one of :data:`TURN_UNITS`.
+    """
+    check_turn_unit(turn_unit)
     last = here - previous
     moves = points - here
     # Products written out, not a matmul: the same elementwise code alone and under vmap (a
     # batched dot may be lowered differently).
     cross = last[0] * moves[:, 1] - last[1] * moves[:, 0]
     dot = last[0] * moves[:, 0] + last[1] * moves[:, 1]
+    angle = jnp.arctan2(jnp.abs(cross), dot)
+    if turn_unit == "degrees":
+        angle = jnp.degrees(angle)
     degenerate = jnp.all(last == 0) | jnp.all(moves == 0, axis=-1) | ~has_turn
-    return jnp.where(degenerate, 0.0, jnp.degrees(jnp.arctan2(jnp.abs(cross), dot)))
+    return jnp.where(degenerate, 0.0, angle)
 
 
 def revisits(points: jax.Array, waypoints: jax.Array, count: jax.Array,
@@ -101,7 +136,7 @@ def revisits(points: jax.Array, waypoints: jax.Array, count: jax.Array,
 
 def guided(points: jax.Array, weights: jax.Array, plane: Plane, goal: jax.Array,
            here: jax.Array, previous: jax.Array, has_turn: jax.Array, lower: jax.Array,
-           upper: jax.Array, reach: jax.Array) -> jax.Array:
+           upper: jax.Array, reach: jax.Array, *, turn_unit: str) -> jax.Array:
     """Phi, eq. 4: f32[N] for candidate points f32[N, 2].
 
     Args:
@@ -111,10 +146,15 @@ def guided(points: jax.Array, weights: jax.Array, plane: Plane, goal: jax.Array,
       here, previous: f32[2] the vehicle's position and the one before (``has_turn`` bool[]:
         whether there was one).
       lower, upper: f32[2] the sensor window; reach: f32[] the rays' length.
+      turn_unit: f3's unit, one of :data:`TURN_UNITS`.
+
+    Raises:
+      ValueError: ``turn_unit`` is not one of :data:`TURN_UNITS`.
     """
     return (weights[0] * goal_distance(points, goal)
             + weights[1] * pushback(points, plane, lower, upper, reach)
-            + weights[2] * turn_degrees(points, here, previous, has_turn))
+            + weights[2] * turn_angle(points, here, previous, has_turn,
+                                    turn_unit=turn_unit))
 
 
 def constraint_violations(points: jax.Array, plane: Plane, here: jax.Array, *,
