@@ -23,6 +23,7 @@ from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.swarm import aco, make, make_task
+from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.swarm.aco.bug2 import first_ant_path
 from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDStarParams,
                                 blind_alleys, carve, erode_banks, erode_eq4, graded_transition,
@@ -420,6 +421,34 @@ def test_ant_system_eq9_then_eq8_on_a_forced_corridor(name):
     got = corridor_step(name, params, num_agents=5)
     expected = 0.75 * initial_pheromone().astype(np.float64) + on_edges(CORRIDOR_EDGES, 2.5)
     assert got.ravel().tolist() == approx(expected.ravel().tolist())
+
+
+def test_ant_system_evaporation_stops_at_the_smallest_normal_float():
+    """Eq. 9 in float32, kept at least TAU_FLOOR = 2 ** -126 (about 1.18e-38, the smallest normal
+    float32). On the open 3 x 3, tau = 1e-37 everywhere but on node 4's slots (tau = 1), rho =
+    0.9: 1e-37 evaporates to 1.0e-38, below 2 ** -126, which XLA flushes to 0 (log 0 = -inf: the
+    edge would be impassable); the floor makes it 2 ** -126. Node 4's tau = 1 becomes 1 - 0.9 in
+    float32 (0.100000024) exactly, as without a floor. One arrived ant 0 E 1 E 2 S 5 S 8 (f = 4,
+    Q = 2) adds 0.5 on its edges, both directions: 0.5 + 2 ** -126 rounds to 0.5. Node 0 then
+    weighs E (to 1) 0.5 and S (to 3) and SE (to 4) 2 ** -126 each: log-weights log 0.5 and
+    -126 log 2 = -87.34, finite, so the ant may still take them."""
+    graph = grid()
+    ants = fake_walk([[0, 1, 2, 5, 8]], 9, arrived=[True], stuck=[False])
+    params = aco.DEFAULT_ANT_SYSTEM._replace(**f32(rho=0.9, q=2.0))
+    start = np.full((9, 8), 1e-37, np.float32)
+    start[4] = 1.0
+    got = np.asarray(ant_system_update(graph, jnp.asarray(start), ants, None, None, None,
+                                       params))
+    floor = np.float32(2.0 ** -126)
+    assert aco.TAU_FLOOR == floor == np.finfo(np.float32).tiny
+    assert np.float32(1e-37) * (np.float32(1.0) - np.float32(0.9)) < floor
+    deposited = on_edges(CORRIDOR_EDGES, 0.5) > 0
+    expected = np.where(deposited, np.float32(0.5), floor)
+    expected[4] = np.float32(1.0) - np.float32(0.9)
+    np.testing.assert_array_equal(got, expected)
+    table = aco.transition_rule(graph, make_task(graph, 0, 8), jnp.asarray(got), params)
+    expect_row(table, 0, {E: math.log(0.5), S: -126 * math.log(2.0),
+                          SE: -126 * math.log(2.0)})
 
 
 def test_eq8_deposit_of_two_ants_of_different_lengths():
