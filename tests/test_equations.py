@@ -363,6 +363,27 @@ def test_one_step_where_every_drop_gets_stuck(name, config, expected_gain):
     assert np.asarray(state.altitude).tolist() == approx([1.0, 1.0 + expected_gain, 1.0, 0.0])
 
 
+@pytest.mark.parametrize("erode, expected", [
+    ("arrived", [1.0, 0.5, 1.0, 0.0]),  # no drop arrived: nothing erodes, eq. 5 adds 0
+    # Every drop's trail 0 -> 1 (gradient 0.5) erodes: node 0 loses 3 drops * 0.1 * 0.5 = 0.15,
+    # every node gains 0.15 / 3 = 0.05 (the blocked node too: eq. 5's "all nodes").
+    ("travelled", [1.0 - 0.15 + 0.05, 0.5 + 0.05, 1.0 + 0.05, 0.0]),
+])
+def test_rfd_star_erodes_the_trails_of_stuck_drops_only_when_told(erode, expected):
+    """1 x 4 map [start, ., #, goal] at altitudes 1, 0.5, 1, 0: every drop walks 0 -> 1 and is
+    stuck, no sediment. N = 4, D = 3, E = 0.9: E / ((N-1) D) = 0.1."""
+    graph = grid(4, 1, blocked=[2])
+    task = make_task(graph, 0, 3)
+    swarm = make("rfd_star", num_agents=3, erode=erode)
+    params = swarm.default_params._replace(**f32(sediment=0.0, initial_height=1.0,
+                                                 erosion=0.9))
+    state = swarm.init(jax.random.key(1), graph, task, params)
+    state = dataclasses.replace(state, altitude=jnp.array([1.0, 0.5, 1.0, 0.0], jnp.float32))
+    state, info = step(swarm, state, graph, task, params)
+    assert float(info.arrived) == 0.0
+    assert np.asarray(state.altitude).tolist() == approx(expected)
+
+
 # ------------------------------------------------------------------------------------------------
 # Ant System (eq. 7), ACO*, Improved Max-Min transitions
 
