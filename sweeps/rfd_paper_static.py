@@ -1,21 +1,24 @@
 """The RFD paper's Table 1 (static environment), reproduced on our nine paper maps.
 
-The paper's six algorithms, with two of them in two variants, beside the paper's values (the
-rows of :mod:`jaxswarm.studies.rfd_table1`):
+The paper's six algorithms, ACO in two variants and RFD* in three, beside the paper's values
+(the rows of :mod:`jaxswarm.studies.rfd_table1`):
 
 * Dijkstra and A* (exact);
 * "ACO (paper, eq. 7)": Ant System as the paper's eq. 7 writes it (``ant_system``, pheromone
   only: beta = 0), and "ACO with eta (beta=1)": the same with the edge-length heuristic eta
   weighted by beta = 1; both beside the paper's ACO row;
 * ACO* (``aco_star``, eq. 7 over the goal distance) and RFD (``rfd``, eqs. 1-5);
-* "RFD* (paper)": the paper's RFD*, eq. 6 with the paper's erosion eqs. 4-5 (``rfd_star``), and
-  "RFD graded (ours)": this project's law, RFD*'s transitions over a graded river bed
-  (``rfd_graded``); both beside the paper's RFD*.
+* "RFD* (paper)": the paper's RFD*, eq. 6 with the paper's erosion eqs. 4-5 on the paths of the
+  drops that reached the goal (``rfd_star``, Algorithm 1's "complete paths"); "RFD* (paper, all
+  travelled paths)": the same with every drop's path eroded (``rfd_star erode=travelled``, the
+  text's "an erosion process is executed on all travelled paths"); and "RFD graded (ours)":
+  this project's law, RFD*'s transitions over a graded river bed (``rfd_graded``); all three
+  beside the paper's RFD*.
 
 Each swarm runs once per seed (``--seeds``, default 20) for up to ``--iterations`` iterations
 (default 100; a run stops earlier only when every agent of an iteration follows the same path)
 with ``--agents`` drops or ants (default 256) and the swarm's default parameters (beta replaced
-by 1 in the eta row). Runs are jitted once per map and row (a warm-up run, compile excluded) and
+by 1 in the eta row) and options (``erode`` replaced in the travelled row). Runs are jitted once per map and row (a warm-up run, compile excluded) and
 then timed one by one. The exact planners are deterministic: they run once per seed too, as
 repeats, and their time is the search time they report themselves (``SearchStats.wall_time``).
 

@@ -6,7 +6,7 @@ import pytest
 import sizes
 
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import aco, make, make_task, run
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import is_valid_path, path_length, step_slots
 
@@ -31,7 +31,8 @@ def test_ant_system_deposits_q_over_length_on_both_directions():
     for x in range(4):  # every edge of the corridor: 8 ants x Q / 4
         assert tau[5 + x, east] == pytest.approx(8 * 2.0 / 4)
         assert tau[6 + x, west] == pytest.approx(8 * 2.0 / 4)
-    assert tau.sum() == pytest.approx(2 * 4 * 8 * 2.0 / 4)  # nothing anywhere else
+    # Nothing anywhere else: every other slot holds the floor (rho = 1), about 1.2e-38.
+    assert tau.sum() == pytest.approx(2 * 4 * 8 * 2.0 / 4)
 
 
 def test_pheromone_is_symmetric_and_max_min_stays_in_its_bounds():
@@ -52,6 +53,30 @@ def test_pheromone_is_symmetric_and_max_min_stays_in_its_bounds():
         if name == "max_min_aco":
             assert tau.min() >= float(params.tau_min)
             assert (tau.max() <= 0.1) == options.get("upper_bound", False)
+
+
+@pytest.mark.parametrize("name", ["ant_system", "aco_star"])
+def test_pheromone_at_rho_09_never_becomes_impassable(name):
+    """alley20, rho = 0.9, 48 iterations: 0.1 ** 48 = 1e-48 is far below the smallest
+    normal float32 (1.18e-38), where float32 arithmetic would make tau 0 and its log -inf. Every
+    valid edge keeps a finite log-weight: the edges left unwalked lie at the floor."""
+    chosen = paper_map("alley20")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    swarm = make(name, **sizes.CONFIG)
+    params = swarm.default_params._replace(rho=np.float32(0.9))
+    state, ran = None, 0
+    for seed in range(6):
+        state, trace = run(swarm, jax.random.key(seed), graph, task, params,
+                           iterations=sizes.ITERATIONS, state=state)
+        ran += int(trace.iterations)
+    assert ran == 6 * sizes.ITERATIONS
+    valid = np.asarray(graph.valid_edges())
+    tau = np.asarray(state.pheromone)[valid]
+    table = np.asarray(aco.transition_rule(graph, task, state.pheromone, params,
+                                           goal_distance=name == "aco_star"))[valid]
+    assert tau.min() == aco.TAU_FLOOR and (tau == aco.TAU_FLOOR).sum() > valid.sum() // 2
+    assert np.isfinite(table).all()
 
 
 def test_bad_params_are_named():

@@ -46,10 +46,15 @@ def test_paper_rule_old_goal_mean_new_goal_zero_opened_node_at_plateau():
     params = swarm.default_params
     state = swarm.init(jax.random.key(0), graph, task, params)
     altitude = jnp.arange(9, dtype=jnp.float32) * 10.0
-    state = dataclasses.replace(state, altitude=altitude.at[8].set(0.0))
+    state = dataclasses.replace(state, altitude=altitude.at[8].set(0.0),
+                                residual=jnp.full((9,), 1e-7, jnp.float32))
     event = make_event(graph, goal=(0, 0), unblock=[(0, 1)])
     new_state, after, new_task = change(swarm, state, event, graph, task, params)
     got = np.asarray(new_state.altitude)
+    # A set altitude has no residual (old goal 8, new goal 0, opened 3); the others keep theirs.
+    kept = np.float32(1e-7)
+    np.testing.assert_array_equal(np.asarray(new_state.residual),
+                                  [0.0, kept, kept, 0.0, kept, kept, kept, kept, 0.0])
     # Node 8's neighbours on the new map: 5, 7 and 4 (no corner rule blocks them): mean 53.33.
     assert got[8] == pytest.approx((50 + 70 + 40) / 3)
     assert got[0] == 0.0  # the new goal

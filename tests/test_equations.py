@@ -23,11 +23,13 @@ from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.swarm import aco, make, make_task
+from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.swarm.aco.bug2 import first_ant_path
 from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDStarParams,
-                                blind_alleys, carve, erode_banks, erode_eq4, graded_transition,
-                                rfd_star_transition, rfd_transition, settle)
-from jaxswarm.swarm.rfd.river import deposit_where_stuck
+                                add_compensated, blind_alleys, carve, erode_banks,
+                                erosion_change, graded_transition, rfd_star_transition,
+                                rfd_transition, settle)
+from jaxswarm.swarm.rfd.river import sediment_where_stuck
 from jaxswarm.swarm.walking import FORCED
 from jaxswarm.world.edits import close_edges
 from jaxswarm.world.graph import grid_graph, path_map_graph
@@ -179,32 +181,69 @@ ALT4 = [3.0, 2.0, 2.5,
         3.0, 2.0, 0.0]
 
 
-@pytest.mark.parametrize("law", ["linear", "exponential"])
-def test_erode_eq4_eq5_by_hand_with_three_drops(law):
-    """Eq. 4: each move i->j of an arrived drop lowers i by E / ((N-1) D) * gradient (linear,
-    negative gradients erode nothing) or * p_base ** gradient (exponential); eq. 5: every node
-    gains the eroded total / (N - 1). N = 9, D = 3 (the drop that did not arrive counts in D but
-    erodes nothing), E = 2.4: E / ((N-1) D) = 0.1.
+# The three drops of the hand tests on ALT4: A 0->4->8 and B 0->1->2->5->8 arrived, C 0->3->6
+# got stuck. Each move is (node, gradient, altitude of the node it goes to).
+THREE_DROPS = [[0, 4, 8], [0, 1, 2, 5, 8], [0, 3, 6]]
+MOVES_A_B = [(0, 1.5 / R2, 1.5), (4, 1.5 / R2, 0.0),
+             (0, 1.0, 2.0), (1, -0.5, 2.5), (2, 1.5, 1.0), (5, 1.0, 0.0)]
+MOVES_C = [(0, 0.2, 2.8), (3, -0.2, 3.0)]
 
-    A: 0->4->8, gradients 1.5/sqrt2 twice. B: 0->1->2->5->8, gradients 1, -0.5 (node 1: uphill),
-    1.5, 1. C: 0->3->6, did not arrive.
-    """
+
+def three_drops():
+    return fake_walk(THREE_DROPS, 9, arrived=[True, True, False], stuck=[False, False, True],
+                     budget=8)
+
+
+@pytest.mark.parametrize("law", ["linear", "exponential"])
+@pytest.mark.parametrize("travelled", [False, True])
+def test_erosion_eq4_eq5_by_hand_with_three_drops(law, travelled):
+    """Eq. 4: each move i->j of an eroding drop lowers i by E / ((N-1) D) * gradient (linear,
+    negative gradients erode nothing) or * p_base ** gradient (exponential, then at most down to
+    the lowest node i's eroding moves go to); eq. 5: every node gains the eroded total / (N - 1).
+    N = 9, D = 3 (every drop counts in D), E = 2.4: E / ((N-1) D) = 0.1, p_base = 2.
+
+    Arrived only, C erodes nothing; all travelled paths, C's moves 0->3 (gradient 0.2) and 3->6
+    (-0.2) erode too. Exponential: node 1 (only an uphill move, to 2.5) and node 3 (only an
+    uphill move, to 3.0) are below every node they go to: they erode nothing; every other node
+    asks for less than its drop to its lowest head (node 0: 0.1 (2 ** 1.06 + 2 + 2 ** 0.2) =
+    0.52 < 3 - 1.5)."""
     graph = grid()
-    drops = fake_walk([[0, 4, 8], [0, 1, 2, 5, 8], [0, 3, 6]], 9,
-                      arrived=[True, True, False], stuck=[False, False, True], budget=8)
     c, p_base = 2.4 / (8 * 3), 2.0
     shape = (lambda g: max(g, 0.0)) if law == "linear" else (lambda g: p_base ** g)
-    moves_made = [(0, 1.5 / R2), (4, 1.5 / R2), (0, 1.0), (1, -0.5), (2, 1.5), (5, 1.0)]
-    eroded = [0.0] * 9
-    for i, g in moves_made:
-        eroded[i] += c * shape(g)
+    moves_made = MOVES_A_B + (MOVES_C if travelled else [])
+    asked, outlet = [0.0] * 9, [math.inf] * 9
+    for i, g, head in moves_made:
+        asked[i] += c * shape(g)
+        outlet[i] = min(outlet[i], head)
+    eroded = asked if law == "linear" else [min(asked[i], max(ALT4[i] - outlet[i], 0.0))
+                                            for i in range(9)]
     total = sum(eroded)
     expected = [ALT4[i] - eroded[i] + total / 8 for i in range(9)]
-    got = erode_eq4(graph, jnp.array(ALT4, jnp.float32), drops, np.float32(2.4),
-                    None if law == "linear" else np.float32(p_base))
-    assert np.asarray(got).tolist() == approx(expected)
-    if law == "linear":
-        assert eroded[1] == 0.0 and expected[1] == approx(2.0 + total / 8)
+    drops = three_drops()
+    eroding = jnp.asarray([True, True, travelled])
+    change = erosion_change(graph, jnp.array(ALT4, jnp.float32), drops, eroding,
+                            np.float32(2.4), None if law == "linear" else np.float32(p_base))
+    assert (np.asarray(ALT4) + np.asarray(change)).tolist() == approx(expected)
+    assert eroded[1] == 0.0 and expected[1] == approx(2.0 + total / 8)
+
+
+def test_exponential_erosion_stops_at_the_lowest_node_a_node_drains_to():
+    """Exponential law, E = 24 (E / ((N-1) D) = 1), p_base = 2, drops A and B of ALT4 arrived:
+    every node asks for more than its drop to its lowest head, and gives exactly that drop.
+    Node 0 asks 2 ** (1.5 / sqrt2) + 2 ** 1 = 4.09 and goes to 4 (1.5) and 1 (2.0): gives 1.5.
+    Node 4 asks 2.09, drains to the goal (0): gives 1.5. Node 1 asks 2 ** -0.5 = 0.71 but its
+    only move climbs to 2.5: gives 0. Node 2 asks 2 ** 1.5 = 2.83, drains to 5 (1.0): gives 1.5.
+    Node 5 asks 2, drains to the goal: gives 1.0. Total 5.5: every node gains 5.5 / 8 = 0.6875.
+    After the erosion (before eq. 5) node 0 is at 1.5, the altitude of node 4: not below it."""
+    graph = grid()
+    drops = three_drops()
+    change = erosion_change(graph, jnp.array(ALT4, jnp.float32), drops, drops.arrived,
+                            np.float32(24.0), np.float32(2.0))
+    eroded = {0: 1.5, 4: 1.5, 1: 0.0, 2: 1.5, 5: 1.0}
+    expected = [ALT4[i] - eroded.get(i, 0.0) + 5.5 / 8 for i in range(9)]
+    assert (np.asarray(ALT4) + np.asarray(change)).tolist() == approx(expected)
+    # Unbounded, node 0 would give 4.09 and end 2.6 below node 4.
+    assert 2.0 ** (1.5 / R2) + 2.0 > ALT4[0] - ALT4[4] + 2.5
 
 
 CORRIDOR = [1.0, 1.5, 0.0]  # a 1 x 3 corridor, start 0, goal 2: every drop walks 0 -> 1 -> 2
@@ -215,10 +254,10 @@ CORRIDOR = [1.0, 1.5, 0.0]  # a 1 x 3 corridor, start 0, goal 2: every drop walk
     # 2 drops * c * 1.5; every node gains the total / 2; the goal is reset to 0.
     ("rfd", {}, 0.4, None, [1.0 + 0.15, 1.5 - 0.3 + 0.15, 0.0]),
     ("rfd_star", {}, 0.4, 2.0, [1.0 + 0.15, 1.5 - 0.3 + 0.15, 0.0]),
-    # Exponential, p_base 4: node 0 loses 2 * 0.1 * 4 ** -0.5 = 0.1, node 1 2 * 0.1 * 4 ** 1.5
-    # = 1.6, every node gains 1.7 / 2.
-    ("rfd_star", {"erosion_law": "exponential"}, 0.4, 4.0, [1.0 - 0.1 + 0.85, 1.5 - 1.6 + 0.85,
-                                                           0.0]),
+    # Exponential, p_base 9: node 0 asks 2 * 0.1 * 9 ** -0.5 = 0.067 but its move climbs (to
+    # 1.5): it gives 0; node 1 asks 2 * 0.1 * 9 ** 1.5 = 5.4 and drains to the goal (0): it gives
+    # 1.5. Every node gains 1.5 / 2. (Unbounded: [3.67, -1.17 clamped to 0, 0].)
+    ("rfd_star", {"erosion_law": "exponential"}, 0.4, 9.0, [1.0 + 0.75, 1.5 - 1.5 + 0.75, 0.0]),
     # E = 8 (c = 2): node 1 loses 6 and gains 3: -1.5, clamped at 0; node 0 gains 3.
     ("rfd", {}, 8.0, None, [4.0, 0.0, 0.0]),
 ])
@@ -237,16 +276,68 @@ def test_one_step_on_a_forced_corridor_erodes_by_eq4_eq5_then_clamps(name, confi
     assert float(info.arrived) == 1.0
     assert np.asarray(state.altitude).tolist() == approx(expected)
     assert float(state.best_cost) == approx(2.0)
+    residual = np.asarray(state.residual)
+    assert residual[2] == 0.0 and (expected[1] > 0.0 or residual[1] == 0.0)  # goal, clamped
+
+
+@pytest.mark.parametrize("name", ["rfd", "rfd_star"])
+def test_erosion_steps_of_1e9_add_up_over_1000_iterations(name):
+    """The corridor 0 -> 1 -> goal 2 at altitudes 1, 1, 0, two drops, E = 4e-9, no sediment:
+    c = E / ((N-1) D) = 1e-9. Each iteration node 1 (gradient 1 to the goal) loses 2 c = 2e-9,
+    node 0 (gradient about 0 to node 1) about nothing, and eq. 5 gives every node 2e-9 / 2 =
+    1e-9: node 0 rises by 1e-9 and node 1 sinks by 1e-9 an iteration. Both steps are far below
+    half the float32 spacing at 1 (3e-8 below it, 6e-8 above), so without the residual neither
+    altitude would ever move; with it, after 1000 iterations node 0 is 1 + 1e-6 and node 1 is
+    1 - 1e-6, to within a float32 spacing (1.2e-7 above 1, 6e-8 below)."""
+    graph = grid(3, 1)
+    task = make_task(graph, 0, 2)
+    swarm = make(name, num_agents=2)
+    params = swarm.default_params._replace(**f32(erosion=4e-9, initial_height=1.0,
+                                                 sediment=0.0))
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    for _ in range(1000):
+        state, _ = step(swarm, state, graph, task, params)
+    altitude, residual = np.asarray(state.altitude), np.asarray(state.residual)
+    assert altitude[0] - 1.0 == pytest.approx(1e-6, abs=1.2e-7)
+    assert 1.0 - altitude[1] == pytest.approx(1e-6, abs=6e-8)
+    # What the altitudes do not show yet is in the residual.
+    assert (altitude[:2].astype(np.float64) + residual[:2]).tolist() == pytest.approx(
+        [1 + 1e-6, 1 - 1e-6], abs=1e-9)
+    assert altitude[2] == 0.0 and residual[2] == 0.0
+
+
+def test_add_compensated_keeps_steps_below_the_float32_spacing():
+    """1e-9 added 1000 times to altitude 1.0: a plain float32 sum stays at 1.0 (1 + 1e-9 rounds
+    back to 1); the compensated sum reaches 1 + 1e-6 to within one spacing (1.2e-7), and the
+    altitude plus its residual is 1 + 1000 * f32(1e-9) = 1 + 9.9999997e-7 almost exactly."""
+    tiny = jnp.full((1,), 1e-9, jnp.float32)
+
+    def add(_, carry):
+        plain, altitude, residual = carry
+        return (plain + tiny, *add_compensated(altitude, residual, tiny))
+
+    one = jnp.ones((1,), jnp.float32)
+    plain, altitude, residual = jax.jit(lambda: jax.lax.fori_loop(
+        0, 1000, add, (one, one, jnp.zeros((1,), jnp.float32))))()
+    assert float(plain[0]) == 1.0
+    assert float(altitude[0]) - 1.0 == pytest.approx(1e-6, abs=1.2e-7)
+    assert float(altitude[0]) + float(residual[0]) == pytest.approx(
+        1.0 + 1000 * float(np.float32(1e-9)), abs=1e-12)
+    # Eager, without XLA's fusion, the same bits.
+    eager = (one, one, jnp.zeros((1,), jnp.float32))
+    for i in range(1000):
+        eager = add(i, eager)
+    assert float(eager[1][0]) == float(altitude[0]) and float(eager[2][0]) == float(residual[0])
 
 
 def test_a_stuck_drop_deposits_sediment_where_it_stands():
-    """deposit_where_stuck: each stuck drop adds ``sediment`` on its node. Stuck at 3, 3 and 5:
+    """sediment_where_stuck: each stuck drop adds ``sediment`` on its node. Stuck at 3, 3 and 5:
     node 3 gains 2 * 0.25, node 5 gains 0.25; the drop that ran out of steps at 7 deposits
     nothing."""
     drops = fake_walk([[0, 3], [0, 3], [0, 1, 2, 5], [0, 4, 7]], 9,
                       arrived=[False] * 4, stuck=[True, True, True, False])
-    got = deposit_where_stuck(jnp.array(ALT4, jnp.float32), drops, np.float32(0.25))
-    expected = list(ALT4)
+    got = sediment_where_stuck(9, drops, np.float32(0.25))
+    expected = [0.0] * 9
     expected[3] += 0.5
     expected[5] += 0.25
     assert np.asarray(got).tolist() == approx(expected)
@@ -270,6 +361,27 @@ def test_one_step_where_every_drop_gets_stuck(name, config, expected_gain):
     state, info = step(swarm, state, graph, task, params)
     assert float(info.arrived) == 0.0
     assert np.asarray(state.altitude).tolist() == approx([1.0, 1.0 + expected_gain, 1.0, 0.0])
+
+
+@pytest.mark.parametrize("erode, expected", [
+    ("arrived", [1.0, 0.5, 1.0, 0.0]),  # no drop arrived: nothing erodes, eq. 5 adds 0
+    # Every drop's trail 0 -> 1 (gradient 0.5) erodes: node 0 loses 3 drops * 0.1 * 0.5 = 0.15,
+    # every node gains 0.15 / 3 = 0.05 (the blocked node too: eq. 5's "all nodes").
+    ("travelled", [1.0 - 0.15 + 0.05, 0.5 + 0.05, 1.0 + 0.05, 0.0]),
+])
+def test_rfd_star_erodes_the_trails_of_stuck_drops_only_when_told(erode, expected):
+    """1 x 4 map [start, ., #, goal] at altitudes 1, 0.5, 1, 0: every drop walks 0 -> 1 and is
+    stuck, no sediment. N = 4, D = 3, E = 0.9: E / ((N-1) D) = 0.1."""
+    graph = grid(4, 1, blocked=[2])
+    task = make_task(graph, 0, 3)
+    swarm = make("rfd_star", num_agents=3, erode=erode)
+    params = swarm.default_params._replace(**f32(sediment=0.0, initial_height=1.0,
+                                                 erosion=0.9))
+    state = swarm.init(jax.random.key(1), graph, task, params)
+    state = dataclasses.replace(state, altitude=jnp.array([1.0, 0.5, 1.0, 0.0], jnp.float32))
+    state, info = step(swarm, state, graph, task, params)
+    assert float(info.arrived) == 0.0
+    assert np.asarray(state.altitude).tolist() == approx(expected)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -420,6 +532,34 @@ def test_ant_system_eq9_then_eq8_on_a_forced_corridor(name):
     got = corridor_step(name, params, num_agents=5)
     expected = 0.75 * initial_pheromone().astype(np.float64) + on_edges(CORRIDOR_EDGES, 2.5)
     assert got.ravel().tolist() == approx(expected.ravel().tolist())
+
+
+def test_ant_system_evaporation_stops_at_the_smallest_normal_float():
+    """Eq. 9 in float32, kept at least TAU_FLOOR = 2 ** -126 (about 1.18e-38, the smallest normal
+    float32). On the open 3 x 3, tau = 1e-37 everywhere but on node 4's slots (tau = 1), rho =
+    0.9: 1e-37 evaporates to 1.0e-38, below 2 ** -126, which XLA flushes to 0 (log 0 = -inf: the
+    edge would be impassable); the floor makes it 2 ** -126. Node 4's tau = 1 becomes 1 - 0.9 in
+    float32 (0.100000024) exactly, as without a floor. One arrived ant 0 E 1 E 2 S 5 S 8 (f = 4,
+    Q = 2) adds 0.5 on its edges, both directions: 0.5 + 2 ** -126 rounds to 0.5. Node 0 then
+    weighs E (to 1) 0.5 and S (to 3) and SE (to 4) 2 ** -126 each: log-weights log 0.5 and
+    -126 log 2 = -87.34, finite, so the ant may still take them."""
+    graph = grid()
+    ants = fake_walk([[0, 1, 2, 5, 8]], 9, arrived=[True], stuck=[False])
+    params = aco.DEFAULT_ANT_SYSTEM._replace(**f32(rho=0.9, q=2.0))
+    start = np.full((9, 8), 1e-37, np.float32)
+    start[4] = 1.0
+    got = np.asarray(ant_system_update(graph, jnp.asarray(start), ants, None, None, None,
+                                       params))
+    floor = np.float32(2.0 ** -126)
+    assert aco.TAU_FLOOR == floor == np.finfo(np.float32).tiny
+    assert np.float32(1e-37) * (np.float32(1.0) - np.float32(0.9)) < floor
+    deposited = on_edges(CORRIDOR_EDGES, 0.5) > 0
+    expected = np.where(deposited, np.float32(0.5), floor)
+    expected[4] = np.float32(1.0) - np.float32(0.9)
+    np.testing.assert_array_equal(got, expected)
+    table = aco.transition_rule(graph, make_task(graph, 0, 8), jnp.asarray(got), params)
+    expect_row(table, 0, {E: math.log(0.5), S: -126 * math.log(2.0),
+                          SE: -126 * math.log(2.0)})
 
 
 def test_eq8_deposit_of_two_ants_of_different_lengths():

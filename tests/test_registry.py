@@ -45,8 +45,8 @@ def test_equal_configs_give_one_swarm(name):
 
 def test_the_papers_variants_are_the_defaults():
     star = make("rfd_star").config
-    assert (star.erosion_law, star.greedy_drops, star.fill_blind_alleys, star.max_climb) == (
-        "linear", 0, False, None)
+    assert (star.erosion_law, star.erode, star.greedy_drops, star.fill_blind_alleys,
+            star.max_climb) == ("linear", "arrived", 0, False, None)
     assert set(make("rfd_star").default_params._fields) == {
         "p_base", "alpha", "initial_height", "erosion", "sediment"}
     assert float(make("ant_system").default_params.beta) == 0.0  # eq. 7: pheromone only

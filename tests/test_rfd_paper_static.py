@@ -1,9 +1,10 @@
 """The RFD paper's Table 1 script (sweeps/rfd_paper_static.py) at a tiny size, with the rows it
-runs (jaxswarm.studies.rfd_table1): its files, its rows (both variants of ACO and of RFD*), the
+runs (jaxswarm.studies.rfd_table1): its files, its rows (the variants of ACO and of RFD*), the
 costs it reports, the best paths it draws, its provenance and its transcription of the paper."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 
@@ -26,6 +27,7 @@ SWARMS = {
     "ACO*": ("aco_star", "ACO*"),
     "RFD": ("rfd", "RFD"),
     "RFD* (paper)": ("rfd_star", "RFD*"),
+    "RFD* (paper, all travelled paths)": ("rfd_star erode=travelled", "RFD*"),
     "RFD graded (ours)": ("rfd_graded", "RFD*"),
 }
 
@@ -123,6 +125,9 @@ def test_markdown_and_json_carry_the_provenance(out):
     assert params["ACO with eta (beta=1)"] == {**params["ACO (paper, eq. 7)"], "beta": 1.0}
     assert params["ACO (paper, eq. 7)"]["beta"] == 0.0
     assert params["Dijkstra"] is None
+    configs = {label: entry.get("config") for label, entry in record["details"]["rows"].items()}
+    assert configs["RFD* (paper, all travelled paths)"] == {
+        **configs["RFD* (paper)"], "erode": "travelled"}
 
 
 def test_a_row_without_a_paper_counterpart_shows_a_dash():
@@ -142,6 +147,16 @@ def test_the_eta_row_runs_ant_system_with_beta_one():
     assert float(plain.beta) == 0.0 and float(eta.beta) == 1.0
     assert eta._replace(beta=plain.beta) == plain
     assert eta.beta.dtype == np.float32
+
+
+def test_the_travelled_row_runs_rfd_star_eroding_every_path():
+    paper_swarm, paper = rfd_table1.row_swarm(rfd_table1.BY_LABEL["RFD* (paper)"], 8)
+    travelled_swarm, travelled = rfd_table1.row_swarm(
+        rfd_table1.BY_LABEL["RFD* (paper, all travelled paths)"], 8)
+    assert paper_swarm.config.erode == "arrived" and travelled_swarm.config.erode == "travelled"
+    assert travelled_swarm.config == dataclasses.replace(paper_swarm.config, erode="travelled")
+    assert travelled == paper == paper_swarm.default_params
+    assert rfd_table1.BY_SWARM["rfd_star"].label == "RFD* (paper)"
 
 
 def test_figure_and_no_temporary_files(out):

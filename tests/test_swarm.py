@@ -130,15 +130,16 @@ def test_linear_erosion_is_eqs_4_and_5(corridor):
                                           1 - 1 / 4 + 1 / 16, 0.0], rtol=1e-6)
 
 
-def test_exponential_erosion_also_erodes_flat_ground(corridor):
-    # p_base ** gradient: 1 on the three flat edges, p_base = 2 on the last one.
+def test_exponential_erosion_erodes_no_node_below_the_node_it_drains_to(corridor):
+    # p_base ** gradient asks 1 on the three flat edges and p_base = 2 on the last one, each
+    # times E / ((N - 1) D) = 1 / 32 per drop. A flat move's node would sink below the node it
+    # goes to: it gives nothing. Node 3 asks 8 / 32 * 2 = 1 / 2 and drains to the goal (0): it
+    # gives it. Eq. 5: every node gains (1 / 2) / 4.
     graph, task = corridor
     swarm = make("rfd_star", num_agents=8, erosion_law="exponential")
     altitude = one_iteration(swarm, graph, task, p_base=2.0, initial_height=1.0, erosion=1.0,
                              sediment=0.0)
-    produced = (3 + 2) / 4
-    np.testing.assert_allclose(altitude, [1 - 1 / 4 + produced / 4] * 3
-                               + [1 - 2 / 4 + produced / 4, 0.0], rtol=1e-6)
+    np.testing.assert_allclose(altitude, [1 + 1 / 8] * 3 + [1 - 1 / 2 + 1 / 8, 0.0], rtol=1e-6)
 
 
 def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corridor):
@@ -333,6 +334,9 @@ def test_rfd_star_options_are_checked():
         make("rfd_star", erosion_law="sideways")
     with pytest.raises(ValueError, match="unknown erosion_law 'graded'"):  # that is rfd_graded
         make("rfd_star", erosion_law="graded")
+    with pytest.raises(ValueError, match="unknown erode 'complete'; choose one of arrived, "
+                                         "travelled"):
+        make("rfd_star", erode="complete")
     with pytest.raises(ValueError, match="max_climb must be non-negative"):
         make("rfd_star", max_climb=-1.0)
     with pytest.raises(ValueError, match="unknown option 'climb' of rfd_star; known: num_agents"):

@@ -35,12 +35,16 @@ class Row(NamedTuple):
     """The registered swarm; None for an exact planner (``PLANNERS[label]``)."""
     params: tuple[tuple[str, float], ...] = ()
     """(name, value) of the swarm params that replace its defaults."""
+    config: tuple[tuple[str, object], ...] = ()
+    """(name, value) of the swarm's static options that replace its defaults."""
 
     def planner(self) -> str:
-        """What runs: the planner, or the registered swarm with the params it replaces."""
+        """What runs: the planner, or the registered swarm with the options and params it
+        replaces."""
         if self.swarm is None:
             return PLANNERS[self.label].__name__
-        return " ".join([self.swarm, *(f"{name}={value:g}" for name, value in self.params)])
+        return " ".join([self.swarm, *(f"{name}={value}" for name, value in self.config),
+                         *(f"{name}={value:g}" for name, value in self.params)])
 
 
 PLANNERS = {"Dijkstra": dijkstra, "A*": astar}
@@ -53,34 +57,41 @@ ROWS = (
     Row("ACO*", "ACO*", "aco_star"),
     Row("RFD", "RFD", "rfd"),
     Row("RFD* (paper)", "RFD*", "rfd_star"),
+    Row("RFD* (paper, all travelled paths)", "RFD*", "rfd_star", config=(("erode", "travelled"),)),
     Row("RFD graded (ours)", "RFD*", "rfd_graded"),
 )
 """The rows, in the paper's order, each variant after the one the paper writes."""
 BY_LABEL = {row.label: row for row in ROWS}
 """Row label -> Row."""
-BY_SWARM = {row.swarm: row for row in ROWS if row.swarm is not None and not row.params}
-"""Registered swarm -> the row that runs it with its default params."""
+BY_SWARM = {row.swarm: row for row in ROWS
+            if row.swarm is not None and not row.params and not row.config}
+"""Registered swarm -> the row that runs it with its default options and params."""
 ALGORITHMS = tuple(BY_LABEL)
 """Row labels, in table order."""
 COLORS = dict(zip(ALGORITHMS, ("tab:blue", "tab:cyan", "tab:orange", "tab:brown", "tab:red",
-                               "tab:purple", "tab:olive", "tab:green")))
+                               "tab:purple", "tab:olive", "tab:pink", "tab:green")))
 """Path colour of each row in the figures."""
 ABOUT = (
     "Rows: Dijkstra and A* (exact); \"ACO (paper, eq. 7)\" is the RFD paper's Ant System "
     "(`ant_system`, pheromone only, beta = 0) and \"ACO with eta (beta=1)\" the same with the "
     "edge-length heuristic weighted by beta = 1; ACO* (`aco_star`) and RFD (`rfd`) are the "
     "paper's; \"RFD* (paper)\" is the paper's RFD* as written (`rfd_star`: eq. 6 with the "
-    "erosion of eqs. 4-5). \"RFD graded (ours)\" (`rfd_graded`) is not the paper's algorithm but "
-    "this project's law (RFD*'s transitions over a graded river bed). Under each row, the "
-    "paper's values of the row it reproduces: both ACO rows the paper's ACO, both RFD* rows the "
-    "paper's RFD*.")
+    "erosion of eqs. 4-5) on the paths of the drops that reached the goal, Algorithm 1's "
+    "\"complete paths\", and \"RFD* (paper, all travelled paths)\" the same with every drop's "
+    "path eroded, the text's \"an erosion process is executed on all travelled paths\" "
+    "(`rfd_star erode=travelled`). \"RFD graded (ours)\" (`rfd_graded`) is not the paper's "
+    "algorithm but this project's law (RFD*'s transitions over a graded river bed). Arithmetic: "
+    "the ant colonies keep pheromone at least the smallest normal float32, and RFD and RFD* add "
+    "their erosion and sediment by compensated summation. Under each row, the paper's values of "
+    "the row it reproduces: both ACO rows the paper's ACO, both RFD* rows and the graded one "
+    "the paper's RFD*.")
 """What the rows are (the paragraph under the provenance of a table of all rows)."""
 
 
 def row_swarm(row: Row, agents: int) -> tuple[Swarm, tuple]:
-    """The swarm of ``row`` with ``agents`` drops or ants, and its params: the defaults with the
-    row's replacements (float32 scalars)."""
-    swarm = make(row.swarm, num_agents=agents)
+    """The swarm of ``row`` with ``agents`` drops or ants and the row's options, and its params:
+    the defaults with the row's replacements (float32 scalars)."""
+    swarm = make(row.swarm, num_agents=agents, **dict(row.config))
     params = swarm.default_params._replace(
         **{name: np.float32(value) for name, value in row.params})
     return swarm, params

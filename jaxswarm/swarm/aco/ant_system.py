@@ -7,6 +7,19 @@
 * ``aco_star``: Ant System divided by ``d_j ** alpha_goal``, the straight-line distance from
   ``j`` to the goal, "as in the denominator of eq. 6". It divides by ``d_goal = 0``, so the goal
   is taken whenever adjacent.
+
+Arithmetic, not algorithm: after evaporation ``tau`` is kept at least ``TAU_FLOOR``, the
+smallest normal float32 (``jnp.finfo(jnp.float32).tiny``, about 1.18e-38). In the paper's
+arithmetic eq. 9 never makes ``tau`` zero; in float32 ``(1 - rho) ** t`` leaves the normal range
+after about 38 evaporations at ``rho = 0.9`` and becomes 0 (XLA on CPU flushes subnormals to
+zero), its log is ``-inf`` and the edge is impassable. With ``rho = 0.9`` on alley20, after 60
+iterations of 32 ants (seed 0), all 1,560 edges of ``ant_system`` and 1,480 of ``aco_star``'s
+were at 0 without the floor. At the floor an edge keeps a log-weight of about ``-87.3 alpha``:
+it is drawn with odds of about 1e-38 against an edge at ``tau = 1``, and where every edge of a
+node lies at the floor the ant draws among them evenly instead of being stuck. Every ``tau``
+that stays in the normal range is computed bit for bit as without the floor (pheromone kept in
+log space would round every update differently); the floor only changes the odds between edges
+that both lie below 1.18e-38. The Max-Min colonies floor at ``tau_min`` already.
 """
 from __future__ import annotations
 
@@ -17,6 +30,9 @@ import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.colony import colony, deposit
 from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
+
+TAU_FLOOR = float(jnp.finfo(jnp.float32).tiny)
+"""The least ``tau`` after evaporation: the smallest normal float32 (arithmetic, see above)."""
 
 
 class AntSystemParams(NamedTuple):
@@ -57,8 +73,10 @@ ours."""
 
 
 def ant_system_update(graph, pheromone, ants, best_path, best_cost, info, params):
-    """Eq. 9, then eq. 8 for every ant that arrived: f32[N, K] pheromone."""
-    return deposit(graph, (1.0 - params.rho) * pheromone, ants.path[:, :-1], ants.slots,
+    """Eq. 9 (kept at least ``TAU_FLOOR``), then eq. 8 for every ant that arrived: f32[N, K]
+    pheromone."""
+    evaporated = jnp.maximum((1.0 - params.rho) * pheromone, TAU_FLOOR)
+    return deposit(graph, evaporated, ants.path[:, :-1], ants.slots,
                    jnp.where(ants.arrived, params.q / ants.length, 0.0))
 
 

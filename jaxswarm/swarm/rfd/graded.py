@@ -255,6 +255,10 @@ def _check_graded(params: GradedParams) -> None:
 
 def build_rfd_graded(config: GradedConfig) -> Swarm:
     """This project's river formation law (see the module docstring), with :class:`GradedParams`."""
-    return river_swarm("rfd_graded", config, transition=graded_transition,
-                       reshape=graded_reshape, greedy_drops=config.greedy_drops,
-                       default_params=DEFAULT_GRADED, check_params=_check_graded, adapt=regrade)
+    def reshape(graph, task, altitude, residual, table, drops, params):
+        # The graded law sets altitudes: the shared residual (compensated additions) stays 0.
+        return graded_reshape(graph, task, altitude, table, drops, params), residual
+
+    return river_swarm("rfd_graded", config, transition=graded_transition, reshape=reshape,
+                       greedy_drops=config.greedy_drops, default_params=DEFAULT_GRADED,
+                       check_params=_check_graded, adapt=regrade)

@@ -10,17 +10,48 @@ j)``, among the neighbours a drop has not visited yet (the paper's per-drop sets
   ``d_j`` the straight-line distance from ``j`` to the goal. Eq. 6 divides by ``d_goal = 0``, so
   the goal wins every draw when it is adjacent: we take it whenever adjacent.
 
-After the walk (Algorithm 1, lines 6-8), every edge ``i -> j`` of each path that reached the goal
-erodes node ``i`` by ``E / ((N - 1) * D) * gradient(i, j)`` (eq. 4; negative gradients erode
-nothing), and every node then gains ``erosionProduced / (N - 1)`` (eq. 5). A drop that could not
-move deposits ``sediment`` on the node where it stands (the paper's "a fraction of carried
-sediment", without an amount: the parameter is that amount). Altitudes are kept non-negative and
-the goal stays at 0.
+After the walk (Algorithm 1, lines 6-8), every move ``i -> j`` of each eroding path (by default
+the paths that reached the goal, see ``erode``) erodes node ``i`` by ``E / ((N - 1) * D) *
+gradient(i, j)`` (eq. 4; negative gradients erode nothing), and every node then gains
+``erosionProduced / (N - 1)`` (eq. 5). A drop that could not move deposits ``sediment`` on the
+node where it stands (the paper's "a fraction of carried sediment", without an amount: the
+parameter is that amount). Altitudes are kept non-negative and the goal stays at 0.
 
-Choices the paper leaves open, as config of ``rfd_star`` (the paper's variant is the default):
+Readings of the paper's text, as config of ``rfd_star`` (the default is the reading we can
+justify; ``rfd`` erodes as the defaults do):
 
+* ``erode``: whose paths erode. The text: "After all drops move, an erosion process is executed
+  on all travelled paths by reducing altitudes of nodes in proportion to their gradient with a
+  successive node (line 7)"; Algorithm 1: "6: Analyse complete paths / 7: Height of nodes on
+  paths -= erosion based on path costs". ``"arrived"`` (the default) erodes the paths of the
+  drops that reached the goal: the sentence defers to line 7, which erodes the paths line 6
+  analyses, "complete paths", "based on path costs", a cost only a path to the goal has; and a
+  drop that cannot move "deposits a fraction of carried sediment and evaporates", which the text
+  says is "weakening bad paths": eroding its trail would deepen the path its sediment weakens.
+  ``"travelled"`` erodes every drop's path, arrived, stuck or out of steps: the text's "all
+  travelled paths" (and its "a group of drops sequentially traverses the space, and then
+  performs erosion on visited nodes").
 * ``erosion_law``: ``"linear"`` is eq. 4; ``"exponential"`` erodes by ``p_base ** gradient``
-  instead of ``gradient`` (the paper: "the same formula can be applied to the erosion values").
+  instead of ``gradient`` (the paper, of eq. 6: "the same formula can be applied to the erosion
+  values"), and then gives at most the node's altitude minus the lowest altitude among the
+  nodes its eroding moves go to. Without that bound the exponential asks for amounts that grow
+  without limit with the gradient (even capped at ``exp(MAX_LOG_EROSION)`` against float32
+  overflow): on alley50 with ``E = 1000`` one iteration cut nodes far below the nodes they drain
+  to, and eq. 5 handed the surplus to every node, a median altitude of 3.95e9 (1.01 with the
+  bound). The bound is ours, from the text's erosion "in proportion to their gradient with a
+  successive node": it ends where the gradient does, as a river does not cut below its outlet.
+  So a node whose eroding moves are all flat or uphill erodes nothing, as under eq. 4, where the
+  unbounded form would erode flat ground by ``p_base ** 0 = 1``. The linear law is eq. 4 as
+  written: a drop leaves a node at most once per iteration, so it does not cut a node below the
+  node it drains to while ``E`` is at most ``N - 1`` times the shortest edge; above that it can,
+  and the clamp at 0 applies.
+
+Arithmetic, not algorithm: an erosion step is ``E / ((N - 1) D)`` times a gradient, and in
+float32 a step below about 3e-8 taken from an altitude of 1 is lost whole (on mosaic50, after 20
+iterations of the default ``rfd_star``, 17 % of the eroding moves of an iteration asked for less
+than 3e-8 times their node's altitude). Every change of the altitudes (sediment, erosion) is
+added by compensated summation (:func:`~jaxswarm.swarm.rfd.river.add_compensated`, the state's
+``residual``), so small steps add up as their sum does.
 
 Additions of this project, each off in the paper's variant:
 
@@ -46,14 +77,16 @@ import jax.numpy as jnp
 
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
-from jaxswarm.swarm.rfd.river import (check_greedy_drops, deposit_where_stuck, gradients,
-                                      river_swarm)
+from jaxswarm.swarm.rfd.river import (add_compensated, check_greedy_drops, gradients,
+                                      river_swarm, sediment_where_stuck)
 from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, neighbour_slots
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 
 EROSION_LAWS = ("linear", "exponential")
-"""How ``rfd_star``'s arrived drops erode their paths: eq. 4, or its exponential form."""
+"""How ``rfd_star``'s drops erode their paths: eq. 4, or its exponential form."""
+EROSION_PATHS = ("arrived", "travelled")
+"""Whose paths ``rfd_star`` erodes: the drops that reached the goal, or every drop's."""
 
 MAX_LOG_EROSION = 60.0
 """Cap on ``log(p_base ** gradient)`` in the exponential erosion (float32 overflows near 88)."""
@@ -69,12 +102,15 @@ class RFDStarConfig(SwarmConfig):
 
     Attributes:
       erosion_law: one of ``EROSION_LAWS``.
+      erode: one of ``EROSION_PATHS``: the paths of the drops that arrived (Algorithm 1's
+        "complete paths") or of every drop (the text's "all travelled paths").
       greedy_drops: ours: how many drops (the first ones) take their most likely move.
       fill_blind_alleys: ours: a stuck drop fills its whole blind alley with ``sediment``.
       max_climb: ours: the steepest uphill gradient a drop takes (None: any, as the paper).
     """
 
     erosion_law: str = "linear"
+    erode: str = "arrived"
     greedy_drops: int = 0
     fill_blind_alleys: bool = False
     max_climb: float | None = None
@@ -85,6 +121,9 @@ class RFDStarConfig(SwarmConfig):
         if self.erosion_law not in EROSION_LAWS:
             raise ValueError(f"unknown erosion_law {self.erosion_law!r}; "
                              f"choose one of {', '.join(EROSION_LAWS)}")
+        if self.erode not in EROSION_PATHS:
+            raise ValueError(f"unknown erode {self.erode!r}; "
+                             f"choose one of {', '.join(EROSION_PATHS)}")
         if self.max_climb is not None:
             check_positive("max_climb", self.max_climb, allow_zero=True)
 
@@ -153,27 +192,41 @@ def rfd_star_transition(config: RFDStarConfig, graph: Graph, task: Task, altitud
     return edge_table(graph, logw.T)
 
 
-def erode_eq4(graph: Graph, altitude, drops: Walk, erosion, p_base=None):
-    """Eqs. 4 and 5 along the paths of the drops that arrived: f32[N] altitudes after erosion.
+def erosion_change(graph: Graph, altitude, drops: Walk, eroding, erosion, p_base=None):
+    """Eqs. 4 and 5: f32[N], the change of every altitude f32[N] when the drops ``eroding``
+    (bool[A]) of a walk of ``D = A`` drops erode their paths.
 
-    Each move ``i -> j`` of an arrived drop lowers ``i`` by ``erosion / ((N - 1) D)`` times
-    ``max(gradient, 0)`` (or, given ``p_base``, times ``p_base ** gradient``, the exponential
-    form); then every node gains the eroded total divided by ``N - 1``.
+    Each move ``i -> j`` of an eroding drop asks node ``i`` for ``erosion / ((N - 1) D)`` times
+    ``max(gradient, 0)`` (eq. 4) or, given ``p_base``, times ``p_base ** gradient`` (the
+    exponential form); with ``p_base``, node ``i`` gives at most its altitude minus the lowest
+    altitude among the nodes its eroding moves go to (nothing if none is lower). Every node then
+    gains the eroded total divided by ``N - 1`` (eq. 5).
     """
     n = altitude.shape[0]
     num_drops = drops.path.shape[0]
-    moved = (drops.slots >= 0) & drops.arrived[:, None]
+    moved = (drops.slots >= 0) & eroding[:, None]
     here = jnp.where(moved, drops.path[:, :-1], 0)
     there = jnp.where(moved, drops.path[:, 1:], 0)
     distance = move_lengths(graph, here, drops.slots)
     gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
+    rate = erosion / ((n - 1) * num_drops)
     if p_base is None:
-        shape = jnp.maximum(gradient, 0.0)
+        asked = jnp.where(moved, rate * jnp.maximum(gradient, 0.0), 0.0)
+        eroded = jnp.zeros_like(altitude).at[here].add(asked)
     else:  # p_base ** gradient, capped so that a cliff cannot overflow float32
         shape = jnp.exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
-    amount = jnp.where(moved, erosion / ((n - 1) * num_drops) * shape, 0.0)
-    altitude = altitude.at[here].add(-amount)
-    return altitude + jnp.sum(amount) / (n - 1)
+        asked = jnp.zeros_like(altitude).at[here].add(jnp.where(moved, rate * shape, 0.0))
+        outlet = jnp.full_like(altitude, jnp.inf).at[jnp.where(moved, here, n)].min(
+            altitude[there], mode="drop")
+        eroded = jnp.minimum(asked, jnp.maximum(altitude - outlet, 0.0))
+    return jnp.sum(eroded) / (n - 1) - eroded
+
+
+def erode(graph: Graph, altitude, residual, drops: Walk, eroding, erosion, p_base=None):
+    """``(altitude f32[N], residual f32[N])`` after :func:`erosion_change`, added by compensated
+    summation (:func:`~jaxswarm.swarm.rfd.river.add_compensated`)."""
+    return add_compensated(altitude, residual,
+                           erosion_change(graph, altitude, drops, eroding, erosion, p_base))
 
 
 def _check_rfd(params: RFDParams) -> None:
@@ -194,9 +247,10 @@ def _check_rfd_star(params: RFDStarParams) -> None:
 
 def build_rfd(config: SwarmConfig) -> Swarm:
     """The original River Formation Dynamics (eqs. 1-5), with :class:`RFDParams`."""
-    def reshape(graph, task, altitude, table, drops, params):
-        altitude = deposit_where_stuck(altitude, drops, params.sediment)
-        return erode_eq4(graph, altitude, drops, params.erosion)
+    def reshape(graph, task, altitude, residual, table, drops, params):
+        altitude, residual = add_compensated(
+            altitude, residual, sediment_where_stuck(graph.num_nodes, drops, params.sediment))
+        return erode(graph, altitude, residual, drops, drops.arrived, params.erosion)
 
     return river_swarm("rfd", config, transition=rfd_transition, reshape=reshape,
                        greedy_drops=0, default_params=DEFAULT_RFD, check_params=_check_rfd)
@@ -207,15 +261,16 @@ def build_rfd_star(config: RFDStarConfig) -> Swarm:
     def transition(graph, task, altitude, params):
         return rfd_star_transition(config, graph, task, altitude, params)
 
-    def reshape(graph, task, altitude, table, drops, params):
+    def reshape(graph, task, altitude, residual, table, drops, params):
         if config.fill_blind_alleys:
-            altitude = altitude + jnp.where(blind_alleys(graph, table, drops), params.sediment,
-                                            0.0)
+            sediment = jnp.where(blind_alleys(graph, table, drops), params.sediment, 0.0)
         else:
-            altitude = deposit_where_stuck(altitude, drops, params.sediment)
+            sediment = sediment_where_stuck(graph.num_nodes, drops, params.sediment)
+        altitude, residual = add_compensated(altitude, residual, sediment)
+        eroding = drops.arrived if config.erode == "arrived" else jnp.ones_like(drops.arrived)
         exponential = config.erosion_law == "exponential"
-        return erode_eq4(graph, altitude, drops, params.erosion,
-                         params.p_base if exponential else None)
+        return erode(graph, altitude, residual, drops, eroding, params.erosion,
+                     params.p_base if exponential else None)
 
     return river_swarm("rfd_star", config, transition=transition, reshape=reshape,
                        greedy_drops=config.greedy_drops, default_params=DEFAULT_RFD_STAR,
