@@ -106,8 +106,10 @@ TITLE = "The IWD_PG paper's experiments"
 """Title of table.md."""
 ABOUT = ("`iwd_pg` is the IWD_PG paper's algorithm with each operator a switch; where the paper's "
          "figures, membership functions, rules and maps did not survive, ours are documented in "
-         "`jaxswarm.swarm.iwd` and `jaxswarm.maps.iwd_pg`. `iwd` is its baseline. Optima are "
-         "Dijkstra's.")
+         "`jaxswarm.swarm.iwd` and `jaxswarm.maps.iwd_pg`. `iwd` is its baseline. In both, only "
+         "the drops that reach the goal change the soil, after the walk (the paper: \"feasible "
+         "solution removes some soil of graph and therefore guides next generation drops\"; "
+         "`local_updates=\"arrived\"`). Optima are Dijkstra's.")
 """What the rows are (the paragraph under the provenance)."""
 
 
