@@ -18,7 +18,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.iwd.memory import join, last_position, prefix_lengths, reverse
+from jaxswarm.swarm.iwd.memory import (join, last_position, prefix_lengths, reverse,
+                                       width_index, widths)
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
 
@@ -74,6 +75,22 @@ def closest_inner_pair(graph: Graph, a: jax.Array, b: jax.Array):
     distance = jnp.where(_inner(a)[:, None] & _inner(b)[None, :], distance, jnp.inf)
     flat = jnp.argmin(distance)
     return flat // b.shape[0], flat % b.shape[0]
+
+
+def closest_inner_pairs(graph: Graph, a: jax.Array, others: jax.Array):
+    """``(i, j)`` i32[P]: :func:`closest_inner_pair` of ``a`` (i32[L]) and each of ``others``
+    (i32[P, L]), worked on the smallest of :func:`~.memory.widths` that holds them all (the
+    positions past their ends are not inner, and the first nearest pair in row-major order is
+    the same on fewer columns)."""
+    length = a.shape[0]
+
+    def within(width):
+        def closest(a, others):
+            return jax.vmap(lambda b: closest_inner_pair(graph, a[:width], b[:width]))(others)
+        return closest
+
+    return jax.lax.switch(width_index(jnp.concatenate([a[None], others])),
+                          [within(width) for width in widths(length)], a, others)
 
 
 def second_intersection(graph: Graph, a, b, i, j, connection) -> Children:

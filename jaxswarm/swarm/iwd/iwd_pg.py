@@ -38,21 +38,21 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 
 import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.iwd import fuzzy
-from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
+from jaxswarm.swarm.iwd.intersect import (closest_inner_pairs, first_intersection,
                                           second_intersection)
 from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, SOIL_LABEL, IWDConfig, IWDParams, build_iwd,
                                     check_iwd, drop_walk, initial_soil, soil_after_best,
                                     soil_per_node, soil_rule)
-from jaxswarm.swarm.iwd.local import connect_all, improve_between, splice_if_shorter
+from jaxswarm.swarm.iwd.local import connect_all, splice_if_shorter
 from jaxswarm.swarm.iwd.memory import Memory, empty_memory, last_position, remember
-from jaxswarm.swarm.iwd.smooth import smooth_path
+from jaxswarm.swarm.iwd.smooth import smooth_paths
 from jaxswarm.swarm.walking import Walk, step_budget
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
@@ -222,75 +222,190 @@ def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool):
     """The drops' paths, with ``smooth`` each one that arrived through the global smooth
     operator, and their lengths: ``(paths i32[A, L], lengths f32[A])`` (a drop that did not
     arrive keeps its walked length)."""
-    paths = drops.path
-    if smooth:
-        # Every drop's path is smoothed (under vmap a cond would run both sides anyway); a
-        # drop that did not arrive keeps its path.
-        smoothed = jax.vmap(lambda p: smooth_path(graph, p))(paths)
-        paths = jnp.where(drops.arrived[:, None], smoothed, paths)
+    paths = smooth_paths(graph, drops.path, drops.arrived) if smooth else drops.path
     lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
                         drops.length)
     return paths, lengths
 
 
+class _Found(NamedTuple):
+    """What a batch of local searches found (:func:`~.local.connect_all`).
+
+    Attributes:
+      paths: i32[B, L] each search's best path; costs: f32[B] its length (inf for none);
+      calls: i32[B] its fitness calls.
+    """
+
+    paths: jax.Array
+    costs: jax.Array
+    calls: jax.Array
+
+
+class _Stage(NamedTuple):
+    """One memory operator: the local searches it asks for and what it makes of them. Both
+    functions read the memory as the stage found it, so what ``apply`` needs of the
+    operator's plan it works out again (the same arrays ``ask`` worked out).
+
+    Attributes:
+      searches: B, the local searches it asks for (static; 0 for none).
+      ask: ``(memory) -> (keys key[B], heres i32[B], theres i32[B])``: each search's key, and
+        the nodes it connects.
+      apply: ``(memory, _Found or None) -> (memory, evaluations i32[])``.
+    """
+
+    searches: int
+    ask: Callable
+    apply: Callable
+
+
 def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
     """The memory operators that are switched on, the intersection operators first, then the
     section local search: ``(memory, evaluations i32[])``, the memory sorted again without
-    duplicates."""
+    duplicates. When both ask for local searches, a loop of two turns runs them through one
+    batch of searches (one compiled program of the small runs; a turn's batch is padded with
+    runs from node 0 to itself, which walk no drop and are dropped). A run's result does not
+    depend on the others of its batch: its drops read its own soil, which changes after their
+    walk (``local_updates="arrived"``)."""
     config = setup.config
     intersection_key, section_key = jax.random.split(key)
-    evaluations = jnp.int32(0)
+    stages = []
     if config.first_intersection or config.second_intersection:
-        memory, count = _intersections(setup, intersection_key, graph, memory, params)
-        evaluations += count
+        stages.append(_intersection_stage(setup, intersection_key, graph))
     if config.local_search:
-        memory, count = _section_search(setup, section_key, graph, memory, params)
-        evaluations += count
+        stages.append(_section_stage(setup, section_key, graph))
+    search = functools.partial(_search, setup, graph, params)
+    if sum(stage.searches > 0 for stage in stages) < 2:
+        evaluations = jnp.int32(0)
+        for stage in stages:
+            found = search(*stage.ask(memory)) if stage.searches else None
+            memory, count = stage.apply(memory, found)
+            evaluations += count
+    else:
+        memory, evaluations = _stage_loop(stages, search, memory)
     return remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs), evaluations
 
 
-def _intersections(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
-    """The intersection operators on the pairs (0, q): ``(memory, evaluations i32[])``, each
-    parent replaced by its child where that is shorter. Their local searches (around the first
+def _search(setup: _Setup, graph: Graph, params: IWDParams, keys, heres, theres) -> _Found:
+    """The local searches (one batch) from ``heres`` to ``theres`` (i32[B]) with ``keys``."""
+    return _Found(*connect_all(keys, graph, heres, theres, params, swarm=setup.local,
+                               iterations=setup.config.local_iterations))
+
+
+def _stage_loop(stages, search, memory: Memory):
+    """The ``stages`` applied in turn, each turn's local searches through one batch of the
+    most searches a stage asks for: ``(memory, evaluations i32[])``."""
+    size = max(stage.searches for stage in stages)
+
+    def padded(stage):
+        def ask(memory):
+            keys, heres, theres = stage.ask(memory)
+            fill = size - stage.searches
+            return (keys[jnp.minimum(jnp.arange(size), stage.searches - 1)],
+                    jnp.pad(heres, (0, fill)), jnp.pad(theres, (0, fill)))
+        return ask
+
+    def applied(stage):
+        def apply(memory, found):
+            return stage.apply(memory, jax.tree_util.tree_map(
+                lambda x: x[:stage.searches], found) if stage.searches else None)
+        return apply
+
+    def turn(index, carry):
+        memory, evaluations = carry
+        found = search(*jax.lax.switch(index, [padded(stage) for stage in stages], memory))
+        memory, count = jax.lax.switch(index, [applied(stage) for stage in stages], memory,
+                                       found)
+        return memory, evaluations + count
+
+    return jax.lax.fori_loop(0, len(stages), turn, (memory, jnp.int32(0)))
+
+
+class _Crossing(NamedTuple):
+    """The intersection operators' plan for the memory's pairs.
+
+    Attributes:
+      pairs: the pairs (:class:`_Pairs`).
+      offspring: the first operator's children (:class:`_Offspring`).
+      crossing: bool[P] the present pairs that share an inner node.
+      around: the children's sub-paths around their joints (:class:`_Spans`, 2P rows), or None
+        without the first operator's local search.
+      closest: ``(i, j)`` i32[P] the pairs' closest inner nodes, or None without the second
+        operator.
+    """
+
+    pairs: _Pairs
+    offspring: _Offspring
+    crossing: jax.Array
+    around: _Spans | None
+    closest: tuple | None
+
+
+def _intersection_stage(setup: _Setup, key, graph: Graph) -> _Stage:
+    """The intersection operators on the pairs (0, q) as a :class:`_Stage`: each parent is
+    replaced by its child where that is shorter. Their local searches (around the first
     operator's joints, and the second's connections) run as one batch."""
+    config = setup.config
+    num_pairs = config.memory_size - 1
+    improve_first = config.first_intersection and config.local_search
+    searches = (2 * num_pairs if improve_first else 0) + (
+        num_pairs if config.second_intersection else 0)
+
+    def ask(memory):
+        plan = _crossing_plan(setup, graph, memory)
+        heres, theres = [], []
+        if improve_first:
+            rows = jnp.arange(2 * num_pairs)
+            heres.append(plan.around.paths[rows, plan.around.begins])
+            theres.append(plan.around.paths[rows, plan.around.ends])
+        if config.second_intersection:
+            heres.append(plan.pairs.best[plan.closest[0]])
+            theres.append(plan.pairs.others[jnp.arange(num_pairs), plan.closest[1]])
+        return jax.random.split(key, searches), jnp.concatenate(heres), jnp.concatenate(theres)
+
+    def apply(memory, found):
+        plan = _crossing_plan(setup, graph, memory)
+        offspring = plan.offspring
+        if improve_first:
+            offspring = _improved_at_joints(
+                graph, offspring, plan.around, plan.crossing, found.paths[:2 * num_pairs],
+                found.costs[:2 * num_pairs], found.calls[:2 * num_pairs])
+        if config.second_intersection:
+            offspring = _with_second_children(graph, plan.pairs, plan.crossing, offspring,
+                                              plan.closest, found.paths[-num_pairs:],
+                                              found.calls[-num_pairs:])
+        return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
+
+    return _Stage(searches=searches, ask=ask, apply=apply)
+
+
+def _crossing_plan(setup: _Setup, graph: Graph, memory: Memory) -> _Crossing:
+    """The intersection operators' :class:`_Crossing` of the memory's pairs (0, q)."""
     config = setup.config
     pairs = _Pairs(best=memory.paths[0], others=memory.paths[1:],
                    present=jnp.isfinite(memory.costs[0]) & jnp.isfinite(memory.costs[1:]))
-    num_pairs = pairs.others.shape[0]
     offspring, joints, crossing = _first_children(graph, pairs, on=config.first_intersection)
-    improve_first = config.first_intersection and config.local_search
-    heres, theres = [], []
-    if improve_first:
-        around = _around_joints(offspring.paths, joints, config.local_span)
-        rows = jnp.arange(around.paths.shape[0])
-        heres.append(around.paths[rows, around.begins])
-        theres.append(around.paths[rows, around.ends])
-    if config.second_intersection:
-        closest = jax.vmap(lambda b: closest_inner_pair(graph, pairs.best, b))(pairs.others)
-        heres.append(pairs.best[closest[0]])
-        theres.append(pairs.others[jnp.arange(num_pairs), closest[1]])
-    if not heres:
-        return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
-    paths, costs, calls = connect_all(key, graph, jnp.concatenate(heres),
-                                      jnp.concatenate(theres), params, swarm=setup.local,
-                                      iterations=config.local_iterations)
-    if improve_first:
-        offspring = _improved_at_joints(graph, offspring, around, crossing, paths[:2 * num_pairs],
-                                        costs[:2 * num_pairs], calls[:2 * num_pairs])
-    if config.second_intersection:
-        offspring = _with_second_children(graph, pairs, crossing, offspring, closest,
-                                          paths[-num_pairs:], calls[-num_pairs:])
-    return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
+    around = (_around_joints(offspring.paths, joints, config.local_span)
+              if config.first_intersection and config.local_search else None)
+    closest = (closest_inner_pairs(graph, pairs.best, pairs.others)
+               if config.second_intersection else None)
+    return _Crossing(pairs=pairs, offspring=offspring, crossing=crossing, around=around,
+                     closest=closest)
 
 
 def _first_children(graph: Graph, pairs: _Pairs, *, on: bool):
     """The first operator's children of the pairs: ``(offspring, joints i32[P, 2], crossing
     bool[P])``, the children (cost inf unless the operator is ``on`` and the pair is present and
     shares an inner node: it crosses) with two fitness calls per crossing pair, and the position
-    in each child where the other parent's part begins."""
+    in each child where the other parent's part begins. When the operator is off no pair
+    crosses, and its children are the pairs themselves (never used: their cost is inf)."""
+    num_pairs = pairs.others.shape[0]
+    if not on:
+        paths = jnp.stack([jnp.broadcast_to(pairs.best, pairs.others.shape), pairs.others], 1)
+        return (_Offspring(paths=paths, costs=jnp.full((num_pairs, 2), jnp.inf),
+                           evaluations=jnp.int32(0)),
+                jnp.zeros((num_pairs, 2), jnp.int32), jnp.zeros((num_pairs,), bool))
     first = jax.vmap(lambda b: first_intersection(graph, pairs.best, b))(pairs.others)
-    crossing = (jnp.isfinite(first.costs[:, 0]) & pairs.present if on
-                else jnp.zeros((pairs.others.shape[0],), bool))
+    crossing = jnp.isfinite(first.costs[:, 0]) & pairs.present
     offspring = _Offspring(paths=first.paths,
                            costs=jnp.where(crossing[:, None], first.costs, jnp.inf),
                            evaluations=2 * jnp.sum(crossing, dtype=jnp.int32))
@@ -355,23 +470,38 @@ def _replace_parents(memory: Memory, paths, costs) -> Memory:
     return Memory(paths=new_paths, costs=new_costs)
 
 
-def _section_search(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
+def _section_stage(setup: _Setup, key, graph: Graph) -> _Stage:
     """Local search on one section's sub-path of each remembered path, the sections split
-    along an axis drawn at random: ``(memory, evaluations i32[])``, each path replaced by its
-    improvement where that is shorter."""
+    along an axis drawn at random, as a :class:`_Stage`: each path is replaced by its
+    improvement where that is shorter (a search's calls count, and one for a spliced path)."""
     config = setup.config
     axis_key, section_key, search_key = jax.random.split(key, 3)
-    axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
-    present = jnp.isfinite(memory.costs)
-    section = _draw_sections(section_key, graph, memory.paths, present, axis, config)
-    begins, ends = _section_spans(graph, memory.paths, section, axis, config.sections)
-    paths, costs, evals = jax.vmap(lambda k, p, b, e: improve_between(
-        k, graph, p, b, e, params, swarm=setup.local, iterations=config.local_iterations))(
-        jax.random.split(search_key, config.memory_size), memory.paths, begins, ends)
-    better = present & (costs < memory.costs)
-    return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
-                   costs=jnp.where(better, costs, memory.costs)),
-            jnp.sum(jnp.where(present, evals, 0)))
+
+    def spans(memory):
+        axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
+        present = jnp.isfinite(memory.costs)
+        section = _draw_sections(section_key, graph, memory.paths, present, axis, config)
+        return _section_spans(graph, memory.paths, section, axis, config.sections)
+
+    def ask(memory):
+        begins, ends = spans(memory)
+        rows = jnp.arange(config.memory_size)
+        return (jax.random.split(search_key, config.memory_size), memory.paths[rows, begins],
+                memory.paths[rows, ends])
+
+    def apply(memory, found):
+        begins, ends = spans(memory)
+        paths, costs, spliced = jax.vmap(
+            lambda p, b, e, m, c: splice_if_shorter(graph, p, b, e, m, c))(
+            memory.paths, begins, ends, found.paths, found.costs)
+        present = jnp.isfinite(memory.costs)
+        better = present & (costs < memory.costs)
+        evaluations = found.calls + spliced.astype(jnp.int32)
+        return (Memory(paths=jnp.where(better[:, None], paths, memory.paths),
+                       costs=jnp.where(better, costs, memory.costs)),
+                jnp.sum(jnp.where(present, evaluations, 0)))
+
+    return _Stage(searches=config.memory_size, ask=ask, apply=apply)
 
 
 def _draw_sections(key, graph: Graph, paths, present, axis, config: IWDPGConfig) -> jax.Array:

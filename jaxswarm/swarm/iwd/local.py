@@ -1,5 +1,5 @@
 """IWD_PG's local search: a small IWD run between two nodes of a path, spliced in when shorter
-(:func:`connect_all` runs a batch of them as one).
+(:func:`connect_all` runs a batch of them as one, :func:`splice_if_shorter` splices).
 
 The run is the ``iwd`` swarm itself with fewer drops and iterations and a memory of its own
 (fresh soil, no IWD_PG memory), through the engine's run loop; its fitness calls count.
@@ -24,11 +24,10 @@ def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations:
     return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
 
 
-def connect_all(key, graph: Graph, heres, theres, params, *, swarm: Swarm, iterations: int):
+def connect_all(keys, graph: Graph, heres, theres, params, *, swarm: Swarm, iterations: int):
     """Small IWD runs (one batch through the walker) from the nodes ``heres`` to ``theres``
-    (i32[B]), each with its own key split from ``key``: ``(paths i32[B, L], costs f32[B],
-    evaluations i32[B])`` as :func:`connect` gives them."""
-    keys = jax.random.split(key, heres.shape[0])
+    (i32[B]), with ``keys`` (key[B]): ``(paths i32[B, L], costs f32[B], evaluations i32[B])`` as
+    :func:`connect` gives them. A run's result does not depend on the others of its batch."""
     return jax.vmap(lambda k, here, there: connect(
         k, graph, here, there, params, swarm=swarm, iterations=iterations))(keys, heres, theres)
 
@@ -44,18 +43,3 @@ def splice_if_shorter(graph: Graph, path, begin, end, middle, middle_cost):
     better = (end > begin + 1) & (middle_cost < prefix[end] - prefix[begin] - IMPROVEMENT)
     new_path = jnp.where(better, splice(path, begin, end, middle), path)
     return new_path, path_length(graph, new_path), better
-
-
-def improve_between(key, graph: Graph, path, begin, end, params, *, swarm: Swarm,
-                    iterations: int):
-    """Local search on the sub-path of ``path`` (i32[L]) from position ``begin`` to ``end``.
-
-    Returns:
-      ``(path, cost, evaluations)``: the path with the small run's path spliced in when it is
-      shorter than the sub-path (else as it was), its length, and the fitness calls (the small
-      run's, and one for the spliced path).
-    """
-    middle, middle_cost, evaluations = connect(key, graph, path[begin], path[end], params,
-                                               swarm=swarm, iterations=iterations)
-    new_path, cost, better = splice_if_shorter(graph, path, begin, end, middle, middle_cost)
-    return new_path, cost, evaluations + better.astype(jnp.int32)

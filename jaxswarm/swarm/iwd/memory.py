@@ -53,6 +53,24 @@ def remember(memory: Memory, paths: jax.Array, costs: jax.Array) -> Memory:
     return Memory(paths=kept_paths, costs=kept_costs)
 
 
+def widths(length: int) -> tuple[int, ...]:
+    """The widths (static, ascending) that operators on paths of ``length`` nodes work on when
+    the paths are shorter: about an eighth and a third of ``length`` (multiples of 32, at least
+    64) and ``length`` itself. Past a path's last node every position is padding, so an
+    operator that reads no position past it gives the same result on the first ``W``
+    positions as on all of them, with less work."""
+    return tuple(sorted({min(length, max(64, -(-length // share // 32) * 32))
+                         for share in (8, 3)} | {length}))
+
+
+def width_index(paths: jax.Array) -> jax.Array:
+    """i32[]: the index in ``widths(L)`` of the smallest width that holds every path of
+    ``paths`` (i32[P, L], -1 padded)."""
+    choices = widths(paths.shape[-1])
+    nodes = jnp.max(jnp.sum(paths >= 0, axis=-1))
+    return jnp.sum(nodes > jnp.asarray(choices[:-1], jnp.int32), dtype=jnp.int32)
+
+
 def node_count(path: jax.Array) -> jax.Array:
     """i32[]: the nodes of a padded path."""
     return jnp.sum(path >= 0, dtype=jnp.int32)

@@ -1,0 +1,259 @@
+"""Speed of ``iwd_pg`` (IWD_PG with its default config): compile seconds, milliseconds per
+iteration, and the share of each stage; and a check that its results are the recorded ones.
+
+For each key of ``--keys`` one run of ``--iterations`` iterations (default 100, no patience:
+a run stops early only when every drop of an iteration took one path) on ``--map`` (default
+mosaic50, the map of ``jaxswarm demo``, with its start and goal). The run is compiled once
+(without the compile cache: its seconds are printed), then each key is timed ``--repeats`` times
+and the median per key is printed, divided by the iterations it ran.
+
+``--stages`` also times variants with one stage switched off (:class:`IWDPGConfig`), each
+compiled on its own: ``no smooth``, ``no operators`` (the memory operators compiled but never
+due: ``operator_patience`` above the iterations), ``no intersections``, ``no local search``;
+a stage's share is how much of the default run's time per iteration the variant saves. The
+variants' runs take other paths (a stage off changes what the drops find), so the shares are
+estimates; the variant ``walk only`` (smooth and operators off) is the drops' walk with the
+bookkeeping of the iteration.
+
+Same results: the SHA-256 of every leaf of each run's state and trace (PRNG keys as their data)
+are compared with :data:`RECORDED`, the digests of the runs before IWD_PG was sped up
+(``same results: yes`` when every leaf matches; printed for the default map, iterations and
+config; ``--record`` prints the digests of this run as the record's source text). They are
+taken with XLA's vector instructions capped at AVX2 as the golden records are
+(``tests/golden/isa.py``: a float reduction over 8 lanes adds in another order than one over
+16), and so is the timing.
+
+XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see
+:mod:`jaxswarm.runtime.cpu`).
+
+Run from the repository root::
+
+    python benchmarks/iwd_pg.py
+    python benchmarks/iwd_pg.py --stages --repeats 3
+    python benchmarks/iwd_pg.py --map maze50 --keys 0
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import os
+import platform
+import statistics
+import time
+
+import jax
+import numpy as np
+
+from jaxswarm.maps.named import named_map
+from jaxswarm.runtime.cpu import configure
+from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.testing import key_data
+
+DEFAULT_MAP, DEFAULT_ITERATIONS = "mosaic50", 100
+
+ISA_CAP = "--xla_cpu_max_isa=AVX2"
+"""The golden records' cap on XLA's vector instructions on x86-64 (``tests/golden/isa.py``)."""
+
+RECORDED = {
+    "mosaic50": {
+        0: {
+            "[0].key": "1f2be08d7289103d", "[0].soil": "0b15aca4eb6dad94",
+            "[0].memory.paths": "6d393f70aeafe64a", "[0].memory.costs": "2769ae8cba785a89",
+            "[0].stale": "26b25d457597a7b0", "[1].best_cost": "823531fc88a2a3c1",
+            "[1].iteration_cost": "a40277cf910dbccf", "[1].arrived": "612780111eee67dc",
+            "[1].iterations": "01b4f6bd5d6a06a7", "[1].moves": "ae01444ce93cd3ee",
+            "[1].lane_steps": "a4638917a8bcdf8d", "[1].evaluations": "0a9b3d33b65126fa",
+        },
+        1: {
+            "[0].key": "4ac7a7d758b49208", "[0].soil": "065082e7c999a125",
+            "[0].memory.paths": "a0d11cde30b78448", "[0].memory.costs": "980155527f311eed",
+            "[0].stale": "6fea016a651b6460", "[1].best_cost": "4c1d788f0e3f71a7",
+            "[1].iteration_cost": "9045da1fda6fac03", "[1].arrived": "27344980c0e2539c",
+            "[1].iterations": "40e736c02a102a05", "[1].moves": "6706359b7c0ba562",
+            "[1].lane_steps": "73aa742b11464967", "[1].evaluations": "b8856eebad40ffc5",
+        },
+        2: {
+            "[0].key": "fc34219733dd7ee7", "[0].soil": "8c16396853be8eec",
+            "[0].memory.paths": "f770368085551180", "[0].memory.costs": "a9fded04746f6f47",
+            "[0].stale": "b01099398ce27bbc", "[1].best_cost": "5ab3dcbff9978e79",
+            "[1].iteration_cost": "ba7fe94fa56a4823", "[1].arrived": "ce14ae54da14e99c",
+            "[1].iterations": "40e736c02a102a05", "[1].moves": "1e4d5adfb23d6716",
+            "[1].lane_steps": "67fadb258a505873", "[1].evaluations": "ec06d422f04a172d",
+        },
+    },
+    "mosaic20": {
+        0: {
+            "[0].key": "8ffd190d67796d1d", "[0].soil": "7b010e09b74c2a70",
+            "[0].memory.paths": "9f2cbf86d4262183", "[0].memory.costs": "d95e9a95d9498a7c",
+            "[0].stale": "91ce314c0a497422", "[1].best_cost": "942d5dfff171f2ca",
+            "[1].iteration_cost": "3454cb8d1144f62a", "[1].arrived": "77d216a69772d7a1",
+            "[1].iterations": "40e736c02a102a05", "[1].moves": "f4c87a3dd175dc01",
+            "[1].lane_steps": "a13389c902fc5cc9", "[1].evaluations": "09f810538d9135e7",
+        },
+        1: {
+            "[0].key": "c612fd0369ff1964", "[0].soil": "cfc2d3c3fb4e2fa2",
+            "[0].memory.paths": "74879d9ef76c9f74", "[0].memory.costs": "779f0a83fb2c2433",
+            "[0].stale": "a376d173ece243d5", "[1].best_cost": "5dd5ee3055823fe7",
+            "[1].iteration_cost": "1de1324fe01000e7", "[1].arrived": "ded4f45924fb0267",
+            "[1].iterations": "0623ccb9b1619bd3", "[1].moves": "6464498b60a7aa45",
+            "[1].lane_steps": "0ddc2a19dcd9ac18", "[1].evaluations": "d4d51995a0ec55c3",
+        },
+        2: {
+            "[0].key": "fc34219733dd7ee7", "[0].soil": "18ce7df985d64aa7",
+            "[0].memory.paths": "ca56cbfde6887f8d", "[0].memory.costs": "bc7dd1e1b68b9511",
+            "[0].stale": "c0736411a62ec0f4", "[1].best_cost": "02052479abb1a729",
+            "[1].iteration_cost": "4a4771c75b17503b", "[1].arrived": "88fb9eb024a10e75",
+            "[1].iterations": "40e736c02a102a05", "[1].moves": "a12c8dbaae46a27f",
+            "[1].lane_steps": "92541f9de7b20e8e", "[1].evaluations": "ba0dfbab235a4089",
+        },
+    },
+    "maze20": {
+        0: {
+            "[0].key": "1049b4c0445a9d42", "[0].soil": "c4a8ca2bb2e9ae52",
+            "[0].memory.paths": "ae7b09b13a79e553", "[0].memory.costs": "f941ecf371914389",
+            "[0].stale": "67abdd721024f0ff", "[1].best_cost": "6599e3077e4c71c1",
+            "[1].iteration_cost": "c951e83b7fd01857", "[1].arrived": "71d1ee93fb6ba870",
+            "[1].iterations": "9d9f290527a6be62", "[1].moves": "2f743625054d30c4",
+            "[1].lane_steps": "6636349a4afee2c9", "[1].evaluations": "99c28d92a8b1e901",
+        },
+        1: {
+            "[0].key": "891e380f28824aeb", "[0].soil": "092fc14b970a66f8",
+            "[0].memory.paths": "ae7b09b13a79e553", "[0].memory.costs": "f941ecf371914389",
+            "[0].stale": "67abdd721024f0ff", "[1].best_cost": "0eafcd13528da8af",
+            "[1].iteration_cost": "0eafcd13528da8af", "[1].arrived": "26537abd03a9ae64",
+            "[1].iterations": "26b25d457597a7b0", "[1].moves": "94103ee33d1e1c2f",
+            "[1].lane_steps": "e22a8b823a1fb16d", "[1].evaluations": "083f49d9f68ded5d",
+        },
+        2: {
+            "[0].key": "9827dae0d0651570", "[0].soil": "b655529514fecd3f",
+            "[0].memory.paths": "ae7b09b13a79e553", "[0].memory.costs": "f941ecf371914389",
+            "[0].stale": "67abdd721024f0ff", "[1].best_cost": "8b9bcd3b847ce1eb",
+            "[1].iteration_cost": "f164f01eb94852fc", "[1].arrived": "6655e76886672b22",
+            "[1].iterations": "9d9f290527a6be62", "[1].moves": "917e4ded805b4496",
+            "[1].lane_steps": "0908a85cb61cf335", "[1].evaluations": "5a4548452968743e",
+        },
+    },
+}
+"""Per map and key: the digest (first 16 hex digits of SHA-256) of each leaf of the run's
+``(state, trace)``, 100 iterations, default config, before the speed-up. On the 50 x 50 maps no
+drop of the default config arrives within 100 iterations (IWD's soil rule, issue 39), so the
+records of mosaic20 and maze20, where the drops arrive and the memory operators run, check the
+smoothing and the operators."""
+
+VARIANTS = {
+    "no smooth": dict(smooth=False),
+    "no operators": dict(operator_patience=10**9),
+    "no intersections": dict(first_intersection=False, second_intersection=False),
+    "no local search": dict(local_search=False),
+    "walk only": dict(smooth=False, operator_patience=10**9),
+}
+"""The config of each variant ``--stages`` times beside the default."""
+
+
+def digests(result) -> dict[str, str]:
+    """The digest of each leaf of a run's ``(state, trace)``, by its place in the tree."""
+    return {jax.tree_util.keystr(where): hashlib.sha256(
+        np.ascontiguousarray(np.asarray(leaf)).tobytes()).hexdigest()[:16]
+        for where, leaf in jax.tree_util.tree_leaves_with_path(key_data(result))}
+
+
+def record_source(records: dict) -> str:
+    """``records`` (map -> key -> leaf -> digest) as the source text of :data:`RECORDED`."""
+    lines = ["RECORDED = {"]
+    for name, keys in records.items():
+        lines.append(f'    "{name}": {{')
+        for key, leaves in keys.items():
+            lines.append(f"        {key}: {{")
+            items = [f'"{leaf}": "{digest}",' for leaf, digest in leaves.items()]
+            lines += ["            " + " ".join(items[i:i + 2]) for i in range(0, len(items), 2)]
+            lines.append("        },")
+        lines.append("    },")
+    return "\n".join(lines + ["}"])
+
+
+def measure(swarm, graph, task, keys, iterations: int, repeats: int):
+    """``(compile seconds, {key: (ms per iteration, iterations, best cost, digests)})``."""
+    params = swarm.default_params
+
+    def once(key):
+        return jax.block_until_ready(run(swarm, jax.random.key(key), graph, task, params,
+                                         iterations=iterations, patience=None))
+
+    began = time.perf_counter()
+    once(keys[0])
+    compile_seconds = time.perf_counter() - began
+    out = {}
+    for key in keys:
+        seconds = []
+        for _ in range(repeats):
+            began = time.perf_counter()
+            state, trace = once(key)
+            seconds.append(time.perf_counter() - began)
+        ran = int(trace.iterations)
+        out[key] = (1e3 * statistics.median(seconds) / ran, ran, float(state.best_cost),
+                    digests((state, trace)))
+    # The first call also ran once: its compile is the rest.
+    return compile_seconds - out[keys[0]][0] * out[keys[0]][1] / 1e3, out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--map", default=DEFAULT_MAP, help="a map jaxswarm demo takes")
+    parser.add_argument("--iterations", type=int, default=DEFAULT_ITERATIONS)
+    parser.add_argument("--keys", default="0,1,2", help="comma-separated PRNG seeds")
+    parser.add_argument("--repeats", type=int, default=5, help="timed runs per key (median)")
+    parser.add_argument("--threads", type=int, default=1,
+                        help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
+    parser.add_argument("--stages", action="store_true",
+                        help="also time the variants with a stage switched off")
+    parser.add_argument("--record", action="store_true",
+                        help="print this run's digests as RECORDED's source text")
+    args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be at least 1, got {args.repeats}")
+    # Before JAX's first computation; compile seconds are measured, so no cached programs.
+    if platform.machine().lower() in ("x86_64", "amd64"):
+        os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} {ISA_CAP}".strip()
+    jax.config.update("jax_enable_compilation_cache", False)
+    try:
+        configure(threads=args.threads)
+        keys = [int(key) for key in args.keys.split(",")]
+        chosen = named_map(args.map)
+    except ValueError as error:
+        parser.error(str(error))
+    graph = chosen.graph
+    task = make_task(graph, chosen.start, chosen.goal)
+    print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
+          f"({jax.default_backend()}, {args.threads} XLA thread(s), AVX2) | load "
+          f"{os.getloadavg()[0]:.1f}")
+    print(f"iwd_pg on {args.map} ({graph.shape[1]}x{graph.shape[0]}), {args.iterations} "
+          f"iterations, no patience, keys {keys}, median of {args.repeats}")
+    rows = [("default", {})] + (list(VARIANTS.items()) if args.stages else [])
+    print(f"{'variant':18} {'compile s':>9} {'ms/iter':>8} {'share':>6}  per key: ms/iter "
+          f"(iterations, best cost)")
+    baseline = None
+    for label, options in rows:
+        compile_seconds, out = measure(make("iwd_pg", **options), graph, task, keys,
+                                       args.iterations, args.repeats)
+        per_iteration = statistics.median(ms for ms, *_ in out.values())
+        baseline = per_iteration if baseline is None else baseline
+        share = "" if label == "default" else f"{(baseline - per_iteration) / baseline:>6.0%}"
+        print(f"{label:18} {compile_seconds:>9.1f} {per_iteration:>8.2f} {share:>6}  " + ", ".join(
+            f"{ms:.2f} ({ran}, {cost:.2f})" for ms, ran, cost, _ in out.values()), flush=True)
+        if label != "default":
+            continue
+        if args.record:
+            print(record_source({args.map: {key: leaves for key, (*_, leaves) in out.items()}}))
+        record = RECORDED.get(args.map, {}) if args.iterations == DEFAULT_ITERATIONS else {}
+        recorded = [key for key in keys if key in record]
+        if recorded:
+            changed = {key: sorted(leaf for leaf, digest in record[key].items()
+                                   if out[key][3].get(leaf) != digest) for key in recorded}
+            same = not any(changed.values())
+            print(f"same results as recorded (keys {recorded}): {'yes' if same else 'NO'}"
+                  + ("" if same else f" changed leaves: {changed}"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
