@@ -215,13 +215,16 @@ def test_robot_study_walks_every_row_to_the_goal_and_draws_it(quick):
 def test_iwd_table_counts_fitness_calls_and_never_beats_the_optimum(quick):
     folder, _, _ = quick
     rows = read_csv(folder / "iwd_paper_maps" / "runs.csv")
-    assert [(r["map"], r["seed"]) for r in rows] == [("maze20", "0"), ("maze20", "1")]
+    variants = ("paper", "while_walking", "backtrack", "hud20")  # every reading, in order
+    assert [(r["map"], r["variant"], r["seed"]) for r in rows] == [
+        ("maze20", variant, seed) for variant in variants for seed in ("0", "1")]
     for r in rows:
         assert float(r["cost"]) >= float(r["optimum"]) * (1 - 1e-6)
         # At most one fitness call per drop and iteration.
         assert 0 <= int(r["evaluations"]) <= 8 * int(r["iterations"])
         assert (r["found"] == "True") == (int(r["evaluations"]) > 0)
-    assert "| maze20 | 78.00 |" in (folder / "iwd_paper_maps" / "table.md").read_text()
+    table = (folder / "iwd_paper_maps" / "table.md").read_text()
+    assert all(f"| maze20 | {variant} | 78.00 |" in table for variant in variants)
 
 
 @pytest.mark.slow
