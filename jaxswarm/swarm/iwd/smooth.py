@@ -16,7 +16,7 @@ smooths a batch's distinct paths only, :data:`ROWS` at a time (under ``vmap`` a 
 runs until its slowest path), on the first ``W`` positions of the paths (the smallest of
 :func:`~.memory.widths` that holds them all: past a path's end every position is padding,
 where a pass finds nothing to replace). On grids and path maps a move's edge is found from
-the cells' coordinates and the slots' fixed directions (:func:`lattice_measure`) instead of a
+the cells' coordinates and the slots' fixed directions (:func:`lattice_costs`) instead of a
 search of the node's slots.
 """
 from __future__ import annotations
@@ -30,7 +30,7 @@ import numpy as np
 
 from jaxswarm.swarm.iwd.memory import width_index, widths
 from jaxswarm.world.graph import NO_NODE, Graph
-from jaxswarm.world.lattice import DIRECTIONS, slot_lengths
+from jaxswarm.world.lattice import DIRECTIONS, ORTHOGONAL_SLOTS, slot_lengths
 
 IMPROVEMENT = 1e-4
 """How much shorter (in length units) a replacement must be: float rounding is no improvement."""
@@ -39,22 +39,22 @@ ROWS = 8
 """Distinct paths smoothed together (one ``vmap`` of the passes' ``while_loop``)."""
 
 
-class Measure(NamedTuple):
-    """How a pass measures moves on one map (both functions give inf where there is no valid
-    edge, and take ``-1`` nodes).
+class Costs(NamedTuple):
+    """The lengths a pass compares, at each position ``t`` of a path (i32[W]); inf where
+    there is no valid edge (padding included).
 
     Attributes:
-      edge: ``(here i32[...], there i32[...]) -> f32[...]`` the length of the valid edge.
-      middles: ``(path i32[W], on_path bool[N]) -> (middle i32[W, K], first f32[W, K])`` each
-        position's neighbours through its slots (some node where a slot has none) and the
-        length of the valid edge to each one that is not on the path (else inf).
-      seconds: ``(path i32[W], middle i32[W, K], end i32[W]) -> f32[W, K]`` the length of the
-        valid edge from each middle node to the position's ``end``.
+      moves: three f32[W]: the moves ``p[t + i] -> p[t + i + 1]``, i = 0, 1, 2.
+      direct: ``{w: f32[W]}`` the edge ``p[t] -> p[t + w]``, w = 2, 3.
+      legs: ``{w: f32[W, K]}`` ``p[t] -> m -> p[t + w]`` through each slot's neighbour ``m``
+        of ``p[t]`` that is not on the path.
+      middle: i32[W, K] those neighbours (some node where a slot has none).
     """
 
-    edge: Callable
-    middles: Callable
-    seconds: Callable
+    moves: list
+    direct: dict
+    legs: dict
+    middle: jax.Array
 
 
 def edge_cost(graph: Graph, valid: jax.Array, here: jax.Array, there: jax.Array) -> jax.Array:
@@ -66,72 +66,90 @@ def edge_cost(graph: Graph, valid: jax.Array, here: jax.Array, there: jax.Array)
     return jnp.min(jnp.where(hit, graph.cost[row], jnp.inf), axis=-1)
 
 
-def graph_measure(graph: Graph) -> Measure:
-    """The :class:`Measure` of any graph: a move's edge searched among the node's slots."""
+def graph_costs(graph: Graph) -> Callable:
+    """``(path i32[W], on_path bool[N]) -> Costs`` on any graph: each edge searched among the
+    node's slots."""
     valid = graph.valid_edges()
 
-    def middles(path, on_path):
+    def costs(path, on_path):
+        ahead = [path] + [_shifted(path, by) for by in (1, 2, 3)]
         row = jnp.maximum(path, 0)
         middle = graph.nbr[row]
         first = jnp.where(valid[row] & ~on_path[jnp.maximum(middle, 0)], graph.cost[row],
                           jnp.inf)
-        return middle, first
+        legs = {w: first + edge_cost(graph, valid, middle, jnp.broadcast_to(
+            ahead[w][:, None], middle.shape)) for w in (2, 3)}
+        return Costs(
+            moves=[edge_cost(graph, valid, ahead[i], ahead[i + 1]) for i in range(3)],
+            direct={w: edge_cost(graph, valid, path, ahead[w]) for w in (2, 3)},
+            legs=legs, middle=middle)
 
-    def seconds(path, middle, end):
-        return edge_cost(graph, valid, middle, jnp.broadcast_to(end[:, None], middle.shape))
-
-    return Measure(edge=functools.partial(edge_cost, graph, valid), middles=middles,
-                   seconds=seconds)
+    return costs
 
 
-def lattice_measure(graph: Graph) -> Measure:
-    """The :class:`Measure` of a grid or path map, the same lengths as :func:`graph_measure`'s:
-    there the valid edge ``a -> b`` is the slot whose direction is ``b``'s cell minus ``a``'s
-    (a valid slot has its lattice neighbour, node ``a`` plus the slot's offset), of the slot's
-    length (``cost`` wherever a slot has a neighbour)."""
+def lattice_costs(graph: Graph) -> Callable:
+    """``(path i32[W], on_path bool[N]) -> Costs`` on a grid or path map, the same lengths as
+    :func:`graph_costs`: there the valid edge ``a -> b`` is the slot whose direction is ``b``'s
+    cell minus ``a``'s (a valid slot's neighbour is node ``a`` plus the slot's offset), of the
+    slot's length (``cost`` wherever a slot has a neighbour). Per position it gathers the
+    node's valid slots and its neighbours' (a table made once), not each edge's slots."""
     width, num_slots = graph.shape[1], graph.max_degree
     directions = DIRECTIONS[:num_slots]
-    slot_of = np.full(9, -1, np.int32)  # the slot of each (dx, dy) in [-1, 1]^2
-    slot_of[(directions[:, 1] + 1) * 3 + directions[:, 0] + 1] = np.arange(num_slots)
-    lengths = slot_lengths(graph)
+    offsets = directions @ np.array([1, width], np.int32)
     valid = graph.valid_edges()
-    bits = jnp.sum(valid.astype(jnp.int32) << jnp.arange(num_slots, dtype=jnp.int32), axis=1)
+    bits = jnp.sum(valid.astype(jnp.int32) << np.arange(num_slots, dtype=np.int32), axis=1)
+    neighbour = jnp.clip(jnp.arange(graph.num_nodes)[:, None] + offsets, 0, graph.num_nodes - 1)
+    reach = jnp.where(valid, bits[neighbour], 0)  # i32[N, K] the valid slots of each neighbour
+    step = functools.partial(_lattice_step, directions, slot_lengths(graph))
 
-    def step_length(a, dx, dy):
-        """The length of the valid move of cell offset (dx, dy) out of node ``a`` (>= 0)."""
-        near = (jnp.abs(dx) <= 1) & (jnp.abs(dy) <= 1)
-        slot = jnp.asarray(slot_of)[jnp.where(near, (dy + 1) * 3 + dx + 1, 4)]
-        open_slot = (bits[a] >> jnp.maximum(slot, 0)) & 1
-        return jnp.where((slot >= 0) & (open_slot == 1),
-                         jnp.asarray(lengths)[jnp.maximum(slot, 0)], jnp.inf)
+    def costs(path, on_path):
+        real = [_shifted(path, by) >= 0 if by else path >= 0 for by in range(4)]
+        node = jnp.maximum(path, 0)
+        x = [_shifted(node % width, by) for by in range(4)]
+        y = [_shifted(node // width, by) for by in range(4)]
+        open_here = [_shifted(bits[node], by) for by in range(3)]
 
-    def edge(here, there):
-        a, b = jnp.maximum(here, 0), jnp.maximum(there, 0)
-        length = step_length(a, b % width - a % width, b // width - a // width)
-        return jnp.where((here >= 0) & (there >= 0), length, jnp.inf)
+        def edge(i, j, open_bits):
+            return jnp.where(real[i] & real[j], step(x[j] - x[i], y[j] - y[i], open_bits),
+                             jnp.inf)
 
-    def middles(path, on_path):
-        row = jnp.maximum(path, 0)
-        offsets = jnp.asarray(directions @ np.array([1, width], np.int32))
-        middle = jnp.clip(row[:, None] + offsets, 0, graph.num_nodes - 1)
-        open_slot = (bits[row][:, None] >> jnp.arange(num_slots, dtype=jnp.int32)) & 1
-        return middle, jnp.where((open_slot == 1) & ~on_path[middle], jnp.asarray(lengths),
-                                 jnp.inf)
+        middle = jnp.clip(node[:, None] + offsets, 0, graph.num_nodes - 1)
+        slot_open = (open_here[0][:, None] >> np.arange(num_slots, dtype=np.int32)) & 1
+        first = jnp.where((slot_open == 1) & ~on_path[middle], slot_lengths(graph), jnp.inf)
+        legs = {w: first + jnp.where((real[0] & real[w])[:, None], step(
+            (x[w] - x[0])[:, None] - directions[:, 0], (y[w] - y[0])[:, None] - directions[:, 1],
+            reach[node]), jnp.inf) for w in (2, 3)}
+        return Costs(moves=[edge(i, i + 1, open_here[i]) for i in range(3)],
+                     direct={w: edge(0, w, open_here[0]) for w in (2, 3)}, legs=legs,
+                     middle=middle)
 
-    def seconds(path, middle, end):
-        a, b = jnp.maximum(path, 0), jnp.maximum(end, 0)
-        dx = (b % width - a % width)[:, None] - jnp.asarray(directions[:, 0])
-        dy = (b // width - a // width)[:, None] - jnp.asarray(directions[:, 1])
-        length = step_length(middle, dx, dy)
-        return jnp.where(((path >= 0) & (end >= 0))[:, None], length, jnp.inf)
-
-    return Measure(edge=edge, middles=middles, seconds=seconds)
+    return costs
 
 
-def measure_of(graph: Graph) -> Measure:
-    """The :class:`Measure` a pass uses on ``graph``: :func:`lattice_measure` on grids and path
-    maps, :func:`graph_measure` on other graphs."""
-    return lattice_measure(graph) if graph.is_grid else graph_measure(graph)
+def _lattice_step(directions: np.ndarray, lengths: np.ndarray, dx, dy, open_bits):
+    """f32[...]: the length of the lattice move of cell offset (``dx``, ``dy``) (i32[...]) when
+    its slot is set in ``open_bits`` (i32[...]), else inf. The slot of each offset in
+    ``[-1, 1]^2`` is read from a table packed into constants (4 bits an offset, 15 for none),
+    so no gather is made."""
+    table = np.full(9, 15, np.int64)
+    table[(directions[:, 1] + 1) * 3 + directions[:, 0] + 1] = np.arange(len(directions))
+    packed = np.uint32(sum(int(slot) << (4 * code) for code, slot in enumerate(table[:8])))
+    near = (jnp.abs(dx) <= 1) & (jnp.abs(dy) <= 1)
+    code = jnp.where(near, (dy + 1) * 3 + dx + 1, 4)  # (0, 0) and far offsets: no slot
+    shift = (4 * jnp.minimum(code, 7)).astype(jnp.uint32)
+    slot = jnp.where(code < 8, jnp.right_shift(jnp.uint32(packed), shift) & 15,
+                     np.uint32(table[8])).astype(jnp.int32)
+    # Slots 0-3 are orthogonal, 4-7 diagonal, each kind of one length (slot_lengths).
+    length = jnp.where(slot < ORTHOGONAL_SLOTS, lengths[0],
+                       lengths[min(ORTHOGONAL_SLOTS, len(lengths) - 1)])
+    return jnp.where((slot < 15) & (((open_bits >> jnp.minimum(slot, 15)) & 1) == 1), length,
+                     jnp.inf)
+
+
+def costs_of(graph: Graph) -> Callable:
+    """The :class:`Costs` of a pass on ``graph``: :func:`lattice_costs` on grids and path maps,
+    :func:`graph_costs` on other graphs."""
+    return lattice_costs(graph) if graph.is_grid else graph_costs(graph)
 
 
 def _shifted(path: jax.Array, by: int) -> jax.Array:
@@ -145,22 +163,16 @@ def _compact(path: jax.Array, keep: jax.Array) -> jax.Array:
     return jnp.full_like(path, NO_NODE).at[position].set(path, mode="drop")
 
 
-def _smooth_pass(num_nodes: int, measure: Measure, path: jax.Array):
-    """One pass over ``path`` (i32[L]) of a map of ``num_nodes`` nodes: ``(path, changed
-    bool[])``."""
-    ahead = [path] + [_shifted(path, by) for by in (1, 2, 3)]
-    move = [measure.edge(ahead[i], ahead[i + 1]) for i in range(3)]
-    window = {2: move[0] + move[1], 3: move[0] + move[1] + move[2]}  # inf past the end
+def _smooth_pass(num_nodes: int, costs_at: Callable, path: jax.Array):
+    """One pass over ``path`` (i32[L]) of a map of ``num_nodes`` nodes, its lengths from
+    ``costs_at`` (:func:`costs_of`): ``(path, changed bool[])``."""
     n = num_nodes
     on_path = jnp.zeros((n + 1,), bool).at[jnp.where(path >= 0, path, n)].set(True)[:n]
+    costs = costs_at(path, on_path)
+    move, direct = costs.moves, costs.direct
+    window = {2: move[0] + move[1], 3: move[0] + move[1] + move[2]}  # inf past the end
     # Through one middle node m: a -> m -> end, m a valid neighbour of a not on the path.
-    middle, first_leg = measure.middles(path, on_path)  # [L, K]
-    direct, via, via_node = {}, {}, {}
-    for w in (2, 3):
-        direct[w] = measure.edge(path, ahead[w])
-        legs = first_leg + measure.seconds(path, middle, ahead[w])
-        via[w] = jnp.min(legs, axis=-1)
-        via_node[w] = jnp.take_along_axis(middle, jnp.argmin(legs, axis=-1)[:, None], 1)[:, 0]
+    via = {w: jnp.min(costs.legs[w], axis=-1) for w in (2, 3)}
     short = {w: direct[w] < window[w] - IMPROVEMENT for w in (2, 3)}
     # Direct shortcuts: a window is taken when no candidate starts one or two moves before it,
     # so the windows taken share at most an end node.
@@ -181,7 +193,9 @@ def _smooth_pass(num_nodes: int, measure: Measure, path: jax.Array):
     any_middle = better[2] | better[3]
     t = jnp.argmax(any_middle)
     w = jnp.where(better[2][t], 2, 3)
-    m = jnp.where(better[2][t], via_node[2][t], via_node[3][t])
+    # The middle node of the shortest legs at t (the first slot among equals).
+    via_node = {w: costs.middle[t, jnp.argmin(costs.legs[w][t])] for w in (2, 3)}
+    m = jnp.where(better[2][t], via_node[2], via_node[3])
     rerouted = path.at[t + 1].set(m)
     rerouted = _compact(rerouted, ~((positions > t + 1) & (positions < t + w)))
     has_direct = jnp.any(taken)
@@ -189,10 +203,10 @@ def _smooth_pass(num_nodes: int, measure: Measure, path: jax.Array):
     return jnp.where(has_direct, shortened, jnp.where(changed, rerouted, path)), changed
 
 
-def _passes(num_nodes: int, measure: Measure, path: jax.Array) -> jax.Array:
+def _passes(num_nodes: int, costs_at: Callable, path: jax.Array) -> jax.Array:
     """i32[L]: ``path`` after passes until one changes nothing."""
     def one_pass(carry):
-        return _smooth_pass(num_nodes, measure, carry[0])
+        return _smooth_pass(num_nodes, costs_at, carry[0])
 
     return jax.lax.while_loop(lambda carry: carry[1], one_pass, (path, jnp.array(True)))[0]
 
@@ -201,7 +215,7 @@ def smooth_path(graph: Graph, path: jax.Array) -> jax.Array:
     """i32[L]: ``path`` (i32[L], -1 padded, a walk on the current map) after the global smooth
     operator (module docstring), repeated until nothing changes. A path of fewer than three
     nodes, or padding, comes back as it was."""
-    return _passes(graph.num_nodes, measure_of(graph), path)
+    return _passes(graph.num_nodes, costs_of(graph), path)
 
 
 def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array) -> jax.Array:
@@ -210,11 +224,11 @@ def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array) -> jax.Array:
     they were; worked on the smallest of :func:`~.memory.widths` that holds every path of
     ``which``."""
     length = paths.shape[1]
-    measure = measure_of(graph)
+    costs_at = costs_of(graph)
 
     def within(width):
         def smooth(paths):
-            smoothed = _smooth_distinct(graph.num_nodes, measure, paths[:, :width], which)
+            smoothed = _smooth_distinct(graph.num_nodes, costs_at, paths[:, :width], which)
             return jnp.pad(smoothed, ((0, 0), (0, length - width)), constant_values=NO_NODE)
         return smooth
 
@@ -223,7 +237,7 @@ def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array) -> jax.Array:
     return jnp.where(which[:, None], smoothed, paths)
 
 
-def _smooth_distinct(num_nodes: int, measure: Measure, paths: jax.Array, which: jax.Array):
+def _smooth_distinct(num_nodes: int, costs_at: Callable, paths: jax.Array, which: jax.Array):
     """i32[A, W]: the paths (i32[A, W]) where ``which`` (bool[A]) smoothed, each distinct one
     once, :data:`ROWS` at a time (rows of a batch not in ``which`` as they were)."""
     count = paths.shape[0]
@@ -238,7 +252,7 @@ def _smooth_distinct(num_nodes: int, measure: Measure, paths: jax.Array, which: 
         chosen = jax.lax.dynamic_slice(order, (b * ROWS,), (ROWS,))
         batch_paths = jnp.where((chosen < count)[:, None], paths[jnp.minimum(chosen, count - 1)],
                                 NO_NODE)
-        smoothed = jax.vmap(functools.partial(_passes, num_nodes, measure))(batch_paths)
+        smoothed = jax.vmap(functools.partial(_passes, num_nodes, costs_at))(batch_paths)
         return done.at[chosen].set(smoothed, mode="drop")
 
     done = jax.lax.fori_loop(0, -(-jnp.sum(distinct) // ROWS), batch, paths)
