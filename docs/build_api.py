@@ -27,6 +27,7 @@ import contextlib
 import functools
 import importlib
 import inspect
+import os
 import pkgutil
 import re
 import sys
@@ -160,6 +161,10 @@ def build(out: Path, *, source: bool = True, search: bool = True
       annotation it could not read, a docstring it could not convert, ...).
     """
     configure(source=source, search=search)
+    # pdoc hides a constant whose value is also an environment variable's, for fear of secrets;
+    # jaxswarm's own constants are public, and one (the instruction set flag) is what importing
+    # jaxswarm puts in $XLA_FLAGS.
+    os.environ["PDOC_DISPLAY_ENV_VARS"] = "1"
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         names = module_names()

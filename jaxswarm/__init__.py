@@ -44,13 +44,16 @@ contract in ``pyproject.toml``, checked by the tests):
 * :mod:`jaxswarm.cli`: the ``jaxswarm`` command.
 
 Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can
-still be called after it. When ``JAXSWARM_CACHE`` names a folder, importing it keeps compiled
-programs there (:mod:`jaxswarm.runtime.cache`).
+still be called after it. On x86-64 it caps XLA:CPU's instruction set at AVX, so that one key
+gives one result in any batch (:mod:`jaxswarm.runtime.arithmetic`); import it before JAX's first
+computation. When ``JAXSWARM_CACHE`` names a folder, importing it keeps compiled programs there
+(:mod:`jaxswarm.runtime.cache`).
 """
 import importlib.metadata
 
-from jaxswarm.runtime import cache
+from jaxswarm.runtime import arithmetic, cache
 
+arithmetic.require_fixed_arithmetic()  # before JAX starts: XLA reads its flags then
 cache.from_environment()  # before jaxswarm.exact imports numba, which reads its cache folder then
 
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, replanner

@@ -17,6 +17,10 @@ or its solution breaks a rule.
 ``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
 map.
+
+``jaxswarm replay STORE ROW`` runs one row of a sweep store again, alone
+(:mod:`jaxswarm.sweep.replay`), prints the stored and the replayed figures, draws the run and
+exits with status 1 when the replay does not reproduce the row bit for bit.
 """
 from __future__ import annotations
 
@@ -58,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--threads: {error}")
     try:
         command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
-                   "sweep": run_sweep_command}
+                   "sweep": run_sweep_command, "replay": run_replay}
         return command[args.command](args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
@@ -79,6 +83,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_robot_parser(commands)
     _add_mapf_parser(commands)
     _add_sweep_parser(commands)
+    _add_replay_parser(commands)
     return parser
 
 
@@ -158,6 +163,40 @@ def _add_sweep_parser(subparsers) -> None:
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--no-plots", action="store_true", help="write no figures")
+
+
+def _add_replay_parser(subparsers) -> None:
+    """The ``replay`` sub-command: run one row of a sweep store again, alone."""
+    replay = subparsers.add_parser(
+        "replay", help="run one row of a sweep store again, alone, check that it gives the "
+                       "stored figures bit for bit and draw it")
+    replay.add_argument("store", type=Path, help="a sweep's results directory")
+    replay.add_argument("row", type=int,
+                        help="the row's position in jaxswarm.sweep.read_results(STORE), from 0")
+    replay.add_argument("--out", type=Path,
+                        help="folder of the figure (default out/replay/STORE_NAME)")
+
+
+def run_replay(args: argparse.Namespace) -> int:
+    """Replay the row, print stored and replayed figures, write the figure; exit status 1 when
+    the replay differs from the row."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from jaxswarm.plot.sweep import plot_replay
+    from jaxswarm.sweep.replay import CHECKED, replay_row
+
+    replayed = replay_row(args.store, args.row)
+    row = replayed.row
+    print(f"{args.store} row {args.row}: {row['algorithm']} on {row['map']}, run {row['run']}, "
+          f"seed {row['seed']}")
+    for name in CHECKED:
+        mark = "" if f"{name}:" not in " ".join(replayed.differences) else "   <- differs"
+        print(f"  {name:<12} stored {row[name]!s:<20} replayed {replayed.figures[name]!s}{mark}")
+    out = args.out if args.out is not None else Path("out/replay") / Path(args.store).name
+    print(f"wrote {plot_replay(replayed, out / f'row{args.row}.png')}")
+    print("reproduced bit for bit" if replayed.reproduced else "the replay differs from the row")
+    return 0 if replayed.reproduced else 1
 
 
 def run_sweep_command(args: argparse.Namespace) -> int:

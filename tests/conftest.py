@@ -2,16 +2,12 @@ import os
 from pathlib import Path
 
 import pytest
-from golden.isa import cap_isa
 from jaxswarm.runtime.cpu import THREADS_VARIABLE
 
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
 # Where the library looks for Moving AI maps named in sweep specs (it never guesses a folder).
 os.environ.setdefault("JAXSWARM_MOVINGAI", str(MOVINGAI))
-# The golden records hold bit for bit only for one set of vector instructions (golden/isa.py); the
-# scripts and notebooks the tests start inherit the setting.
-cap_isa()
 # Each pytest-xdist worker gets its share of the cores for XLA's thread pool (by default each
 # would take one thread per core, and the workers' threads would take turns on the same cores);
 # the scripts and notebooks a worker starts inherit it.

@@ -15,7 +15,7 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
 from jaxswarm.swarm.testing import (Compilations, check_compiles_once, check_reproducible,
-                                    check_valid_results)
+                                     check_valid_results)
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution

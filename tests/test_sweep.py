@@ -23,15 +23,19 @@ from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.maps.planes import paper_plane
 from jaxswarm.plot.sweep import heatmap_figure, line_figure, plot_sweep, summary
-from jaxswarm.swarm import definition, make, make_task, run
+import jaxswarm
+from jaxswarm.swarm import definition, make, make_task, registered, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
+from jaxswarm.sweep.maps import resolve_map
+from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.runner import group_size
+from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 
 REPO = Path(__file__).resolve().parents[1]
 
 OUTCOME_COLUMNS = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "iterations",
-                   "moves"]
+                   "moves", "fingerprint"]
 """What a run decides, without its timing: equal wherever and however the runs are batched."""
 
 
@@ -281,13 +285,13 @@ def test_a_store_records_the_swarms_definition_and_refuses_another(finished, tmp
         run_sweep(spec, copy, progress=False)
 
 
-def test_a_store_of_0_5_0_is_not_resumed(finished, tmp_path):
+def test_a_store_of_0_6_0_is_not_resumed(finished, tmp_path):
     spec, out, _ = finished
     old = tmp_path / "old"
     shutil.copytree(out, old)
-    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.5.0"))  # same definition, older results
-    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.5\.0, whose swarms "
-                                                 r"computed otherwise \(results changed in 0\.6\.0"):
+    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.6.0"))  # same definition, older results
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.6\.0, whose swarms "
+                       r"computed otherwise \(results changed in 0\.7\.0"):
         run_sweep(spec, old, progress=False)
 
 
@@ -499,3 +503,94 @@ def test_two_processes_with_jax_distributed_give_identical_rows(finished, tmp_pa
     assert all(p.returncode == 0 for p in processes), outputs
     assert all("processes 2 devices 4" in stdout for stdout, _ in outputs)
     pd.testing.assert_frame_equal(read_results(out)[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
+
+
+ONE_KEY = textwrap.dedent("""
+    import sys
+    from jaxswarm.runtime.cpu import configure
+    configure(threads=int(sys.argv[1]), devices=int(sys.argv[2]))
+    import jax
+    from jaxswarm.sweep import spec_from_dict, run_sweep
+    run_sweep(spec_from_dict({document!r}), sys.argv[3], progress=False, log=print)
+    print("devices", len(jax.devices()))
+""")
+"""A sweep run in a process of its own, with the threads and devices its arguments name."""
+
+
+def one_key_document(name: str) -> dict:
+    """A sweep of ``name`` over 4 seeds in chunks of 4 (2 runs a device on 2 devices)."""
+    on_plane = make(name).world is not jaxswarm.Graph
+    config = {"num_agents": 8} | ({"local_updates": "while_walking"} if name == "iwd" else {})
+    return {"sweep": {"name": f"one_key_{name}", "algorithm": name, "seeds": 4,
+                      "maps": [{"plane": "map1"}] if on_plane else ["mosaic20"],
+                      "iterations": 4, "chunk_size": 4},
+            "config": config}
+
+
+@pytest.mark.parametrize("name", [
+    "iwd", *(pytest.param(name, marks=pytest.mark.slow) for name in registered()
+             if name != "iwd")])
+def test_a_row_is_the_run_alone_on_any_thread_and_device_count_and_process(name, tmp_path):
+    # iwd with drops that change the soil as they walk, the walker's hardest case.
+    document = one_key_document(name)
+    fingerprints = []
+    for threads, devices in ((1, 1), (2, 2)):
+        out = tmp_path / f"{threads}-{devices}"
+        done = subprocess.run(
+            [sys.executable, "-c", ONE_KEY.format(document=document), str(threads),
+             str(devices), str(out)], capture_output=True, text=True, timeout=600, cwd=REPO)
+        assert done.returncode == 0, done.stderr
+        assert f"devices {devices}" in done.stdout
+        fingerprints.append(list(read_results(out)["fingerprint"]))
+    spec = spec_from_dict(document)
+    swarm = make(name, **spec.config)
+    sweep_map = resolve_map(spec.maps[0])
+    task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
+    alone = [hex_fingerprint(run_fingerprint(*run(
+        swarm, jax.random.key(seed), sweep_map.world, task, swarm.default_params,
+        iterations=spec.iterations))) for seed in spec.seeds]
+    assert fingerprints == [alone, alone]
+
+
+def test_a_replayed_row_gives_the_stored_figures_bit_for_bit(finished, tmp_path):
+    _, out, frame = finished
+    for row in (0, 7, 23):
+        replayed = replay_row(out, row)
+        assert replayed.reproduced, replayed.differences
+        assert replayed.figures["fingerprint"] == frame["fingerprint"][row]
+    figure = tmp_path / "figures"
+    done = subprocess.run([sys.executable, "-m", "jaxswarm.cli", "replay", str(out), "13",
+                           "--out", str(figure)], capture_output=True, text=True, timeout=600,
+                          cwd=REPO)
+    assert done.returncode == 0, done.stderr
+    assert "reproduced bit for bit" in done.stdout and (figure / "row13.png").is_file()
+
+
+def test_a_replay_that_differs_says_which_figure_and_a_bad_row_is_named(finished, tmp_path):
+    _, out, _ = finished
+    copy = tmp_path / "tampered"
+    shutil.copytree(out, copy)
+    part = sorted((copy / "runs").glob("part-*.parquet"))[0]
+    rows = pd.read_parquet(part)
+    rows.loc[0, "moves"] += 1
+    rows.to_parquet(part)
+    replayed = replay_row(copy, 0)
+    assert not replayed.reproduced and [d.split(":")[0] for d in replayed.differences] == ["moves"]
+    with pytest.raises(ValueError, match="rows 0 to 23, not row 24"):
+        replay_row(out, 24)
+    with pytest.raises(ValueError, match="not a sweep store"):
+        replay_row(tmp_path, 0)
+
+
+@pytest.mark.slow  # about a minute
+def test_twenty_random_rows_of_a_thousand_run_store_replay_bit_for_bit(tmp_path):
+    spec = spec_from_dict({
+        "sweep": {"name": "thousand", "algorithm": "aco_star", "maps": ["mosaic20"],
+                  "seeds": 100, "iterations": 6, "chunk_size": 500},
+        "config": {"num_agents": 16},
+        "params": {"rho": {"start": 0.05, "stop": 0.5, "num": 10}}})
+    frame = run_sweep(spec, tmp_path / "store", progress=False, log=lambda _: None)
+    assert len(frame) == 1000
+    for row in np.random.default_rng(0).choice(1000, 20, replace=False):
+        replayed = replay_row(tmp_path / "store", int(row))
+        assert replayed.reproduced, (row, replayed.differences)

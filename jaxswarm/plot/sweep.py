@@ -1,7 +1,8 @@
-"""Figures from a sweep's results: heat maps over two params, lines over one, faceted by map.
+"""Figures from a sweep's results: heat maps over two params, lines over one, faceted by map,
+and one replayed row (:func:`plot_replay`).
 
-Every function takes the DataFrame of :func:`jaxswarm.sweep.read_results` (one row per run with
-the swept params as columns) and aggregates over seeds (and over any params not drawn).
+The figures of many runs take the DataFrame of :func:`jaxswarm.sweep.read_results` (one row per
+run with the swept params as columns) and aggregate over seeds (and over any params not drawn).
 """
 from __future__ import annotations
 
@@ -12,7 +13,10 @@ import numpy as np
 import pandas as pd
 from matplotlib import patheffects
 
-from jaxswarm.plot.graph import save_png
+from jaxswarm.plot.graph import draw_trace, plot_swarm_run, save_png
+from jaxswarm.plot.plane import draw_plane, draw_trajectory
+from jaxswarm.sweep.replay import Replayed
+from jaxswarm.world.plane import Plane
 
 METRICS = {"success": "success rate", "gap": "mean gap to the optimum"}
 
@@ -108,6 +112,32 @@ def plot_sweep(frame: pd.DataFrame, params: list[str], out_dir,
         _save(line_figure(frame, name, log=name in log_scale), path)
         written.append(path)
     return written
+
+
+def plot_replay(replayed: Replayed, path) -> Path:
+    """Write the figure of a replayed row to ``path`` (PNG) and return it: on a graph the
+    swarm's memory with its best path, on a plane the best trajectory; beside it the run's
+    convergence, titled with whether the replay reproduced the row."""
+    row, world = replayed.row, replayed.sweep_map.world
+    solution = replayed.swarm.best(replayed.state)
+    verdict = "reproduces the row" if replayed.reproduced else "differs from the row"
+    title = (f"{replayed.swarm.name} on {row['map']}, run {row['run']} (seed {row['seed']}): "
+             f"{verdict}")
+    start, goal = replayed.sweep_map.start, replayed.sweep_map.goal
+    if isinstance(world, Plane):
+        fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.5))
+        draw_plane(left, world, start=start, goal=goal)
+        draw_trajectory(left, solution.path, label=f"best ({float(solution.cost):.2f})",
+                        color="tab:red")
+        left.legend(loc="upper right")
+        draw_trace(right, replayed.trace, optimum=row["optimum"])
+        fig.suptitle(title)
+    else:
+        fig = plot_swarm_run(world, replayed.swarm.memory(replayed.state), solution,
+                             replayed.trace, start=start, goal=goal, optimum=row["optimum"],
+                             field_label=replayed.swarm.memory_label, title=title)
+    _save(fig, Path(path))
+    return Path(path)
 
 
 def _save(fig, path: Path) -> None:

@@ -56,7 +56,7 @@ def configure(*, devices: int | None = None, threads: int | None = None,
     for name, value in (("devices", devices), ("threads", threads)):
         if value is not None and (not isinstance(value, int) or value < 1):
             raise ValueError(f"{name} must be a whole number of at least 1, got {value!r}")
-    if _backends_started():
+    if backends_started():
         raise RuntimeError("jaxswarm.runtime.cpu.configure must be called before JAX's first "
                            "computation (JAX reads the device count and thread pool size when "
                            "it starts); call it right after `import jax`")
@@ -68,7 +68,7 @@ def configure(*, devices: int | None = None, threads: int | None = None,
         enable_cache(cache)
 
 
-def _backends_started() -> bool:
+def backends_started() -> bool:
     """Whether JAX has started its backends. JAX's public API has no query for it, but it refuses
     a new CPU device count once they have started: try one, then put the old one back."""
     current = jax.config.jax_num_cpu_devices

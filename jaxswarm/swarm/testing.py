@@ -12,9 +12,15 @@ Each check raises ``AssertionError`` naming what failed:
   rectangle, and its cost is :func:`jaxswarm.world.plane.trajectory_length`.
 * :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
   and new values of the same shapes do not compile again.
+* :func:`check_batch_invariant`: one key, one result: a run alone equals the same key in
+  batches of 1, 3 and 64 runs, every leaf bit for bit. Threads, devices and processes are set
+  when a process starts, so they are checked across processes: a sweep's rows
+  (:func:`jaxswarm.sweep.run_sweep`) carry each run's fingerprint
+  (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`) to compare with the run alone.
 
-The three checks share two programs per swarm: one run, and one batch of ``runs`` runs with
-their keys and params batched (:func:`run_batch`), so a suite pays each swarm's compile twice.
+The first three checks share two programs per swarm: one run, and one batch of ``runs`` runs
+with their keys and params batched (:func:`run_batch`); :func:`check_batch_invariant` adds one
+batch program per width.
 :class:`Compilations` counts the programs JAX builds while it is open, for checks of one's own
 (a change of the map that must not recompile, a grid of params).
 
@@ -207,8 +213,46 @@ def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: i
     assert jax.vmap(swarm.best)(state).cost.shape == (runs,)
 
 
+WIDTHS = (1, 3, 64)
+"""The batch widths :func:`check_batch_invariant` runs each key in by default."""
+
+
+def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations: int = 8,
+                          widths: tuple[int, ...] = WIDTHS, keys: int | None = None,
+                          runs: list | None = None) -> list:
+    """One key, one result: each of ``keys`` keys (default the widest width) run alone equals
+    the same key in vmapped batches (:func:`run_batch`) of each of ``widths``, every leaf of its
+    final state and trace bit for bit (:func:`outcome`). The last batch of a width is filled
+    with the first keys again.
+
+    Args:
+      runs: the keys' runs alone (:func:`outcome` of each), when the caller has them already.
+
+    Returns:
+      The runs alone, for another check of the same keys.
+    """
+    count = max(widths) if keys is None else keys
+    split = jax.random.split(jax.random.key(11), count)
+    params = swarm.default_params
+    if runs is None:
+        runs = [outcome(run(swarm, key, world, task, params, iterations=iterations))
+                for key in split]
+    for width in widths:
+        for first in range(0, count, width):
+            rows = np.minimum(np.arange(first, first + width), count - 1)
+            batch = outcome(run_batch(swarm, split[rows], world, task,
+                                      batched_params(params, width), iterations=iterations))
+            for row in range(min(width, count - first)):
+                assert leaves_equal(jax.tree_util.tree_map(lambda x: x[row], batch),
+                                    runs[first + row]), (
+                    f"{swarm.name}: key {first + row} alone differs from the same key in a "
+                    f"batch of {width}")
+    return runs
+
+
 def check_swarm(swarm: Swarm, graph: World, task: Task, optimum: float) -> None:
     """Every check of this module, with their defaults."""
     check_reproducible(swarm, graph, task)
+    check_batch_invariant(swarm, graph, task)
     check_valid_results(swarm, graph, task, optimum)
     check_compiles_once(swarm, graph, task)

@@ -10,12 +10,10 @@ of agents over the walker's lanes (:func:`jaxswarm.swarm.walking.walk`), and a r
 walks no more, so small swarms fill the lanes from many runs: the group is ``vmap_size`` runs, by
 default enough to fill the lanes (:func:`group_size`).
 Maps of the same shape share the compiled program; each compile is logged. A run with seed
-``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
-whatever the chunk size, the group size and the number of devices, as far as XLA compiles a
-run's arithmetic alike in groups of different sizes: it fuses a multiply and an add into one FMA
-as its fusions allow, and very wide groups may fuse otherwise, which on rare runs changes the last
-bit of a number a random choice depends on (``cabc``: 2 of 100 runs differed in a group of 1,000;
-none at the default group sizes).
+``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)`` bit for
+bit whatever the chunk size, the group size and the number of devices or threads (the arithmetic
+of :mod:`jaxswarm.runtime.arithmetic`); its ``fingerprint`` column says so
+(:func:`jaxswarm.sweep.replay.replay_row` reruns a row alone and compares).
 
 Each map's optimum is measured as the swarms measure their paths (Dijkstra's path on a graph,
 :func:`jaxswarm.exact.optimal_length`; the visibility-graph shortest path on a plane,
@@ -44,6 +42,7 @@ from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap, check_query, resolve_map
 from jaxswarm.sweep.spec import SweepSpec
@@ -76,10 +75,11 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
       ``seed``, one column per swept param, ``cost`` (inf if no path), ``optimum``, ``gap``
       (relative), ``found``, ``success`` (gap < 1e-4), ``iterations`` (used), ``moves`` (made
       by its agents, all iterations), ``evaluations`` (complete paths evaluated, all
-      iterations: fitness calls), ``chunk`` (the compiled batch the run was part of) and
-      ``chunk_seconds`` (that whole chunk's wall time,
-      compile excluded: the same in each of its rows; runs of a chunk run together, so no run
-      has a time of its own).
+      iterations: fitness calls), ``fingerprint`` (16 hex digits of the run's final state and
+      trace, :func:`~jaxswarm.swarm.fingerprint.run_fingerprint`), ``chunk`` (the compiled
+      batch the run was part of) and ``chunk_seconds`` (that whole chunk's wall time, compile
+      excluded: the same in each of its rows; runs of a chunk run together, so no run has a
+      time of its own).
 
     Raises:
       ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec
@@ -194,11 +194,10 @@ def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: li
         inputs = _chunk_inputs(chunks.params, chunks.seeds, first, chunks.padded,
                                chunks.num_runs, chunks.batch_sharding)
         began = time.perf_counter()
-        cost, iterations, moves, evaluations = _gather(compiled(*inputs, world, task))
+        outputs = _gather(compiled(*inputs, world, task))
         seconds = time.perf_counter() - began
         rows = _rows(spec, chunks.grid, chunks.seeds, sweep_map.label, map_index, c, first,
-                     count, cost[:count], iterations[:count], moves[:count],
-                     evaluations[:count], best, seconds)
+                     count, *(x[:count] for x in outputs), best, seconds)
         if chunks.writer:
             chunks.store.write_chunk(map_index, c, rows)
         bar.update(count)
@@ -250,7 +249,8 @@ def group_size(num_agents: int) -> int:
 
 def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
     """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], world, task) -> (cost
-    f32[C], iterations i32[C], moves i32[C], evaluations i32[C])``, C a multiple of the mesh
+    f32[C], iterations i32[C], moves i32[C], evaluations i32[C], fingerprint u32[C, 2])``
+    (:func:`~jaxswarm.swarm.fingerprint.run_fingerprint`), C a multiple of the mesh
     size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
     ``group`` at a time."""
     def one(run_input, world, task):
@@ -258,7 +258,7 @@ def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
         state, trace = run(swarm, jax.random.key(seed), world, task, params,
                            iterations=spec.iterations, patience=spec.patience)
         return (swarm.best(state).cost, trace.iterations, jnp.sum(trace.moves),
-                jnp.sum(trace.evaluations))
+                jnp.sum(trace.evaluations), run_fingerprint(state, trace))
 
     def share(seeds, params, world, task):
         return jax.lax.map(lambda run_input: one(run_input, world, task), (seeds, params),
@@ -304,7 +304,7 @@ def _gather(outputs):
 
 
 def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, cost, iterations,
-          moves, evaluations, best, seconds) -> dict:
+          moves, evaluations, fingerprints, best, seconds) -> dict:
     runs = np.arange(first, first + count)
     cost = np.asarray(cost, np.float64)
     found = np.isfinite(cost)
@@ -317,6 +317,7 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, first, count, c
     rows.update(cost=cost, optimum=np.full(count, best), gap=gap, found=found,
                 success=found & (gap < SUCCESS_GAP), iterations=np.asarray(iterations, np.int32),
                 moves=np.asarray(moves, np.int64), evaluations=np.asarray(evaluations, np.int64),
+                fingerprint=[hex_fingerprint(f) for f in fingerprints],
                 chunk_seconds=np.full(count, seconds), chunk=np.full(count, chunk, np.int32))
     return rows
 

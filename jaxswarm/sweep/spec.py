@@ -161,6 +161,17 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
     return spec
 
 
+def spec_from_record(record: dict, *, source: str) -> SweepSpec:
+    """The spec a store recorded (:meth:`SweepSpec.as_dict`, in its ``metadata.json``), checked
+    again as :func:`spec_from_dict` checks a document; ``source`` names the record in errors."""
+    sweep = {key: record[key] for key in ("name", "algorithm", "maps", "seeds", "iterations",
+                                          "chunk_size")}
+    if record.get("patience") is not None:
+        sweep["patience"] = record["patience"]
+    return spec_from_dict({"sweep": sweep, "config": record["config"],
+                           "params": record["params"]}, source=source)
+
+
 def _sweep_table(document: dict, fail) -> dict:
     """The [sweep] table, once the document has only known sections and the table only known
     keys, among them the required ``algorithm``, ``maps`` and ``seeds``."""

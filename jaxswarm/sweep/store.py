@@ -92,9 +92,9 @@ def _differences(before: dict, after: dict) -> list[str]:
     return sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
 
 
-SAME_RESULTS_SINCE = (0, 6)
-"""The jaxswarm release since which a run's results are the same: 0.6.0 reads the papers again
-where IWD, IWD_PG, RFD*, Ant System, ACO* and cABC computed otherwise (see CHANGELOG.md), so a
+SAME_RESULTS_SINCE = (0, 7)
+"""The jaxswarm release since which a run's results are the same: 0.7.0 computes with arithmetic
+that does not depend on the batch (:mod:`jaxswarm.runtime.arithmetic`; see CHANGELOG.md), so a
 store of an older release is not resumed."""
 
 

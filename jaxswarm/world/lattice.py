@@ -20,6 +20,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.arithmetic import ordered_sum
+
 if TYPE_CHECKING:
     from jaxswarm.world.graph import Graph
 
@@ -79,7 +81,7 @@ def total_length(graph: Graph, nodes: jax.Array, slots: jax.Array) -> jax.Array:
     general graphs the lengths are summed.
     """
     if not graph.is_grid:
-        return jnp.sum(move_lengths(graph, nodes, slots), axis=-1)
+        return ordered_sum(move_lengths(graph, nodes, slots), axis=-1)
     return lattice_length(jnp.sum(slots >= 0, axis=-1),
                           jnp.sum(slots >= ORTHOGONAL_SLOTS, axis=-1))
 

@@ -24,6 +24,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.arithmetic import ordered_sum
+
 
 @dataclasses.dataclass(frozen=True)
 class Plane:
@@ -113,7 +115,7 @@ def in_plane(plane: Plane, points: jax.Array) -> jax.Array:
 def trajectory_length(waypoints: jax.Array) -> jax.Array:
     """f32[]: the length of a polyline f32[L, 2] padded with NaN rows (padding ends it)."""
     segments = jnp.linalg.norm(waypoints[1:] - waypoints[:-1], axis=-1)
-    return jnp.sum(jnp.where(jnp.isnan(segments), 0.0, segments))
+    return ordered_sum(jnp.where(jnp.isnan(segments), 0.0, segments))
 
 
 def check_point(plane: Plane, point, *, name: str = "point") -> tuple[float, float]:

@@ -19,6 +19,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.aco.bug2 import direction_cosine
 from jaxswarm.swarm.core import Swarm, Task, best_solution, check_positive, keep_best
 from jaxswarm.swarm.walking import (FORCED, edge_table, goal_log_distance, heads, step_budget,
@@ -153,7 +154,7 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
     adapt = pheromone_rule if init_best is None else first_path_rule(init_best)
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
                  best=best_solution, default_params=default_params, check_params=check_params,
-                 memory=lambda state: state.pheromone.sum(axis=-1),
+                 memory=lambda state: ordered_sum(state.pheromone),
                  memory_label="pheromone on a node's edges", adapt=adapt)
 
 

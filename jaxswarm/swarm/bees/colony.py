@@ -26,6 +26,8 @@ from typing import Callable, NamedTuple
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import ordered_sum
+
 ONLOOKER_ROUNDS = 8
 """Rounds over the sources in which onlookers are sent (eq. 10 gives a feasible source p >= 0.5,
 so N onlookers need about two; a colony whose sources are all infeasible with equal violations has
@@ -89,7 +91,7 @@ def onlooker_probabilities(phi: jax.Array, violations: jax.Array) -> jax.Array:
     ``0.5 (1 - viol_i / sum_j viol_j)`` for an infeasible one."""
     fit = fitness(phi)
     total_violations = jnp.maximum(jnp.sum(violations), 1).astype(jnp.float32)
-    return jnp.where(violations == 0, 0.5 + 0.5 * fit / jnp.sum(fit),
+    return jnp.where(violations == 0, 0.5 + 0.5 * fit / ordered_sum(fit),
                      0.5 * (1.0 - violations / total_violations))
 
 

@@ -42,6 +42,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.world.plane import Plane, crossings, violations
 
 
@@ -84,7 +85,7 @@ def pushback(points: jax.Array, plane: Plane, lower: jax.Array, upper: jax.Array
              reach: jax.Array) -> jax.Array:
     """f2: f32[N], ``sum over the four rays of (reach - distance)`` (see the module docstring)."""
     boxes, seen = visible_rectangles(plane, lower, upper)
-    return jnp.sum(reach - ray_distances(points, boxes, seen, reach), axis=-1)
+    return ordered_sum(reach - ray_distances(points, boxes, seen, reach), axis=-1)
 
 
 TURN_UNITS = ("degrees", "radians")

@@ -27,6 +27,7 @@ import jax.numpy as jnp
 import numpy as np
 import optax
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.core import Swarm, Task, run
 from jaxswarm.world.plane import Plane
 
@@ -61,7 +62,7 @@ def objective(lengths: jax.Array, reached: jax.Array, worst: float) -> Score:
     """Eq. 11 from runs: ``lengths`` f32[..., K] (inf where a run did not arrive) and ``reached``
     bool[..., K] -> :class:`Score` over the leading axes."""
     target = jnp.sum(reached, axis=-1, dtype=jnp.int32)
-    total = jnp.sum(jnp.where(reached, lengths, 0.0), axis=-1)
+    total = ordered_sum(jnp.where(reached, lengths, 0.0))
     avg = jnp.where(target > 0, total / jnp.maximum(target, 1), jnp.nan)
     return Score(avg_length=avg, target=target,
                  objective=jnp.where(target > 0, avg / (1.0 + target), worst))

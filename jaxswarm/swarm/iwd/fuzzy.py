@@ -29,6 +29,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 from jaxswarm.world.paths import step_slots
@@ -61,7 +62,7 @@ def fuzzy_score(spl: jax.Array, ospl: jax.Array) -> jax.Array:
                           for s in (LOW, MEDIUM, HIGH)], axis=-1)
     points = jnp.linspace(0.0, 1.0, OUTPUT_POINTS)
     shape = jnp.max(jnp.minimum(strength[..., None, :], memberships(points)), axis=-1)
-    return jnp.sum(shape * points, axis=-1) / jnp.maximum(jnp.sum(shape, axis=-1), 1e-12)
+    return ordered_sum(shape * points) / jnp.maximum(ordered_sum(shape), 1e-12)
 
 
 def section_of(graph: Graph, coordinate: jax.Array, axis, sections: int) -> jax.Array:
@@ -89,7 +90,7 @@ def section_scores(lengths: jax.Array, present: jax.Array) -> jax.Array:
       lengths: f32[P, S] SPL of each path in each section (:func:`section_lengths`).
       present: bool[P] the paths to compare (remembered ones); the others score 0.
     """
-    total = jnp.sum(lengths, axis=-1, keepdims=True)
+    total = ordered_sum(lengths)[:, None]
     inputs = []
     for value in (lengths, total - lengths):  # SPL, OSPL
         enters = present[:, None] & (lengths > 0)

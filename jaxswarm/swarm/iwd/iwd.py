@@ -25,6 +25,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
                                  default_params, keep_best)
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_updates,
@@ -188,7 +189,7 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     return drops._replace(
         memory=arrived_updates(graph, soil, drops.path, drops.slots, taken, drops.arrived,
                                params),
-        state=jnp.stack([velocity, jnp.sum(taken, axis=1)], axis=-1))
+        state=jnp.stack([velocity, ordered_sum(taken, axis=1)], axis=-1))
 
 
 def soil_choice(graph: Graph, table, soil, params: IWDParams):
@@ -217,7 +218,7 @@ def soil_after_best(graph: Graph, drops: Walk, paths, costs, params: IWDParams) 
 
 def soil_per_node(state) -> jax.Array:
     """f32[N] the mean soil on each node's edge slots (the figures' view of the memory)."""
-    return jnp.mean(state.soil, axis=-1)
+    return ordered_sum(state.soil) / state.soil.shape[-1]
 
 
 SOIL_LABEL = "soil on a node's edges (mean)"

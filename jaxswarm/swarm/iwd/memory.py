@@ -12,6 +12,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import ordered_cumsum
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import move_lengths
 from jaxswarm.world.paths import step_slots
@@ -97,7 +98,7 @@ def prefix_lengths(graph: Graph, path: jax.Array) -> jax.Array:
     """f32[L]: the length of ``path`` (i32[L], -1 padded) from its start to each position
     (constant past its end)."""
     moves = move_lengths(graph, path[:-1], step_slots(graph, path))
-    return jnp.concatenate([jnp.zeros((1,), jnp.float32), jnp.cumsum(moves)])
+    return jnp.concatenate([jnp.zeros((1,), jnp.float32), ordered_cumsum(moves)])
 
 
 def last_position(path: jax.Array) -> jax.Array:

@@ -43,6 +43,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import ordered_cumsum
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
 from jaxswarm.swarm.walking.hooks import Move, StepHook
 from jaxswarm.world.graph import Graph
@@ -118,7 +119,8 @@ def _keep_memory(params, soil, move: Move, graph: Graph):
 
 
 SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,), jnp.float32),
-                       log_weights=choice_log_weights, update=_keep_memory)
+                       log_weights=choice_log_weights, update=_keep_memory,
+                       changes_memory=False)
 """The walker hook of drops that read the soil and leave it as it is during the walk (eqs. 1-3;
 their updates come after it, :func:`arrived_updates`)."""
 
@@ -132,7 +134,7 @@ def walked_soil(graph: Graph, soil, path, slots, params):
     here = jnp.where(moved, path[:, :-1], 0)
     slot = jnp.maximum(slots, 0).astype(jnp.int32)
     gained = jnp.where(moved, velocity_gain(params, soil[here, slot]), 0.0)
-    velocity = params.initial_velocity + jnp.cumsum(gained, axis=1)
+    velocity = params.initial_velocity + ordered_cumsum(gained, axis=1)
     taken = jnp.where(moved, soil_taken(params, move_lengths(graph, here, slots), velocity), 0.0)
     return taken, velocity[:, -1]
 

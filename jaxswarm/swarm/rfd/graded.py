@@ -43,6 +43,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.exact.field import distance_field
+from jaxswarm.runtime.arithmetic import ordered_cumsum
 from jaxswarm.runtime.batching import one_at_a_time
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
@@ -201,7 +202,7 @@ def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
         node = jnp.where(on_path, nodes, 0)
         edge = move_lengths(graph, node, slot)
         # to_end[a, k]: length drop a walks from this node to where it stopped.
-        to_end = after[:, None] + jax.lax.cumsum(edge, axis=1, reverse=True)
+        to_end = after[:, None] + ordered_cumsum(edge, axis=1, reverse=True)
         depth = altitude[node]
         water = jnp.where(on_path & (depth < params.initial_height),
                           depth / params.erosion - to_end, jnp.inf)

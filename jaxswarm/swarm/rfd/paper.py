@@ -75,6 +75,7 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import exp, ordered_sum
 from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (add_compensated, check_greedy_drops, gradients,
@@ -214,12 +215,12 @@ def erosion_change(graph: Graph, altitude, drops: Walk, eroding, erosion, p_base
         asked = jnp.where(moved, rate * jnp.maximum(gradient, 0.0), 0.0)
         eroded = jnp.zeros_like(altitude).at[here].add(asked)
     else:  # p_base ** gradient, capped so that a cliff cannot overflow float32
-        shape = jnp.exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
+        shape = exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
         asked = jnp.zeros_like(altitude).at[here].add(jnp.where(moved, rate * shape, 0.0))
         outlet = jnp.full_like(altitude, jnp.inf).at[jnp.where(moved, here, n)].min(
             altitude[there], mode="drop")
         eroded = jnp.minimum(asked, jnp.maximum(altitude - outlet, 0.0))
-    return jnp.sum(eroded) / (n - 1) - eroded
+    return ordered_sum(eroded) / (n - 1) - eroded
 
 
 def erode(graph: Graph, altitude, residual, drops: Walk, eroding, erosion, p_base=None):

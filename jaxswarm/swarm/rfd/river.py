@@ -24,6 +24,7 @@ from typing import Callable
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.walking import Walk, heads, neighbour_slots, step_budget, walk
 from jaxswarm.world.graph import Graph
@@ -115,7 +116,7 @@ def paper_altitude_rule(state: RFDState, before: Graph, after: Graph, old: Task,
     altitude = state.altitude
     valid = after.valid_edges()[old.goal]
     around = jnp.where(valid, altitude[jnp.maximum(after.nbr[old.goal], 0)], 0.0)
-    mean = jnp.sum(around) / jnp.maximum(jnp.sum(valid), 1)
+    mean = ordered_sum(around) / jnp.maximum(jnp.sum(valid), 1)
     nodes = jnp.arange(altitude.shape[0])
     moved = (nodes == old.goal) & (new.goal != old.goal)
     opened = after.free & ~before.free

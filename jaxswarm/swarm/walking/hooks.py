@@ -14,8 +14,11 @@ its velocity depend on the soil it finds. Such a swarm hands :func:`~.loop.walk`
    state (``f32[E]`` per agent, e.g. velocity and carried soil), which the walk returns.
 
 Every agent of a step reads the memory as it was at the start of the step; the writes of agents
-that cross the same edge in one step are applied in the order of their lanes (the walker's lanes
-are a deterministic function of the walk's inputs), so one key gives one bit-identical result.
+that cross the same edge in one step are applied in the order of their lanes. When the hook
+changes the memory, every agent of a run has a lane from the first step, in agent order, and the
+lanes never take another agent: step ``m`` is every agent's ``m``-th move, the lanes of one run
+keep their order, and runs write only their own memory, so what a run's agents see of each
+other's writes depends on neither the number of lanes nor the other runs of a batch.
 A swarm without a hook pays nothing: the walker's program is the same as before.
 """
 from __future__ import annotations
@@ -41,6 +44,8 @@ class StepHook(NamedTuple):
         ``memory_rows`` each lane's node's row of its run's memory, e.g. f32[l, K]).
       update: ``(params, memory, move: Move, graph) -> (memory, f32[l, E])``: the memory of
         every run (leading axis R) and the lanes' states after the step's moves.
+      changes_memory: whether ``update`` writes the memory (False: it only reads it, and the
+        agents may walk in any lanes at any time).
 
     Build hooks from module-level functions, once: the walker's compiled loops are cached by
     the hook (a hook made per call would compile per call).
@@ -50,6 +55,7 @@ class StepHook(NamedTuple):
     initial_state: Callable[[Any], jax.Array]
     log_weights: Callable[..., jax.Array]
     update: Callable[..., tuple[Any, jax.Array]]
+    changes_memory: bool = True
 
 
 class EdgeGroups(NamedTuple):

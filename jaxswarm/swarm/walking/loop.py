@@ -30,9 +30,10 @@ starts a finished run of a batch there, so its lanes go to the runs still going.
 
 Memory that changes during a walk (water drops' soil) goes through a per-step hook
 (:mod:`.hooks`): ``walk(..., hook=, memory=, hook_params=)`` returns the memory after the walk and
-each agent's own state. With a hook the lanes of one loop walk in lockstep, and which agents share
-a step, and the order in which their writes to one edge apply (the lanes' order), depend on the
-lanes; the walk is still one deterministic function of its key and of how walks are batched.
+each agent's own state. When the hook writes the memory, every agent of the batch gets a lane at
+the first step and keeps it (no queue, no ``LANES`` cap): a run's agents then make their ``m``-th
+moves in the same step and write in agent order, whatever the batch, so such a walk too is one
+function of its key.
 Hook params shared by a batch stay one run's, so the lanes read them without a gather; the
 loop carries one i32 per node of every run to group each step's moves (:func:`.hooks.edge_groups`).
 
@@ -288,7 +289,9 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     """
     queue = _queue(inputs, count)
     initial = _initial_results(inputs, queue)
-    num_lanes = min(LANES, count)
+    # Agents that write a memory they all read walk together (module docstring).
+    num_lanes = count if inputs.hook is not None and inputs.hook.changes_memory else min(
+        LANES, count)
     claims = None if inputs.hook is None else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
     loop = Loop(lanes=_fresh_lanes(inputs, queue, jnp.arange(num_lanes)), results=initial,

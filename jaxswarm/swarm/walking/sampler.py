@@ -7,6 +7,7 @@ import operator
 import jax
 import jax.numpy as jnp
 
+from jaxswarm.runtime.arithmetic import exp
 from jaxswarm.world.graph import NO_NODE
 
 FORCED = 1e30
@@ -32,7 +33,7 @@ def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
     masked = jnp.where(mask, log_weights, -jnp.inf)
     top = jnp.max(masked, axis=-1, keepdims=True)
     has_choice = jnp.isfinite(top[..., 0])  # False for no slot, all -inf, or NaN weights
-    weights = jnp.exp(masked - jnp.where(has_choice[..., None], top, 0.0))
+    weights = exp(masked - jnp.where(has_choice[..., None], top, 0.0))
     if greedy is not None:
         weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
     # The first slot whose cumulative weight exceeds u (a slot of positive weight), capped at the

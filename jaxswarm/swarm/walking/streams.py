@@ -14,12 +14,13 @@ def uniforms(seed: jax.Array, agent: jax.Array, move: jax.Array) -> jax.Array:
     tenth of the arithmetic of a Threefry draw.
     """
     counter = (agent.astype(jnp.uint32) * jnp.uint32(0x9E3779B1)) ^ move.astype(jnp.uint32)
-    mixed = _finalise(_finalise(counter ^ seed[..., 0]) ^ seed[..., 1])
+    mixed = fmix32(fmix32(counter ^ seed[..., 0]) ^ seed[..., 1])
     return (mixed >> 8).astype(jnp.float32) * jnp.float32(2.0 ** -24)
 
 
-def _finalise(x: jax.Array) -> jax.Array:
-    """MurmurHash3's fmix32 on u32: every input bit flips each output bit with probability ~1/2."""
+def fmix32(x: jax.Array) -> jax.Array:
+    """u32[...]: MurmurHash3's 32-bit finaliser, a bijection in which every input bit flips each
+    output bit with probability about 1/2."""
     x = x ^ (x >> 16)
     x = x * jnp.uint32(0x85EBCA6B)
     x = x ^ (x >> 13)

@@ -1,0 +1,168 @@
+"""Float arithmetic whose result does not depend on how XLA fuses and batches a program.
+
+A key fixes a run only if every float that reaches a discrete choice (a draw, a comparison, a
+best path) is the same bit for bit alone, in a ``vmap`` of any width, on any thread or device
+count. XLA:CPU makes three kinds of result that depend on the program rather than on the
+arithmetic, each measured on x86-64 with jax 0.10.2:
+
+* **Contraction.** A multiply and an add in one fusion become one fused multiply-add (one
+  rounding instead of two); whether they share a fusion depends on the program's shapes. No XLA
+  option turns contraction off, but without FMA instructions there is nothing to contract to:
+  :data:`ISA_FLAG` caps XLA's vector instructions at AVX, whose multiplies and adds each round
+  once. Every elementwise chain of IEEE operations (``+ - * /``, ``sqrt``, comparisons, integer
+  conversions) then gives one result in every program.
+* **Transcendentals.** XLA's ``exp`` takes another code path on some widths (1 of 8 results
+  differs in its last bit between a row of 3 and a row of 3,000); ``log``, ``pow``, ``tanh``,
+  ``log1p`` and ``expm1`` were the same on every width tried. :func:`exp` is built from IEEE
+  operations only, so it is one function on every width.
+* **Reductions.** A float sum over an axis adds in an order XLA picks per program (vector
+  accumulators when alone, one row at a time in a batch), and a cumulative sum is a reduce-window
+  XLA may rewrite by length. :func:`ordered_sum` and :func:`ordered_cumsum` add in an order fixed
+  by the axis length alone, as a sequence of elementwise adds XLA may not reassociate. Sums of
+  at most two terms, of small integers held as floats, and minima and maxima are exact in any
+  order and stay plain reductions.
+
+Scatter-adds of floats (erosion, soil, sediment) apply their updates in update order: XLA:CPU
+emits a scatter as one serial loop over the updates, and a batch adds an outer loop over the
+runs, so each run's updates reach an entry in the same order alone and in a batch.
+
+Where float arithmetic reaches a choice, and why the choice is the same in every program:
+
+* **Moves** (:func:`jaxswarm.swarm.walking.sampler.sample_masked`): weights are :func:`exp` of
+  log-weights minus their row's maximum (exact), summed slot by slot in slot order and compared
+  with a uniform made from integer hashes. The log-weights are elementwise chains (RFD's
+  gradients and ``p_base``, the colonies' ``alpha log tau + beta log eta``, IWD's ``-log(eps_s +
+  g(soil))``, the goal terms ``-alpha log d``) of IEEE operations and ``log``, one result under
+  the cap.
+* **Best paths** (:func:`jaxswarm.swarm.core.keep_best`, IWD_PG's memory): a path's length on a
+  grid or path map is its count of straight and of diagonal moves times two constants
+  (:func:`jaxswarm.world.lattice.lattice_length`), on a general graph an :func:`ordered_sum`; on
+  a plane :func:`jaxswarm.world.plane.trajectory_length` is an :func:`ordered_sum`. Comparisons,
+  minima and ``argmin`` are exact.
+* **Memory updates** that later draws read: IWD's velocities are an :func:`ordered_cumsum`, its
+  arrived drops' updates a scan in agent order, the soil a drop carries an :func:`ordered_sum`;
+  RFD's erosion, sediment and the colonies' deposits are scatter-adds (update order, above) and
+  elementwise chains, the eroded total shared out by eq. 5 an :func:`ordered_sum`; RFD's
+  exponential law uses :func:`exp`; IWD_PG's section lengths are a scatter-add of move
+  lengths, its fuzzy scores :func:`ordered_sum` s, its prefix lengths an :func:`ordered_cumsum`,
+  its roulette ``jax.random.categorical`` (``log`` and an ``argmax``).
+* **The bees' guided function** ``w1 f1 + w2 f2 + w3 f3``: three terms added left to right, the
+  pushback's four rays an :func:`ordered_sum`, the nearest obstacle a minimum, the turn an
+  ``arctan2`` (the same on every width tried; ``arctan`` was not, and is not used); the
+  onlookers' probabilities (eq. 10) divide by an :func:`ordered_sum` of the fitnesses.
+* Dot products of two-vectors (the Bug2 ant's direction cosine, distances between points) are
+  sums of two terms, the same in either order.
+
+The guarantee is "same key, same version, same platform" (x86-64 with AVX, or the same CPU family
+elsewhere): the cap is x86-64's, and another jax version may emit other code.
+"""
+from __future__ import annotations
+
+import os
+import platform
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.runtime.cpu import backends_started
+
+ISA_FLAG = "--xla_cpu_max_isa=AVX"
+"""The ``XLA_FLAGS`` entry that caps XLA:CPU's vector instructions at AVX (no FMA), on x86-64."""
+
+FLAGS_VARIABLE = "XLA_FLAGS"
+"""The environment variable XLA reads its flags from when JAX starts its CPU client."""
+
+
+def fixed_arithmetic_flags(environ=os.environ, machine: str | None = None) -> bool:
+    """Add :data:`ISA_FLAG` to ``environ["XLA_FLAGS"]`` on x86-64 unless the flags already cap
+    the instruction set (the user's choice stands). It applies to the XLA:CPU client JAX starts
+    afterwards; importing jaxswarm calls it (:func:`require_fixed_arithmetic`).
+
+    Args:
+      environ: the environment to change (``os.environ``).
+      machine: the processor architecture (``platform.machine()`` when None).
+
+    Returns:
+      Whether it added the flag.
+    """
+    machine = platform.machine() if machine is None else machine
+    flags = environ.get(FLAGS_VARIABLE, "")
+    if machine.lower() not in ("x86_64", "amd64") or "--xla_cpu_max_isa" in flags:
+        return False
+    environ[FLAGS_VARIABLE] = f"{flags} {ISA_FLAG}".strip()
+    return True
+
+
+def require_fixed_arithmetic() -> None:
+    """:func:`fixed_arithmetic_flags`, with a warning when JAX has already started its CPU
+    client, which then compiles with FMA: one key still gives one result within one program,
+    but not across batch widths. Called when jaxswarm is imported."""
+    if fixed_arithmetic_flags() and backends_started():
+        warnings.warn(f"jaxswarm was imported after JAX started its CPU backend, so XLA compiles "
+                      f"with fused multiply-adds and a run may differ in its last bits between "
+                      f"batches; import jaxswarm before JAX's first computation, or set "
+                      f"XLA_FLAGS={ISA_FLAG}", RuntimeWarning, stacklevel=3)
+
+
+# Cephes' expf: exp(x) = 2^n exp(r), n = round(x / ln 2), r = x - n ln 2 in two parts (the first
+# has few bits, so n * its value is exact), exp(r) by a polynomial of degree 7 (about 1 ulp).
+_LOG2E = np.float32(1.44269504088896341)
+_LN2_HIGH = np.float32(0.693359375)
+_LN2_LOW = np.float32(-2.12194440e-4)
+_EXP_POLY = tuple(np.float32(c) for c in (1.9875691500e-4, 1.3981999507e-3, 8.3334519073e-3,
+                                          4.1665795894e-2, 1.6666665459e-1, 5.0000001201e-1))
+_EXP_MAX, _EXP_MIN = np.float32(88.72283935546875), np.float32(-103.972084045410)
+
+
+def exp(x: jax.Array) -> jax.Array:
+    """``exp`` of f32[...] by IEEE operations only, at most 1 ulp from the true value where
+    that is a normal float (XLA's own: up to 5): the same bits in every program and on every
+    width (XLA's ``exp`` is not; see the module docstring). Below the smallest normal float the
+    result is 0, as XLA:CPU flushes subnormals; ``-inf`` gives 0, anything above 88.72 ``inf``,
+    NaN NaN."""
+    x = jnp.asarray(x, jnp.float32)
+    clipped = jnp.clip(x, _EXP_MIN, _EXP_MAX)
+    n = jnp.floor(clipped * _LOG2E + np.float32(0.5))
+    r = (clipped - n * _LN2_HIGH) - n * _LN2_LOW
+    p = _EXP_POLY[0]
+    for c in _EXP_POLY[1:]:
+        p = p * r + c
+    y = p * (r * r) + r + np.float32(1.0)
+    # 2^n as two normal powers of two (n is in [-150, 128]): each product is exact but the last,
+    # which rounds once.
+    half = jnp.floor(n * np.float32(0.5)).astype(jnp.int32)
+    rest = n.astype(jnp.int32) - half
+    value = y * _power_of_two(half) * _power_of_two(rest)
+    value = jnp.where(x > _EXP_MAX, jnp.inf, value)
+    return jnp.where(jnp.isnan(x), x, value)
+
+
+def _power_of_two(n: jax.Array) -> jax.Array:
+    """f32[...] ``2^n`` for i32[...] ``n`` in [-126, 127], from its exponent bits."""
+    return jax.lax.bitcast_convert_type((n + 127) << 23, jnp.float32)
+
+
+def ordered_sum(x: jax.Array, axis: int = -1) -> jax.Array:
+    """The sum of f32[...] ``x`` over ``axis`` in a fixed order: padded with zeros to a power of
+    two, then halved (the first half plus the second) until one term is left. The order depends
+    on the axis length only, so the sum is the same bits alone and in any batch."""
+    x = jnp.moveaxis(jnp.asarray(x), axis, -1)
+    length = x.shape[-1]
+    if length == 0:
+        return jnp.zeros(x.shape[:-1], x.dtype)
+    width = 1 << (length - 1).bit_length()
+    x = jnp.pad(x, [(0, 0)] * (x.ndim - 1) + [(0, width - length)])
+    while x.shape[-1] > 1:
+        half = x.shape[-1] // 2
+        x = x[..., :half] + x[..., half:]
+    return x[..., 0]
+
+
+def ordered_cumsum(x: jax.Array, axis: int = -1, *, reverse: bool = False) -> jax.Array:
+    """The running sums of ``x`` along ``axis`` (``reverse``: from the end) by
+    :func:`jax.lax.associative_scan`, whose adds are elementwise operations arranged by the axis
+    length alone: the same bits alone and in any batch (``jnp.cumsum`` is a reduce-window whose
+    order XLA chooses)."""
+    return jax.lax.associative_scan(jnp.add, jnp.asarray(x), reverse=reverse, axis=axis)
