@@ -350,7 +350,9 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
     """The intersection operators on the pairs (0, q) of ``memory`` (the memory they run on:
     they run first) as a :class:`_Stage`: each parent is replaced by its child where that is
     shorter. Their local searches (around the first operator's joints, and the second's
-    connections) run as one batch."""
+    connections) run as one batch; a search whose result no pair uses (around the joints of a
+    pair that does not cross, or connecting a pair that does) runs from its first node to
+    itself, where no drop walks."""
     config = setup.config
     num_pairs = config.memory_size - 1
     improve_first = config.first_intersection and config.local_search
@@ -362,11 +364,15 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
         heres, theres = [], []
         if improve_first:
             rows = jnp.arange(2 * num_pairs)
-            heres.append(plan.around.paths[rows, plan.around.begins])
-            theres.append(plan.around.paths[rows, plan.around.ends])
+            here = plan.around.paths[rows, plan.around.begins]
+            heres.append(here)
+            theres.append(jnp.where(jnp.repeat(plan.crossing, 2),
+                                    plan.around.paths[rows, plan.around.ends], here))
         if config.second_intersection:
-            heres.append(plan.pairs.best[plan.closest[0]])
-            theres.append(plan.pairs.others[jnp.arange(num_pairs), plan.closest[1]])
+            here = plan.pairs.best[plan.closest[0]]
+            heres.append(here)
+            theres.append(jnp.where(plan.pairs.present & ~plan.crossing, plan.pairs.others[
+                jnp.arange(num_pairs), plan.closest[1]], here))
         return (jax.random.split(key, searches), jnp.concatenate(heres),
                 jnp.concatenate(theres)), None
 
