@@ -242,15 +242,16 @@ class _Found(NamedTuple):
 
 
 class _Stage(NamedTuple):
-    """One memory operator: the local searches it asks for and what it makes of them. Both
-    functions read the memory as the stage found it, so what ``apply`` needs of the
-    operator's plan it works out again (the same arrays ``ask`` worked out).
+    """One memory operator: the local searches it asks for and what it makes of them, both
+    from the memory as the stage finds it.
 
     Attributes:
       searches: B, the local searches it asks for (static; 0 for none).
-      ask: ``(memory) -> (keys key[B], heres i32[B], theres i32[B])``: each search's key, and
-        the nodes it connects.
-      apply: ``(memory, _Found or None) -> (memory, evaluations i32[])``.
+      ask: ``(memory) -> ((keys key[B], heres i32[B], theres i32[B]), plan)``: each search's
+        key and the nodes it connects, and what ``apply`` needs of the work that chose them
+        (arrays, or None).
+      apply: ``(memory, plan, _Found) -> (memory, evaluations i32[])`` (plan and found None
+        for a stage without searches).
     """
 
     searches: int
@@ -270,15 +271,15 @@ def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDPara
     intersection_key, section_key = jax.random.split(key)
     stages = []
     if config.first_intersection or config.second_intersection:
-        stages.append(_intersection_stage(setup, intersection_key, graph))
+        stages.append(_intersection_stage(setup, intersection_key, graph, memory))
     if config.local_search:
         stages.append(_section_stage(setup, section_key, graph))
     search = functools.partial(_search, setup, graph, params)
     if sum(stage.searches > 0 for stage in stages) < 2:
         evaluations = jnp.int32(0)
         for stage in stages:
-            found = search(*stage.ask(memory)) if stage.searches else None
-            memory, count = stage.apply(memory, found)
+            searches, plan = stage.ask(memory) if stage.searches else (None, None)
+            memory, count = stage.apply(memory, plan, search(*searches) if searches else None)
             evaluations += count
     else:
         memory, evaluations = _stage_loop(stages, search, memory)
@@ -293,28 +294,34 @@ def _search(setup: _Setup, graph: Graph, params: IWDParams, keys, heres, theres)
 
 def _stage_loop(stages, search, memory: Memory):
     """The ``stages`` applied in turn, each turn's local searches through one batch of the
-    most searches a stage asks for: ``(memory, evaluations i32[])``."""
+    most searches a stage asks for: ``(memory, evaluations i32[])``. A turn carries every
+    stage's plan from its ask to its apply (zeros for the other stages')."""
     size = max(stage.searches for stage in stages)
+    plans = [jax.tree_util.tree_map(lambda s: jnp.zeros(s.shape, s.dtype), jax.eval_shape(
+        lambda memory, stage=stage: stage.ask(memory)[1], memory)) for stage in stages]
 
-    def padded(stage):
+    def asking(index, stage):
         def ask(memory):
-            keys, heres, theres = stage.ask(memory)
+            (keys, heres, theres), plan = stage.ask(memory)
             fill = size - stage.searches
-            return (keys[jnp.minimum(jnp.arange(size), stage.searches - 1)],
-                    jnp.pad(heres, (0, fill)), jnp.pad(theres, (0, fill)))
+            return ((keys[jnp.minimum(jnp.arange(size), stage.searches - 1)],
+                     jnp.pad(heres, (0, fill)), jnp.pad(theres, (0, fill))),
+                    plans[:index] + [plan] + plans[index + 1:])
         return ask
 
-    def applied(stage):
-        def apply(memory, found):
-            return stage.apply(memory, jax.tree_util.tree_map(
-                lambda x: x[:stage.searches], found) if stage.searches else None)
+    def applying(index, stage):
+        def apply(memory, turn_plans, found):
+            return stage.apply(memory, turn_plans[index], jax.tree_util.tree_map(
+                lambda x: x[:stage.searches], found))
         return apply
 
     def turn(index, carry):
         memory, evaluations = carry
-        found = search(*jax.lax.switch(index, [padded(stage) for stage in stages], memory))
-        memory, count = jax.lax.switch(index, [applied(stage) for stage in stages], memory,
-                                       found)
+        searches, turn_plans = jax.lax.switch(
+            index, [asking(i, stage) for i, stage in enumerate(stages)], memory)
+        memory, count = jax.lax.switch(
+            index, [applying(i, stage) for i, stage in enumerate(stages)], memory, turn_plans,
+            search(*searches))
         return memory, evaluations + count
 
     return jax.lax.fori_loop(0, len(stages), turn, (memory, jnp.int32(0)))
@@ -340,30 +347,37 @@ class _Crossing(NamedTuple):
     closest: tuple | None
 
 
-def _intersection_stage(setup: _Setup, key, graph: Graph) -> _Stage:
-    """The intersection operators on the pairs (0, q) as a :class:`_Stage`: each parent is
-    replaced by its child where that is shorter. Their local searches (around the first
-    operator's joints, and the second's connections) run as one batch."""
+def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _Stage:
+    """The intersection operators on the pairs (0, q) of ``memory`` (the memory they run on:
+    they run first) as a :class:`_Stage`: each parent is replaced by its child where that is
+    shorter. Their local searches (around the first operator's joints, and the second's
+    connections) run as one batch; a search whose result no pair uses (around the joints of a
+    pair that does not cross, or connecting a pair that does) runs from its first node to
+    itself, where no drop walks."""
     config = setup.config
     num_pairs = config.memory_size - 1
     improve_first = config.first_intersection and config.local_search
     searches = (2 * num_pairs if improve_first else 0) + (
         num_pairs if config.second_intersection else 0)
+    plan = _crossing_plan(setup, graph, memory)
 
     def ask(memory):
-        plan = _crossing_plan(setup, graph, memory)
         heres, theres = [], []
         if improve_first:
             rows = jnp.arange(2 * num_pairs)
-            heres.append(plan.around.paths[rows, plan.around.begins])
-            theres.append(plan.around.paths[rows, plan.around.ends])
+            here = plan.around.paths[rows, plan.around.begins]
+            heres.append(here)
+            theres.append(jnp.where(jnp.repeat(plan.crossing, 2),
+                                    plan.around.paths[rows, plan.around.ends], here))
         if config.second_intersection:
-            heres.append(plan.pairs.best[plan.closest[0]])
-            theres.append(plan.pairs.others[jnp.arange(num_pairs), plan.closest[1]])
-        return jax.random.split(key, searches), jnp.concatenate(heres), jnp.concatenate(theres)
+            here = plan.pairs.best[plan.closest[0]]
+            heres.append(here)
+            theres.append(jnp.where(plan.pairs.present & ~plan.crossing, plan.pairs.others[
+                jnp.arange(num_pairs), plan.closest[1]], here))
+        return (jax.random.split(key, searches), jnp.concatenate(heres),
+                jnp.concatenate(theres)), None
 
-    def apply(memory, found):
-        plan = _crossing_plan(setup, graph, memory)
+    def apply(memory, _, found):
         offspring = plan.offspring
         if improve_first:
             offspring = _improved_at_joints(
@@ -477,23 +491,19 @@ def _section_stage(setup: _Setup, key, graph: Graph) -> _Stage:
     config = setup.config
     axis_key, section_key, search_key = jax.random.split(key, 3)
 
-    def spans(memory):
+    def ask(memory):
         axis = jax.random.bernoulli(axis_key).astype(jnp.int32)
         present = jnp.isfinite(memory.costs)
         section = _draw_sections(section_key, graph, memory.paths, present, axis, config)
-        return _section_spans(graph, memory.paths, section, axis, config.sections)
-
-    def ask(memory):
-        begins, ends = spans(memory)
+        begins, ends = _section_spans(graph, memory.paths, section, axis, config.sections)
         rows = jnp.arange(config.memory_size)
-        return (jax.random.split(search_key, config.memory_size), memory.paths[rows, begins],
-                memory.paths[rows, ends])
+        return ((jax.random.split(search_key, config.memory_size), memory.paths[rows, begins],
+                 memory.paths[rows, ends]), (begins, ends))
 
-    def apply(memory, found):
-        begins, ends = spans(memory)
+    def apply(memory, spans, found):
         paths, costs, spliced = jax.vmap(
             lambda p, b, e, m, c: splice_if_shorter(graph, p, b, e, m, c))(
-            memory.paths, begins, ends, found.paths, found.costs)
+            memory.paths, *spans, found.paths, found.costs)
         present = jnp.isfinite(memory.costs)
         better = present & (costs < memory.costs)
         evaluations = found.calls + spliced.astype(jnp.int32)

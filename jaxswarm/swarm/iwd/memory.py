@@ -55,13 +55,14 @@ def remember(memory: Memory, paths: jax.Array, costs: jax.Array) -> Memory:
 
 
 def widths(length: int) -> tuple[int, ...]:
-    """The widths (static, ascending) that operators on paths of ``length`` nodes work on when
-    the paths are shorter: about an eighth and a third of ``length`` (multiples of 32, at least
-    64) and ``length`` itself. Past a path's last node every position is padding, so an
-    operator that reads no position past it gives the same result on the first ``W``
-    positions as on all of them, with less work."""
-    return tuple(sorted({min(length, max(64, -(-length // share // 32) * 32))
-                         for share in (8, 3)} | {length}))
+    """The widths (static, ascending) that operators on paths of ``length`` nodes work on: about
+    an eighth of ``length`` (a multiple of 32, at least 64) for short paths when that is at
+    most half of ``length``, and ``length``. Past a path's last node every position is
+    padding, so an operator that reads no position past it gives the same result on the first
+    ``W`` positions as on all of them, with less work; each width is a program of its own to
+    compile."""
+    short = max(64, -(-length // 8 // 32) * 32)
+    return (short, length) if 2 * short <= length else (length,)
 
 
 def width_index(paths: jax.Array) -> jax.Array:

@@ -91,59 +91,50 @@ def lattice_costs(graph: Graph) -> Callable:
     """``(path i32[W], on_path bool[N]) -> Costs`` on a grid or path map, the same lengths as
     :func:`graph_costs`: there the valid edge ``a -> b`` is the slot whose direction is ``b``'s
     cell minus ``a``'s (a valid slot's neighbour is node ``a`` plus the slot's offset), of the
-    slot's length (``cost`` wherever a slot has a neighbour). Per position it gathers the
-    node's valid slots and its neighbours' (a table made once), not each edge's slots."""
+    slot's length (``cost`` wherever a slot has a neighbour). Each node's valid moves are a
+    mask of bits, one per cell offset ``(dx, dy)`` in ``[-1, 1]^2`` (bit ``3 (dy + 1) + dx +
+    1``), so a pass gathers only each position's mask and its neighbours' (a table made once),
+    not each edge's slots."""
     width, num_slots = graph.shape[1], graph.max_degree
     directions = DIRECTIONS[:num_slots]
     offsets = directions @ np.array([1, width], np.int32)
+    codes = (directions[:, 1] + 1) * 3 + directions[:, 0] + 1
     valid = graph.valid_edges()
-    bits = jnp.sum(valid.astype(jnp.int32) << np.arange(num_slots, dtype=np.int32), axis=1)
+    moves = jnp.sum(valid.astype(jnp.int32) << codes, axis=1)  # i32[N] the mask of each node
     neighbour = jnp.clip(jnp.arange(graph.num_nodes)[:, None] + offsets, 0, graph.num_nodes - 1)
-    reach = jnp.where(valid, bits[neighbour], 0)  # i32[N, K] the valid slots of each neighbour
-    step = functools.partial(_lattice_step, directions, slot_lengths(graph))
+    reach = jnp.where(valid, moves[neighbour], 0)  # i32[N, K] the mask of each neighbour
+    lengths = slot_lengths(graph)
+    # Odd bits are the orthogonal offsets, even ones the diagonal (slot_lengths: one length
+    # each).
+    straight, diagonal = lengths[0], lengths[min(ORTHOGONAL_SLOTS, num_slots - 1)]
+
+    def step(dx, dy, mask):
+        """The length of the move of cell offset (dx, dy) set in ``mask``, else inf."""
+        code = jnp.clip((dy + 1) * 3 + dx + 1, 0, 8)
+        near = (jnp.abs(dx) <= 1) & (jnp.abs(dy) <= 1) & (((mask >> code) & 1) == 1)
+        return jnp.where(near, jnp.where(code % 2 == 1, straight, diagonal), jnp.inf)
 
     def costs(path, on_path):
         real = [_shifted(path, by) >= 0 if by else path >= 0 for by in range(4)]
         node = jnp.maximum(path, 0)
         x = [_shifted(node % width, by) for by in range(4)]
         y = [_shifted(node // width, by) for by in range(4)]
-        open_here = [_shifted(bits[node], by) for by in range(3)]
+        mask = [_shifted(moves[node], by) for by in range(3)]
 
-        def edge(i, j, open_bits):
-            return jnp.where(real[i] & real[j], step(x[j] - x[i], y[j] - y[i], open_bits),
+        def edge(i, j):
+            return jnp.where(real[i] & real[j], step(x[j] - x[i], y[j] - y[i], mask[i]),
                              jnp.inf)
 
         middle = jnp.clip(node[:, None] + offsets, 0, graph.num_nodes - 1)
-        slot_open = (open_here[0][:, None] >> np.arange(num_slots, dtype=np.int32)) & 1
-        first = jnp.where((slot_open == 1) & ~on_path[middle], slot_lengths(graph), jnp.inf)
+        first = jnp.where((((mask[0][:, None] >> codes) & 1) == 1) & ~on_path[middle], lengths,
+                          jnp.inf)
         legs = {w: first + jnp.where((real[0] & real[w])[:, None], step(
             (x[w] - x[0])[:, None] - directions[:, 0], (y[w] - y[0])[:, None] - directions[:, 1],
             reach[node]), jnp.inf) for w in (2, 3)}
-        return Costs(moves=[edge(i, i + 1, open_here[i]) for i in range(3)],
-                     direct={w: edge(0, w, open_here[0]) for w in (2, 3)}, legs=legs,
-                     middle=middle)
+        return Costs(moves=[edge(i, i + 1) for i in range(3)],
+                     direct={w: edge(0, w) for w in (2, 3)}, legs=legs, middle=middle)
 
     return costs
-
-
-def _lattice_step(directions: np.ndarray, lengths: np.ndarray, dx, dy, open_bits):
-    """f32[...]: the length of the lattice move of cell offset (``dx``, ``dy``) (i32[...]) when
-    its slot is set in ``open_bits`` (i32[...]), else inf. The slot of each offset in
-    ``[-1, 1]^2`` is read from a table packed into constants (4 bits an offset, 15 for none),
-    so no gather is made."""
-    table = np.full(9, 15, np.int64)
-    table[(directions[:, 1] + 1) * 3 + directions[:, 0] + 1] = np.arange(len(directions))
-    packed = np.uint32(sum(int(slot) << (4 * code) for code, slot in enumerate(table[:8])))
-    near = (jnp.abs(dx) <= 1) & (jnp.abs(dy) <= 1)
-    code = jnp.where(near, (dy + 1) * 3 + dx + 1, 4)  # (0, 0) and far offsets: no slot
-    shift = (4 * jnp.minimum(code, 7)).astype(jnp.uint32)
-    slot = jnp.where(code < 8, jnp.right_shift(jnp.uint32(packed), shift) & 15,
-                     np.uint32(table[8])).astype(jnp.int32)
-    # Slots 0-3 are orthogonal, 4-7 diagonal, each kind of one length (slot_lengths).
-    length = jnp.where(slot < ORTHOGONAL_SLOTS, lengths[0],
-                       lengths[min(ORTHOGONAL_SLOTS, len(lengths) - 1)])
-    return jnp.where((slot < 15) & (((open_bits >> jnp.minimum(slot, 15)) & 1) == 1), length,
-                     jnp.inf)
 
 
 def costs_of(graph: Graph) -> Callable:
@@ -197,7 +188,8 @@ def _smooth_pass(num_nodes: int, costs_at: Callable, path: jax.Array):
     via_node = {w: costs.middle[t, jnp.argmin(costs.legs[w][t])] for w in (2, 3)}
     m = jnp.where(better[2][t], via_node[2], via_node[3])
     rerouted = path.at[t + 1].set(m)
-    rerouted = _compact(rerouted, ~((positions > t + 1) & (positions < t + w)))
+    # Through m, a window of three moves loses its node at t + 2: the rest moves up one.
+    rerouted = jnp.where((w == 3) & (positions > t + 1), _shifted(rerouted, 1), rerouted)
     has_direct = jnp.any(taken)
     changed = has_direct | jnp.any(any_middle)
     return jnp.where(has_direct, shortened, jnp.where(changed, rerouted, path)), changed

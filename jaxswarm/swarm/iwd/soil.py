@@ -113,14 +113,8 @@ SOIL = StepHook(state_width=2, initial_state=initial_state, log_weights=choice_l
 run, eqs. 1-6."""
 
 
-def _keep_memory(params, soil, move: Move, graph: Graph):
-    """A step that writes nothing: the memory and the lanes' (empty) states as they were."""
-    return soil, move.state
-
-
 SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,), jnp.float32),
-                       log_weights=choice_log_weights, update=_keep_memory,
-                       changes_memory=False)
+                       log_weights=choice_log_weights)
 """The walker hook of drops that read the soil and leave it as it is during the walk (eqs. 1-3;
 their updates come after it, :func:`arrived_updates`)."""
 

@@ -43,9 +43,9 @@ class StepHook(NamedTuple):
         fixed table's row of each lane's node (``params`` per lane, f32[l] leaves;
         ``memory_rows`` each lane's node's row of its run's memory, e.g. f32[l, K]).
       update: ``(params, memory, move: Move, graph) -> (memory, f32[l, E])``: the memory of
-        every run (leading axis R) and the lanes' states after the step's moves.
-      changes_memory: whether ``update`` writes the memory (False: it only reads it, and the
-        agents may walk in any lanes at any time).
+        every run (leading axis R) and the lanes' states after the step's moves; None for a
+        hook that only reads its memory (the walk leaves the memory and the states as they
+        were, groups no moves, and the agents may walk in any lanes at any time).
 
     Build hooks from module-level functions, once: the walker's compiled loops are cached by
     the hook (a hook made per call would compile per call).
@@ -54,8 +54,12 @@ class StepHook(NamedTuple):
     state_width: int
     initial_state: Callable[[Any], jax.Array]
     log_weights: Callable[..., jax.Array]
-    update: Callable[..., tuple[Any, jax.Array]]
-    changes_memory: bool = True
+    update: Callable[..., tuple[Any, jax.Array]] | None = None
+
+    @property
+    def writes(self) -> bool:
+        """Whether the hook writes its memory and the agents' states at each step."""
+        return self.update is not None
 
 
 class EdgeGroups(NamedTuple):

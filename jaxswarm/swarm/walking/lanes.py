@@ -161,7 +161,7 @@ def step(inputs: WalkInputs, lanes: Lanes, memory, claims):
       lanes: the lanes before the move.
       memory: the hook's memory, leading axis R (None without a hook).
       claims: i32[R * N] the hook's grouping scratch (:func:`~.hooks.edge_groups`; None
-        without a hook).
+        without a hook that writes).
 
     Returns:
       ``(lanes, memory, claims, slot, node)``: the lanes, memory and claims after the move,
@@ -176,7 +176,7 @@ def step(inputs: WalkInputs, lanes: Lanes, memory, claims):
     there = jnp.where(moving, target, here)
     moves = lanes.moves + moving
     arrived_now = moving & (there == inputs.goal[lanes.run])
-    if inputs.hook is not None:
+    if inputs.hook is not None and inputs.hook.writes:
         slot = jnp.where(moving, choice, -1)
         groups, claims = edge_groups(lanes.run, here, slot, moving, claims, graph.num_nodes,
                                      graph.max_degree)

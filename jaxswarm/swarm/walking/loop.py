@@ -33,9 +33,9 @@ Memory that changes during a walk (water drops' soil) goes through a per-step ho
 each agent's own state. When the hook writes the memory, every agent of the batch gets a lane at
 the first step and keeps it (no queue, no ``LANES`` cap): a run's agents then make their ``m``-th
 moves in the same step and write in agent order, whatever the batch, so such a walk too is one
-function of its key.
-Hook params shared by a batch stay one run's, so the lanes read them without a gather; the
-loop carries one i32 per node of every run to group each step's moves (:func:`.hooks.edge_groups`).
+function of its key. Hook params shared by a batch stay one run's, so the lanes read them without
+a gather; with a hook that writes, the loop carries one i32 per node of every run to group each
+step's moves (:func:`.hooks.edge_groups`). A hook that only reads (no ``update``) groups nothing.
 
 Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs, written
 in place as agents move and stop, are each agent's visited set (same layout), its slots
@@ -236,8 +236,8 @@ class Queue(NamedTuple):
 
 class Loop(NamedTuple):
     """The loop's carry: the lanes, the results, the queue's next entry, the lane-steps, and
-    with a hook its memory and the claims buffer that groups each step's moves
-    (:func:`~.hooks.edge_groups`; both None without a hook)."""
+    with a hook its memory and, when the hook writes, the claims buffer that groups each
+    step's moves (:func:`~.hooks.edge_groups`; None without)."""
 
     lanes: Lanes
     results: Results
@@ -289,10 +289,10 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     """
     queue = _queue(inputs, count)
     initial = _initial_results(inputs, queue)
+    writes = inputs.hook is not None and inputs.hook.writes
     # Agents that write a memory they all read walk together (module docstring).
-    num_lanes = count if inputs.hook is not None and inputs.hook.changes_memory else min(
-        LANES, count)
-    claims = None if inputs.hook is None else jnp.full(
+    num_lanes = count if writes else min(LANES, count)
+    claims = None if not writes else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
     loop = Loop(lanes=_fresh_lanes(inputs, queue, jnp.arange(num_lanes)), results=initial,
                 next_queued=jnp.minimum(jnp.int32(num_lanes), queue.live),
