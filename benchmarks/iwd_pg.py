@@ -16,12 +16,10 @@ estimates; the variant ``walk only`` (smooth and operators off) is the drops' wa
 bookkeeping of the iteration.
 
 Same results: the SHA-256 of every leaf of each run's state and trace (PRNG keys as their data)
-are compared with :data:`RECORDED`, the digests of the runs before IWD_PG was sped up
-(``same results: yes`` when every leaf matches; printed for the default map, iterations and
-config; ``--record`` prints the digests of this run as the record's source text). They are
-taken with XLA's vector instructions capped at AVX2 as the golden records are
-(``tests/golden/isa.py``: a float reduction over 8 lanes adds in another order than one over
-16), and so is the timing.
+are compared with :data:`RECORDED`, the digests of jaxswarm 0.7.0's runs (the same runs as
+before IWD_PG was sped up, in 0.7.0's arithmetic, :mod:`jaxswarm.runtime.arithmetic`; ``same
+results: yes`` when every leaf matches; printed for the default map, iterations and config;
+``--record`` prints the digests of this run as the record's source text).
 
 XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see
 :mod:`jaxswarm.runtime.cpu`).
@@ -51,60 +49,57 @@ from jaxswarm.swarm.testing import key_data
 
 DEFAULT_MAP, DEFAULT_ITERATIONS = "mosaic50", 100
 
-ISA_CAP = "--xla_cpu_max_isa=AVX2"
-"""The golden records' cap on XLA's vector instructions on x86-64 (``tests/golden/isa.py``)."""
-
 RECORDED = {
     "mosaic50": {
         0: {
-            "[0].key": "1f2be08d7289103d", "[0].soil": "0b15aca4eb6dad94",
-            "[0].memory.paths": "6d393f70aeafe64a", "[0].memory.costs": "2769ae8cba785a89",
-            "[0].stale": "26b25d457597a7b0", "[1].best_cost": "823531fc88a2a3c1",
-            "[1].iteration_cost": "a40277cf910dbccf", "[1].arrived": "612780111eee67dc",
-            "[1].iterations": "01b4f6bd5d6a06a7", "[1].moves": "ae01444ce93cd3ee",
-            "[1].lane_steps": "a4638917a8bcdf8d", "[1].evaluations": "0a9b3d33b65126fa",
+            "[0].key": "2c1f94e5b9ee9b5a", "[0].soil": "4ba817617095f6ea",
+            "[0].memory.paths": "458a1dca8eda1c65", "[0].memory.costs": "7e3d4200ed1d489a",
+            "[0].stale": "67abdd721024f0ff", "[1].best_cost": "ce88b07c3f1acd28",
+            "[1].iteration_cost": "aa908661e8a35611", "[1].arrived": "4debf29cf4a84b43",
+            "[1].iterations": "972b8373b897c65c", "[1].moves": "b92dbbc426935283",
+            "[1].lane_steps": "ed5cec1bea1a85ec", "[1].evaluations": "01d8a5fd17c1c23e",
         },
         1: {
-            "[0].key": "4ac7a7d758b49208", "[0].soil": "065082e7c999a125",
-            "[0].memory.paths": "a0d11cde30b78448", "[0].memory.costs": "980155527f311eed",
-            "[0].stale": "6fea016a651b6460", "[1].best_cost": "4c1d788f0e3f71a7",
-            "[1].iteration_cost": "9045da1fda6fac03", "[1].arrived": "27344980c0e2539c",
+            "[0].key": "4ac7a7d758b49208", "[0].soil": "403462fd0b78550e",
+            "[0].memory.paths": "a0d11cde30b78448", "[0].memory.costs": "9079d5d8486da594",
+            "[0].stale": "6fea016a651b6460", "[1].best_cost": "01e312a0b472c10a",
+            "[1].iteration_cost": "237b93b815f432ba", "[1].arrived": "27344980c0e2539c",
             "[1].iterations": "40e736c02a102a05", "[1].moves": "6706359b7c0ba562",
-            "[1].lane_steps": "73aa742b11464967", "[1].evaluations": "b8856eebad40ffc5",
+            "[1].lane_steps": "73aa742b11464967", "[1].evaluations": "dedd1c9fffb9f2f1",
         },
         2: {
-            "[0].key": "fc34219733dd7ee7", "[0].soil": "8c16396853be8eec",
-            "[0].memory.paths": "f770368085551180", "[0].memory.costs": "a9fded04746f6f47",
-            "[0].stale": "b01099398ce27bbc", "[1].best_cost": "5ab3dcbff9978e79",
+            "[0].key": "fc34219733dd7ee7", "[0].soil": "4705109515e32d71",
+            "[0].memory.paths": "8a2f096761ea40a6", "[0].memory.costs": "234328b8a31aba7e",
+            "[0].stale": "6cb5a8ec7215303a", "[1].best_cost": "5057b7c4e04e0c99",
             "[1].iteration_cost": "ba7fe94fa56a4823", "[1].arrived": "ce14ae54da14e99c",
             "[1].iterations": "40e736c02a102a05", "[1].moves": "1e4d5adfb23d6716",
-            "[1].lane_steps": "67fadb258a505873", "[1].evaluations": "ec06d422f04a172d",
+            "[1].lane_steps": "67fadb258a505873", "[1].evaluations": "94b8c717852a08a1",
         },
     },
     "mosaic20": {
         0: {
-            "[0].key": "8ffd190d67796d1d", "[0].soil": "7b010e09b74c2a70",
+            "[0].key": "8ffd190d67796d1d", "[0].soil": "929487c2e2a6c580",
             "[0].memory.paths": "9f2cbf86d4262183", "[0].memory.costs": "d95e9a95d9498a7c",
             "[0].stale": "91ce314c0a497422", "[1].best_cost": "942d5dfff171f2ca",
             "[1].iteration_cost": "3454cb8d1144f62a", "[1].arrived": "77d216a69772d7a1",
             "[1].iterations": "40e736c02a102a05", "[1].moves": "f4c87a3dd175dc01",
-            "[1].lane_steps": "a13389c902fc5cc9", "[1].evaluations": "09f810538d9135e7",
+            "[1].lane_steps": "a13389c902fc5cc9", "[1].evaluations": "e4ba20658830cd73",
         },
         1: {
-            "[0].key": "c612fd0369ff1964", "[0].soil": "cfc2d3c3fb4e2fa2",
+            "[0].key": "c612fd0369ff1964", "[0].soil": "5e675b430d0f01ba",
             "[0].memory.paths": "74879d9ef76c9f74", "[0].memory.costs": "779f0a83fb2c2433",
             "[0].stale": "a376d173ece243d5", "[1].best_cost": "5dd5ee3055823fe7",
             "[1].iteration_cost": "1de1324fe01000e7", "[1].arrived": "ded4f45924fb0267",
             "[1].iterations": "0623ccb9b1619bd3", "[1].moves": "6464498b60a7aa45",
-            "[1].lane_steps": "0ddc2a19dcd9ac18", "[1].evaluations": "d4d51995a0ec55c3",
+            "[1].lane_steps": "0ddc2a19dcd9ac18", "[1].evaluations": "bc6f5d65baa5e027",
         },
         2: {
-            "[0].key": "fc34219733dd7ee7", "[0].soil": "18ce7df985d64aa7",
+            "[0].key": "fc34219733dd7ee7", "[0].soil": "f0a491624ef4a133",
             "[0].memory.paths": "ca56cbfde6887f8d", "[0].memory.costs": "bc7dd1e1b68b9511",
             "[0].stale": "c0736411a62ec0f4", "[1].best_cost": "02052479abb1a729",
             "[1].iteration_cost": "4a4771c75b17503b", "[1].arrived": "88fb9eb024a10e75",
             "[1].iterations": "40e736c02a102a05", "[1].moves": "a12c8dbaae46a27f",
-            "[1].lane_steps": "92541f9de7b20e8e", "[1].evaluations": "ba0dfbab235a4089",
+            "[1].lane_steps": "92541f9de7b20e8e", "[1].evaluations": "9d61ea05c722ff6c",
         },
     },
     "maze20": {
@@ -117,7 +112,7 @@ RECORDED = {
             "[1].lane_steps": "6636349a4afee2c9", "[1].evaluations": "99c28d92a8b1e901",
         },
         1: {
-            "[0].key": "891e380f28824aeb", "[0].soil": "092fc14b970a66f8",
+            "[0].key": "891e380f28824aeb", "[0].soil": "2dccc92f5a84afef",
             "[0].memory.paths": "ae7b09b13a79e553", "[0].memory.costs": "f941ecf371914389",
             "[0].stale": "67abdd721024f0ff", "[1].best_cost": "0eafcd13528da8af",
             "[1].iteration_cost": "0eafcd13528da8af", "[1].arrived": "26537abd03a9ae64",
@@ -135,10 +130,9 @@ RECORDED = {
     },
 }
 """Per map and key: the digest (first 16 hex digits of SHA-256) of each leaf of the run's
-``(state, trace)``, 100 iterations, default config, before the speed-up. On the 50 x 50 maps no
-drop of the default config arrives within 100 iterations (IWD's soil rule, issue 39), so the
-records of mosaic20 and maze20, where the drops arrive and the memory operators run, check the
-smoothing and the operators."""
+``(state, trace)``, 100 iterations, default config, jaxswarm 0.7.0. The records of mosaic20 and
+maze20, where the drops arrive early and the memory operators run from the first iterations,
+check the smoothing and the operators on small maps too."""
 
 VARIANTS = {
     "no smooth": dict(smooth=False),
@@ -212,8 +206,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
     # Before JAX's first computation; compile seconds are measured, so no cached programs.
-    if platform.machine().lower() in ("x86_64", "amd64"):
-        os.environ["XLA_FLAGS"] = f"{os.environ.get('XLA_FLAGS', '')} {ISA_CAP}".strip()
     jax.config.update("jax_enable_compilation_cache", False)
     try:
         configure(threads=args.threads)
@@ -224,7 +216,7 @@ def main(argv: list[str] | None = None) -> int:
     graph = chosen.graph
     task = make_task(graph, chosen.start, chosen.goal)
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
-          f"({jax.default_backend()}, {args.threads} XLA thread(s), AVX2) | load "
+          f"({jax.default_backend()}, {args.threads} XLA thread(s)) | load "
           f"{os.getloadavg()[0]:.1f}")
     print(f"iwd_pg on {args.map} ({graph.shape[1]}x{graph.shape[0]}), {args.iterations} "
           f"iterations, no patience, keys {keys}, median of {args.repeats}")
