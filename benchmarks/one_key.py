@@ -71,7 +71,10 @@ print(json.dumps(dict(seconds=statistics.median(seconds),
 def measure(tree: Path, args, name: str) -> dict:
     """One measurement of swarm ``name`` with the jaxswarm of ``tree``: seconds (median),
     moves and evaluations of the batch."""
-    env = dict(os.environ, PYTHONPATH=str(tree), PJRT_NPROC=str(args.threads))
+    # A baseline checkout has no ../shared beside it: both read this tree's Moving AI folder.
+    env = dict(os.environ, PYTHONPATH=str(tree), PJRT_NPROC=str(args.threads),
+               JAXSWARM_MOVINGAI=os.environ.get(
+                   "JAXSWARM_MOVINGAI", str(REPO.parent / "shared" / "benchdata" / "movingai")))
     done = subprocess.run([sys.executable, "-c", MEASURE, name, args.map, str(args.runs),
                            str(args.iterations), str(args.agents), str(args.repeats)],
                           capture_output=True, text=True, env=env, cwd=tree, check=False)

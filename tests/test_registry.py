@@ -18,6 +18,7 @@ GOLDEN = Path(__file__).parent / "golden" / "rfd_graded_0.3.0.json"
 ``tests/golden/record.py``: map, agents, iterations, patience, seed and what came out (best path
 and cost, iterations run, the best cost after each, final altitudes). jaxswarm 0.1.0's
 ``rfd_star`` was this law; 0.3.0's walker draws other random numbers, so the record was made
+again then, and 0.7.0's arithmetic (:mod:`jaxswarm.runtime.arithmetic`) moved its last bits, so
 again then."""
 
 
