@@ -218,25 +218,16 @@ WIDTHS = (1, 3, 64)
 
 
 def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations: int = 8,
-                          widths: tuple[int, ...] = WIDTHS, keys: int | None = None,
-                          runs: list | None = None) -> list:
+                          widths: tuple[int, ...] = WIDTHS, keys: int | None = None) -> None:
     """One key, one result: each of ``keys`` keys (default the widest width) run alone equals
     the same key in vmapped batches (:func:`run_batch`) of each of ``widths``, every leaf of its
-    final state and trace bit for bit (:func:`outcome`). The last batch of a width is filled
-    with the first keys again.
-
-    Args:
-      runs: the keys' runs alone (:func:`outcome` of each), when the caller has them already.
-
-    Returns:
-      The runs alone, for another check of the same keys.
-    """
+    final state and trace bit for bit (:func:`outcome`). A width's last batch is filled up with
+    the last key."""
     count = max(widths) if keys is None else keys
     split = jax.random.split(jax.random.key(11), count)
     params = swarm.default_params
-    if runs is None:
-        runs = [outcome(run(swarm, key, world, task, params, iterations=iterations))
-                for key in split]
+    runs = [outcome(run(swarm, key, world, task, params, iterations=iterations))
+            for key in split]
     for width in widths:
         for first in range(0, count, width):
             rows = np.minimum(np.arange(first, first + width), count - 1)
@@ -247,7 +238,6 @@ def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations:
                                     runs[first + row]), (
                     f"{swarm.name}: key {first + row} alone differs from the same key in a "
                     f"batch of {width}")
-    return runs
 
 
 def check_swarm(swarm: Swarm, graph: World, task: Task, optimum: float) -> None:
