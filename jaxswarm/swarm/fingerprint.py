@@ -46,13 +46,14 @@ def hex_fingerprint(value) -> str:
 
 
 def _words(leaf) -> jax.Array:
-    """u32[n]: a leaf's elements as 32-bit words (keys: their data; narrower types widened,
-    booleans as 0 or 1; 64-bit types split)."""
+    """u32[n]: a leaf's elements as 32-bit words (keys: their data; narrower types widened
+    exactly, booleans as 0 or 1; 64-bit types split)."""
     leaf = jnp.asarray(leaf)
     if jnp.issubdtype(leaf.dtype, jax.dtypes.prng_key):
         leaf = jax.random.key_data(leaf)
     if leaf.dtype == jnp.bool_:
         leaf = leaf.astype(jnp.uint32)
-    elif leaf.dtype.itemsize < 4:
-        leaf = leaf.astype(jnp.int32)
+    elif leaf.dtype.itemsize < 4:  # exactly, as float32 or int32
+        leaf = leaf.astype(jnp.float32 if jnp.issubdtype(leaf.dtype, jnp.floating)
+                           else jnp.int32)
     return jax.lax.bitcast_convert_type(leaf.reshape(-1), jnp.uint32).reshape(-1)
