@@ -104,7 +104,8 @@ def crossings(plane: Plane, a: jax.Array, b: jax.Array) -> jax.Array:
     """i32[...]: how many rectangles the segment from ``a`` to ``b`` passes through (f32[..., 2]
     each, broadcast together)."""
     a, b = jnp.broadcast_arrays(jnp.asarray(a, jnp.float32), jnp.asarray(b, jnp.float32))
-    return jnp.sum(segment_crosses(jnp, plane.rectangles, plane.mask, a, b), axis=-1, dtype=jnp.int32)
+    return jnp.sum(segment_crosses(jnp, plane.rectangles, plane.mask, a, b), axis=-1,
+                   dtype=jnp.int32)
 
 
 def in_plane(plane: Plane, points: jax.Array) -> jax.Array:
