@@ -5,50 +5,31 @@ counts, in processes of their own, are checked in ``test_sweep.py``. A file of i
 its compiles run beside ``test_swarm.py``'s on another worker."""
 import pytest
 import sizes
+from conformance import field, maze, world_of  # noqa: F401 (fixtures)
 
 from jaxswarm import swarm as swarms
-from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import make, make_task
+from jaxswarm.swarm import make
 from jaxswarm.swarm.testing import check_batch_invariant
-from jaxswarm.world.plane import Plane
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
 
 
-@pytest.fixture(scope="module")
-def maze():
-    chosen = paper_map(sizes.MAP)
-    graph = chosen.graph()
-    return graph, make_task(graph, chosen.start, chosen.goal)
-
-
-@pytest.fixture(scope="module")
-def field():
-    plane, start, goal = sizes.plane()
-    return plane, make_task(plane, start, goal)
-
-
-def world_of(name, maze, field):
-    """The conformance world of a swarm: maze20 for the walkers, the 6 x 6 plane for the bees."""
-    return field if make(name).world is Plane else maze
-
-
 @pytest.mark.parametrize("name", swarms.registered())
 def test_a_key_gives_one_result_alone_and_in_batches_of_1_3_and_64(name, maze, field):
-    world, task = world_of(name, maze, field)
+    world, task, _ = world_of(name, maze, field)
     check_batch_invariant(make(name, **SMALL), world, task, iterations=ITERATIONS)
 
 
 @pytest.mark.slow  # 1,000 runs alone per swarm, of 2 iterations to fit CI: minutes in all
 @pytest.mark.parametrize("name", swarms.registered())
 def test_a_thousand_keys_alone_equal_them_in_one_batch_of_a_thousand(name, maze, field):
-    world, task = world_of(name, maze, field)
+    world, task, _ = world_of(name, maze, field)
     check_batch_invariant(make(name, **SMALL), world, task, iterations=2, widths=(1000,))
 
 
 def test_a_hooked_walk_gives_one_result_alone_and_in_batches(maze):
     # Drops that change the soil as they walk read each other's writes: in a batch, as alone.
-    world, task = maze
+    world, task, _ = maze
     check_batch_invariant(make("iwd", local_updates="while_walking", **SMALL), world, task,
                           iterations=ITERATIONS)

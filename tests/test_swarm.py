@@ -7,10 +7,10 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import sizes
+from conformance import field, maze, world_of  # noqa: F401 (fixtures)
 
 from jaxswarm import swarm as swarms
-from jaxswarm.exact import dijkstra, optimal_length
-from jaxswarm.exact.visibility import shortest_path
+from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
@@ -19,30 +19,9 @@ from jaxswarm.swarm.testing import (Compilations, check_compiles_once, check_rep
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution
-from jaxswarm.world.plane import Plane
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
-
-
-@pytest.fixture(scope="module")
-def maze():
-    chosen = paper_map(sizes.MAP)
-    graph = chosen.graph()
-    return graph, make_task(graph, chosen.start, chosen.goal), optimal_length(
-        graph, chosen.start, chosen.goal)
-
-
-@pytest.fixture(scope="module")
-def field():
-    """The bees' shared plane (:func:`sizes.plane`), its task and its optimum."""
-    plane, start, goal = sizes.plane()
-    return plane, make_task(plane, start, goal), shortest_path(plane, start, goal)[0]
-
-
-def world_of(name, maze, field):
-    """The conformance world of a swarm: maze20 for the walkers, the 6 x 6 plane for the bees."""
-    return field if make(name).world is Plane else maze
 
 
 @pytest.mark.parametrize("name", swarms.registered())
