@@ -18,8 +18,8 @@ or its solution breaks a rule.
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
 map.
 
-``jaxswarm replay STORE ROW`` runs one row of a sweep store again, alone
-(:mod:`jaxswarm.sweep.replay`), prints the stored and the replayed figures, draws the run and
+``jaxswarm replay STORE ROW`` runs one row of a sweep store (or of a table's ``runs.csv``) again,
+alone (:mod:`jaxswarm.sweep.replay`), prints the stored and the replayed figures, draws the run and
 exits with status 1 when the replay does not reproduce the row bit for bit.
 """
 from __future__ import annotations
@@ -168,11 +168,13 @@ def _add_sweep_parser(subparsers) -> None:
 def _add_replay_parser(subparsers) -> None:
     """The ``replay`` sub-command: run one row of a sweep store again, alone."""
     replay = subparsers.add_parser(
-        "replay", help="run one row of a sweep store again, alone, check that it gives the "
-                       "stored figures bit for bit and draw it")
-    replay.add_argument("store", type=Path, help="a sweep's results directory")
+        "replay", help="run one row of a sweep store or of a results table again, alone, "
+                       "check that it gives the stored figures bit for bit and draw it")
+    replay.add_argument("store", type=Path,
+                        help="a sweep's results directory, or a results/ folder with runs.csv")
     replay.add_argument("row", type=int,
-                        help="the row's position in jaxswarm.sweep.read_results(STORE), from 0")
+                        help="the row's position in jaxswarm.sweep.read_results(STORE), or in "
+                             "runs.csv, from 0")
     replay.add_argument("--out", type=Path,
                         help="folder of the figure (default out/replay/STORE_NAME)")
 
@@ -184,13 +186,12 @@ def run_replay(args: argparse.Namespace) -> int:
 
     matplotlib.use("Agg")
     from jaxswarm.plot.sweep import plot_replay
-    from jaxswarm.sweep.replay import CHECKED, replay_row
+    from jaxswarm.sweep.replay import replay_row
 
     replayed = replay_row(args.store, args.row)
     row = replayed.row
-    print(f"{args.store} row {args.row}: {row['algorithm']} on {row['map']}, run {row['run']}, "
-          f"seed {row['seed']}")
-    for name in CHECKED:
+    print(f"{args.store} row {args.row}: {replayed.title}")
+    for name in replayed.figures:
         mark = "" if f"{name}:" not in " ".join(replayed.differences) else "   <- differs"
         print(f"  {name:<12} stored {row[name]!s:<20} replayed {replayed.figures[name]!s}{mark}")
     out = args.out if args.out is not None else Path("out/replay") / Path(args.store).name

@@ -40,12 +40,14 @@ from jaxswarm.studies.arguments import add_out_argument, check_counts
 from jaxswarm.studies.problems import (Problem, movingai_folder, named_problem,
                                        scenario_problem)
 from jaxswarm.studies.success import reaches_optimum, relative_gap
+from jaxswarm.sweep.run_record import COLUMNS as REPLAY_COLUMNS
 from jaxswarm.studies.timing import median_milliseconds, seed_keys, timed_runs
 from jaxswarm.swarm import definition, make
 
 COLUMNS = ("map", "variant", "seed", "optimum", "cost", "gap", "found", "optimal", "iterations",
-           "evaluations", "seconds")
-"""Columns of runs.csv (``evaluations``: complete paths evaluated, all iterations)."""
+           "evaluations", "seconds", *REPLAY_COLUMNS)
+"""Columns of runs.csv (``evaluations``: complete paths evaluated, all iterations;
+``run_record`` and ``fingerprint``: what ``jaxswarm replay`` needs to run the row again)."""
 TITLE = "Intelligent Water Drops (the IWD_PG paper's baseline) on the RFD paper's maps"
 """Title of table.md."""
 ABOUT = ("`iwd` is Shah-Hosseini's IWD with its standard values, as the IWD_PG paper uses it "
@@ -96,7 +98,7 @@ def study_map(problem: Problem, variant: str, *, seeds: int, drops: int, iterati
         name: type(getattr(swarm.default_params, name))(value)
         for name, value in chosen.params.items()})
     runs = timed_runs(swarm, seed_keys(seeds), problem.graph, problem.task, params,
-                      iterations=iterations, patience=patience)
+                      iterations=iterations, patience=patience, entry=problem.entry)
     rows = []
     for seed, one in enumerate(runs):
         cost = float(swarm.best(one.state).cost)
@@ -104,7 +106,8 @@ def study_map(problem: Problem, variant: str, *, seeds: int, drops: int, iterati
         rows.append(dict(map=problem.label, variant=variant, seed=seed, optimum=problem.optimum,
                          cost=cost, gap=gap, found=cost != float("inf"),
                          optimal=reaches_optimum(gap), iterations=int(one.trace.iterations),
-                         evaluations=int(one.trace.evaluations.sum()), seconds=one.seconds))
+                         evaluations=int(one.trace.evaluations.sum()), seconds=one.seconds,
+                         **one.replay))
     return rows
 
 

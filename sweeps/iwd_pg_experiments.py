@@ -63,6 +63,7 @@ from jaxswarm.studies.arguments import (add_out_argument, check_counts,  # noqa:
 from jaxswarm.studies.figures import write_png  # noqa: E402
 from jaxswarm.studies.problems import Problem, make_problem, named_problem  # noqa: E402
 from jaxswarm.studies.success import SUCCESS_GAP, at_optimum  # noqa: E402
+from jaxswarm.sweep.run_record import COLUMNS as REPLAY_COLUMNS  # noqa: E402
 from jaxswarm.studies.timing import TimedRun, seed_keys, timed_runs  # noqa: E402
 from jaxswarm.swarm import Swarm, definition, make  # noqa: E402
 from jaxswarm.swarm.iwd import fuzzy  # noqa: E402
@@ -96,8 +97,10 @@ IWD_PG_MAPS = ("field", "complex")
 PAPER_MAPS = ("mosaic20", "alley20", "maze20", "mosaic50", "alley50", "maze50")
 """The RFD paper's maps of experiment 7 (default)."""
 RUN_COLUMNS = ("experiment", "map", "variant", "seed", "optimum", "cost", "optimal",
-               "iterations", "evaluations", "evaluations_to_optimum", "seconds")
-"""Columns of runs.csv."""
+               "iterations", "evaluations", "evaluations_to_optimum", "seconds", *REPLAY_COLUMNS)
+"""Columns of runs.csv (``run_record`` and ``fingerprint``: what ``jaxswarm replay`` needs to
+run the row again; ``run_record`` empty on the paper's own field maps, which no map entry
+names)."""
 CURVE_COLUMNS = ("experiment", "variant", "seed", "iteration", "best_cost", "evaluations")
 """Columns of curves.csv."""
 SCORE_COLUMNS = ("path", "length", "section", "spl", "ospl", "score")
@@ -153,7 +156,7 @@ def run_rows(experiment: int, problem: Problem, variant: str, seed: int, swarm: 
                optimum=problem.optimum, cost=cost, optimal=at_optimum(cost, problem.optimum),
                iterations=used, evaluations=int(calls[-1]) if used else 0,
                evaluations_to_optimum="" if first is None else int(calls[first - 1]),
-               seconds=one.seconds)
+               seconds=one.seconds, **one.replay)
     curves = [dict(experiment=experiment, variant=variant, seed=seed, iteration=t + 1,
                    best_cost=float(best[t]), evaluations=int(calls[t])) for t in range(used)]
     return row, curves
@@ -166,7 +169,7 @@ def study(experiment: int, map_name: str, swarm_name: str, variant: str, options
     problem = load_problem(map_name)
     swarm = make(swarm_name, num_agents=drops, **options)
     timed = timed_runs(swarm, seed_keys(runs), problem.graph, problem.task, swarm.default_params,
-                       iterations=iterations)
+                       iterations=iterations, entry=problem.entry)
     rows, curves = [], []
     for seed, one in enumerate(timed):
         row, curve = run_rows(experiment, problem, variant, seed, swarm, one)

@@ -49,6 +49,7 @@ from jaxswarm.maps.named import named_map
 from jaxswarm.maps.paper import paper_maps_argument
 from jaxswarm.plot.graph import draw_map, draw_paths
 from jaxswarm.runtime.atomic import write_csv
+from jaxswarm.runtime.programs import release_if_crowded
 from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts, numbers_argument
 from jaxswarm.studies.figures import panel_grid, write_png
@@ -133,6 +134,7 @@ def swarm_runs(name, chosen, graph, row, tables, *, seeds, iterations, patience,
         for seed, (key, state) in enumerate(zip(keys, states)):
             key = jax.random.fold_in(key, table)
             if seed == 0:
+                release_if_crowded()
                 jax.block_until_ready(replay(state, key, iterations))  # compile
             (solution, trace), seconds = timed_call(replay, state, key, iterations)
             first = first_iteration_at(trace, scenario.optimum, gap=SUCCESS_GAP)

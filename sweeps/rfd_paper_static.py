@@ -67,6 +67,7 @@ from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts
 from jaxswarm.studies.figures import panel_grid, write_png
 from jaxswarm.studies.problems import Problem, named_problem
+from jaxswarm.sweep.run_record import COLUMNS as REPLAY_COLUMNS
 from jaxswarm.studies.rfd_table1 import (ABOUT, ALGORITHMS, BY_LABEL, ROWS, Row, draw_best_paths,
                                          length_cell, optimal_cell, row_definitions,
                                          run_planner_row, run_swarm_row, time_cell)
@@ -74,20 +75,22 @@ from jaxswarm.studies.success import SUCCESS_GAP, relative_gap
 from jaxswarm.world.paths import Solution
 
 COLUMNS = ("map", "algorithm", "planner", "seed", "optimum", "cost", "gap", "found", "iterations",
-           "seconds")
-"""Columns of runs.csv."""
+           "seconds", *REPLAY_COLUMNS)
+"""Columns of runs.csv (``run_record`` and ``fingerprint``: what ``jaxswarm replay`` needs to
+run a swarm's row again; empty for an exact planner's)."""
 TITLE = "RFD paper, Table 1 (static environment): ours beside the paper's"
 """Title of table.md."""
 
 
 def make_row(problem: Problem, row: Row, seed: int, solution: Solution, iterations: int | str,
-             seconds: float) -> dict:
+             seconds: float, replay: dict | None = None) -> dict:
     """One runs.csv row for one run of ``row`` on ``problem`` and its best ``solution`` (cost
-    f[], found bool[])."""
+    f[], found bool[]); ``replay``: a swarm run's replay columns."""
     cost = float(solution.cost)
     return dict(map=problem.label, algorithm=row.label, planner=row.planner(), seed=seed,
                 optimum=problem.optimum, cost=cost, gap=relative_gap(cost, problem.optimum),
-                found=bool(solution.found), iterations=iterations, seconds=seconds)
+                found=bool(solution.found), iterations=iterations, seconds=seconds,
+                **(replay or dict.fromkeys(REPLAY_COLUMNS, "")))
 
 
 def solve_row(row: Row, problem: Problem, seeds: int, *, iterations: int,
@@ -107,7 +110,8 @@ def solve_row(row: Row, problem: Problem, seeds: int, *, iterations: int,
     else:
         swarm, runs = run_swarm_row(row, problem, seeds, iterations=iterations, agents=agents)
         solutions = [swarm.best(one.state) for one in runs]
-        rows = [make_row(problem, row, seed, solution, int(one.trace.iterations), one.seconds)
+        rows = [make_row(problem, row, seed, solution, int(one.trace.iterations), one.seconds,
+                         one.replay)
                 for seed, (solution, one) in enumerate(zip(solutions, runs))]
     return rows, min(solutions, key=lambda solution: float(solution.cost))
 

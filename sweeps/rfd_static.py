@@ -32,6 +32,7 @@ from jaxswarm.runtime.atomic import write_csv
 from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts
 from jaxswarm.studies.problems import Problem, named_problem
+from jaxswarm.sweep.run_record import COLUMNS as REPLAY_COLUMNS
 from jaxswarm.studies.rfd_table1 import BY_SWARM, run_swarm_row
 from jaxswarm.studies.success import SUCCESS_GAP, reaches_optimum, relative_gap
 from jaxswarm.studies.timing import median_milliseconds
@@ -42,9 +43,10 @@ SOURCES = {"rfd": "RFD paper", "rfd_star": "RFD paper", "rfd_graded": "ours"}
 ALGORITHMS = tuple(SOURCES)
 """The registered swarms of the table, in order."""
 COLUMNS = ("map", "algorithm", "seed", "optimum", "cost", "gap", "success", "iterations",
-           "first_optimal_iteration", "seconds", "moves", "lane_steps")
+           "first_optimal_iteration", "seconds", "moves", "lane_steps", *REPLAY_COLUMNS)
 """Columns of runs.csv (``moves``: the drops' moves in all iterations; ``lane_steps``: the
-walker's lane-steps, so ``moves / lane_steps`` is the share of its work that moved a drop)."""
+walker's lane-steps, so ``moves / lane_steps`` is the share of its work that moved a drop;
+``run_record`` and ``fingerprint``: what ``jaxswarm replay`` needs to run the row again)."""
 TITLE = "RFD, RFD* and RFD graded on the RFD paper's nine maps (static environment)"
 """Title of table.md."""
 ABOUT = (
@@ -71,7 +73,7 @@ def run_algorithm(problem: Problem, algorithm: str, seeds: int, *, iterations: i
                          moves=int(one.trace.moves.sum()),
                          lane_steps=int(one.trace.lane_steps.sum()),
                          first_optimal_iteration="" if first is None else first,
-                         seconds=one.seconds))
+                         seconds=one.seconds, **one.replay))
     return rows
 
 

@@ -3,6 +3,7 @@ from pathlib import Path
 
 import pytest
 from jaxswarm.runtime.cpu import THREADS_VARIABLE
+from jaxswarm.runtime.programs import release_if_crowded
 
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
@@ -14,6 +15,15 @@ os.environ.setdefault("JAXSWARM_MOVINGAI", str(MOVINGAI))
 if "PYTEST_XDIST_WORKER_COUNT" in os.environ:
     os.environ.setdefault(THREADS_VARIABLE, str(max(
         1, (os.cpu_count() or 1) // int(os.environ["PYTEST_XDIST_WORKER_COUNT"]))))
+
+
+@pytest.fixture(autouse=True)
+def _room_for_programs():
+    """A worker compiles hundreds of programs; XLA's code pages would exhaust the process's
+    memory mappings (:mod:`jaxswarm.runtime.programs`), so each test ends by letting them go once
+    the worker holds half its limit."""
+    yield
+    release_if_crowded()
 
 
 @pytest.fixture(scope="session")

@@ -13,12 +13,15 @@ from jaxswarm.swarm.testing import check_batch_invariant
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
+KEYS = 4
+"""Keys of the default checks, each alone and in every width (the width 64 batch holds them and
+copies of the last): a width's program is compiled once whatever the count, its runs are not."""
 
 
 @pytest.mark.parametrize("name", swarms.registered())
 def test_a_key_gives_one_result_alone_and_in_batches_of_1_3_and_64(name, maze, field):
     world, task, _ = world_of(name, maze, field)
-    check_batch_invariant(make(name, **SMALL), world, task, iterations=ITERATIONS)
+    check_batch_invariant(make(name, **SMALL), world, task, iterations=ITERATIONS, keys=KEYS)
 
 
 @pytest.mark.slow  # 1,000 runs alone per swarm, of 2 iterations to fit CI: minutes in all
@@ -32,4 +35,4 @@ def test_a_hooked_walk_gives_one_result_alone_and_in_batches(maze):
     # Drops that change the soil as they walk read each other's writes: in a batch, as alone.
     world, task, _ = maze
     check_batch_invariant(make("iwd", local_updates="while_walking", **SMALL), world, task,
-                          iterations=ITERATIONS)
+                          iterations=ITERATIONS, keys=KEYS)

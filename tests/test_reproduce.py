@@ -430,3 +430,30 @@ def test_the_first_input_runs_once_more_to_compile_and_every_run_is_timed():
 def test_seed_keys_split_the_seed_key():
     assert (jax.random.key_data(seed_keys(3, seed=7))
             == jax.random.key_data(jax.random.split(jax.random.key(7), 3))).all()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("table", ["rfd_paper_table1", "rfd_static", "iwd_paper_maps"])
+def test_a_tables_swarm_rows_replay_alone_bit_for_bit(quick, table):
+    from jaxswarm.sweep.replay import replay_row
+
+    folder, _, _ = quick
+    rows = read_csv(folder / table / "runs.csv")
+    replayable = [index for index, row in enumerate(rows) if row["run_record"]]
+    assert replayable, f"{table}: no row has a run record"
+    for index in {replayable[0], replayable[-1]}:
+        replayed = replay_row(folder / table, index)
+        assert replayed.reproduced, (table, index, replayed.differences)
+
+
+@pytest.mark.slow
+def test_iwd_pg_rows_on_its_own_fields_say_they_cannot_be_replayed(quick):
+    from jaxswarm.sweep.replay import replay_row
+
+    folder, _, _ = quick
+    fields = load_script("sweeps/iwd_pg_experiments.py").IWD_PG_MAPS
+    rows = read_csv(folder / "iwd_pg_experiments" / "runs.csv")
+    assert rows and all((row["run_record"] == "") == (row["map"] in fields) for row in rows)
+    first = next(index for index, row in enumerate(rows) if row["map"] in fields)
+    with pytest.raises(ValueError, match="no run record"):
+        replay_row(folder / "iwd_pg_experiments", first)

@@ -121,8 +121,7 @@ def plot_replay(replayed: Replayed, path) -> Path:
     row, world = replayed.row, replayed.sweep_map.world
     solution = replayed.swarm.best(replayed.state)
     verdict = "reproduces the row" if replayed.reproduced else "differs from the row"
-    title = (f"{replayed.swarm.name} on {row['map']}, run {row['run']} (seed {row['seed']}): "
-             f"{verdict}")
+    title = f"{replayed.title}: {verdict}"
     start, goal = replayed.sweep_map.start, replayed.sweep_map.goal
     if isinstance(world, Plane):
         fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.5))
@@ -130,11 +129,11 @@ def plot_replay(replayed: Replayed, path) -> Path:
         draw_trajectory(left, solution.path, label=f"best ({float(solution.cost):.2f})",
                         color="tab:red")
         left.legend(loc="upper right")
-        draw_trace(right, replayed.trace, optimum=row["optimum"])
+        draw_trace(right, replayed.trace, optimum=row.get("optimum"))
         fig.suptitle(title)
     else:
         fig = plot_swarm_run(world, replayed.swarm.memory(replayed.state), solution,
-                             replayed.trace, start=start, goal=goal, optimum=row["optimum"],
+                             replayed.trace, start=start, goal=goal, optimum=row.get("optimum"),
                              field_label=replayed.swarm.memory_label, title=title)
     _save(fig, Path(path))
     return Path(path)

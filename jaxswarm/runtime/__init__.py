@@ -1,6 +1,7 @@
 """How jaxswarm runs: arithmetic whose result does not depend on the batch
 (:mod:`~jaxswarm.runtime.arithmetic`), XLA:CPU devices and threads
 (:mod:`~jaxswarm.runtime.cpu`), compiled programs kept between processes
-(:mod:`~jaxswarm.runtime.cache`), files written whole or not at all
+(:mod:`~jaxswarm.runtime.cache`) and let go when a process holds too many
+(:mod:`~jaxswarm.runtime.programs`), files written whole or not at all
 (:mod:`~jaxswarm.runtime.atomic`) and a vmap rule for loops whose trip count differs between
 batch members (:mod:`~jaxswarm.runtime.batching`)."""

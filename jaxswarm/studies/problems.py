@@ -6,11 +6,11 @@ import math
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.movingai import load_map, load_scenarios
-from jaxswarm.maps.named import named_map
+from jaxswarm.maps.named import PAPER, map_kind, named_map
 from jaxswarm.studies import provenance
 from jaxswarm.sweep.maps import MOVINGAI_DATA
 from jaxswarm.swarm import Task, make_task
@@ -27,6 +27,8 @@ class Problem(NamedTuple):
       start, goal: (x, y) cells.
       task: the swarms' Task (start and goal as node indices, i32[] each).
       optimum: the exact planner's path length (a Python float).
+      entry: the sweep-spec map entry that builds the same graph, start and goal again
+        (:mod:`jaxswarm.sweep.maps`), or None for a map built otherwise.
     """
 
     label: str
@@ -35,21 +37,23 @@ class Problem(NamedTuple):
     goal: tuple[int, int]
     task: Task
     optimum: float
+    entry: Any = None
 
 
 def make_problem(label: str, graph: Graph, start: tuple[int, int], goal: tuple[int, int], *,
-                 planner: Callable[..., Solution] = dijkstra) -> Problem:
+                 planner: Callable[..., Solution] = dijkstra, entry=None) -> Problem:
     """The problem of ``graph`` from ``start`` to ``goal``, its optimum found by ``planner``
-    (an exact planner of :mod:`jaxswarm.exact`)."""
+    (an exact planner of :mod:`jaxswarm.exact`); ``entry``: the map entry that builds it."""
     return Problem(label, graph, start, goal, make_task(graph, start, goal),
-                   float(planner(graph, start, goal).cost))
+                   float(planner(graph, start, goal).cost), entry)
 
 
 def named_problem(name: str, *, seed: int = 0,
                   planner: Callable[..., Solution] = dijkstra) -> Problem:
     """The problem of the map ``name`` (a paper map or ``pathmapWxH`` seeded by ``seed``, see
     :func:`jaxswarm.maps.named.named_map`) with its own start and goal."""
-    return make_problem(*named_map(name, seed=seed), planner=planner)
+    entry = name if map_kind(name) == PAPER else dict(pathmap=name[len("pathmap"):], seed=seed)
+    return make_problem(*named_map(name, seed=seed), planner=planner, entry=entry)
 
 
 def movingai_folder() -> Path:
@@ -74,9 +78,24 @@ def scenario_problem(folder: Path, name: str, *,
     for path in (map_path, scenario_path):
         if not path.is_file():
             raise ValueError(f"Moving AI file {path} not found")
-    rows = sorted((row for row in load_scenarios(scenario_path)
-                   if math.isfinite(row.optimal_length)), key=lambda row: row.optimal_length)
+    scenarios = load_scenarios(scenario_path)
+    rows = sorted((index for index, row in enumerate(scenarios)
+                   if math.isfinite(row.optimal_length)),
+                  key=lambda index: scenarios[index].optimal_length)
     if not rows:
         raise ValueError(f"{scenario_path}: no row has a path")
-    row = rows[len(rows) // 2]
-    return make_problem(name, load_map(map_path), row.start, row.goal, planner=planner)
+    index = rows[len(rows) // 2]
+    entry = dict(movingai=_entry_path(map_path), scenario=index,
+                 scenario_file=scenario_path.name)
+    return make_problem(name, load_map(map_path), scenarios[index].start,
+                        scenarios[index].goal, planner=planner, entry=entry)
+
+
+def _entry_path(map_path: Path) -> str:
+    """``map_path`` as a map entry names it: relative to the Moving AI folder (the parent of
+    :func:`movingai_folder`, which ``$JAXSWARM_MOVINGAI`` names to a sweep) where it lies
+    there, so that the entry holds on another machine; else absolute."""
+    folder = movingai_folder().parent.resolve()
+    if map_path.resolve().is_relative_to(folder):
+        return str(map_path.resolve().relative_to(folder))
+    return str(map_path.resolve())

@@ -107,7 +107,7 @@ def run_swarm_row(row: Row, problem: Problem, seeds: int, *, iterations: int, ag
     """
     swarm, params = row_swarm(row, agents)
     runs = timed_runs(swarm, seed_keys(seeds), problem.graph, problem.task, params,
-                      iterations=iterations, patience=patience)
+                      iterations=iterations, patience=patience, entry=problem.entry)
     return swarm, runs
 
 

@@ -7,7 +7,9 @@ bees (``{ plane = "map1" }``, the bees paper's map #1 or #2, or
 :func:`jaxswarm.maps.planes.random_plane`) or one row of a Moving AI
 scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 counted from 0;
 ``scenario_file = "random"`` takes the MAPF set's ``<map>-random-1.scen`` instead of the default
-``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map).
+``<map>.map.scen`` or ``<map>-even-1.scen``, and any other value names a file beside the map), or
+a seeded thin-wall path map (``{ pathmap = "20x20", seed = 3 }``, see
+:func:`jaxswarm.maps.random.random_path_map`), top-left to bottom-right.
 A relative ``.map`` path is looked up beside the spec, then in the folder that the environment
 variable ``JAXSWARM_MOVINGAI`` names (e.g. ``shared/benchdata/movingai``).
 """
@@ -22,7 +24,7 @@ import jax
 from jaxswarm.exact import optimal_length
 from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps import movingai
-from jaxswarm.maps.named import PAPER, map_kind, named_map
+from jaxswarm.maps.named import PAPER, PATH_MAP, map_kind, named_map
 from jaxswarm.maps.paper import PAPER_MAPS
 from jaxswarm.maps.planes import PAPER_PLANES, RANDOM_RECTANGLES, paper_plane, random_plane
 from jaxswarm.maps.random import random_grid
@@ -33,6 +35,7 @@ from jaxswarm.world.plane import Plane
 RANDOM_KEYS = {"random", "seed", "density"}
 PLANE_KEYS = {"plane", "seed", "rectangles"}
 MOVINGAI_KEYS = {"movingai", "scenario", "scenario_file"}
+PATH_MAP_KEYS = {"pathmap", "seed"}
 MOVINGAI_DATA = "JAXSWARM_MOVINGAI"
 """The environment variable naming the folder of Moving AI maps (relative entries are looked up
 there after the spec's own folder)."""
@@ -80,7 +83,7 @@ def check_map_entry(entry) -> str | None:
         if map_kind(entry) != PAPER:
             return (f"unknown map {entry!r}; paper maps: {', '.join(PAPER_MAPS)} (or a table "
                     "{ random = SIZE, seed = S } / { movingai = FILE, scenario = ROW } / "
-                    "{ plane = NAME })")
+                    "{ plane = NAME } / { pathmap = WxH, seed = S })")
         return None
     if not isinstance(entry, dict):
         return f"a map is a paper map name or a table, got {entry!r}"
@@ -127,7 +130,23 @@ def check_map_entry(entry) -> str | None:
             return (f"scenario_file = {entry['scenario_file']!r}: 'even', 'random' or a .scen "
                     "file beside the map")
         return None
-    return f"a map table needs a 'random', 'movingai' or 'plane' key, got {sorted(entry)}"
+    if "pathmap" in entry:
+        return _check_path_map(entry)
+    return (f"a map table needs a 'random', 'movingai', 'plane' or 'pathmap' key, got "
+            f"{sorted(entry)}")
+
+
+def _check_path_map(entry: dict) -> str | None:
+    """The problem with a ``{ pathmap = "WxH", seed = S }`` entry, or None."""
+    unknown = set(entry) - PATH_MAP_KEYS
+    if unknown:
+        return f"unknown keys {sorted(unknown)} for a path map (pathmap, seed)"
+    size = entry["pathmap"]
+    if not isinstance(size, str) or map_kind(f"pathmap{size}") != PATH_MAP:
+        return f"pathmap = {size!r}: the size must be 'WxH' (e.g. '20x20')"
+    if not _int_at_least(entry.get("seed"), 0):
+        return f"seed = {entry.get('seed')!r}: a path map needs a non-negative integer seed"
+    return None
 
 
 def entry_world(entry) -> type:
@@ -160,6 +179,10 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
             chosen = paper_plane(entry["plane"])
             label = chosen.label
         return SweepMap(label, chosen.plane, chosen.start, chosen.goal)
+    if "pathmap" in entry:
+        named = named_map(f"pathmap{entry['pathmap']}", seed=entry["seed"])
+        return SweepMap(f"{named.label}-s{entry['seed']}", named.graph, tuple(named.start),
+                        tuple(named.goal))
     if "random" in entry:
         density = float(entry.get("density", 0.3))
         grid = random_grid(entry["random"], entry["seed"], density=density)

@@ -1,11 +1,14 @@
-"""Replay one row of a sweep store alone, and check that it reproduces the stored figures.
+"""Replay one row of a sweep store, or of a table of ``results/``, alone, and check that it
+reproduces the stored figures.
 
 A store's ``metadata.json`` holds the spec, so a row's run is known from the row itself: its map
 (``map_index`` into the spec's maps), its params (the swept columns, every other param the
-swarm's default) and its key (``jax.random.key(seed)``). :func:`replay_row` runs it once, alone,
-and compares cost, iterations, moves, evaluations and the fingerprint of the final state and
-trace (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`) with the stored ones, bit for bit. The
-replay holds the run's state, so its memory and best path can be drawn
+swarm's default) and its key (``jax.random.key(seed)``). A table's ``runs.csv`` row carries its
+own ``run_record`` (:mod:`jaxswarm.sweep.run_record`: swarm, params, map entry, key data, stop
+rules). :func:`replay_row` runs the row once, alone, and compares its figures with the stored
+ones, bit for bit: for a store cost, iterations, moves, evaluations and the fingerprint of the
+final state and trace (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`); for a table cost and
+fingerprint. The replay holds the run's state, so its memory and best path can be drawn
 (:func:`jaxswarm.plot.sweep.plot_replay`); ``jaxswarm replay STORE ROW`` does both.
 """
 from __future__ import annotations
@@ -18,7 +21,9 @@ from typing import Any
 
 import jax
 import numpy as np
+import pandas as pd
 
+from jaxswarm.sweep.run_record import read_run_record
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import Swarm, Task, Trace
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
@@ -27,7 +32,9 @@ from jaxswarm.sweep.spec import spec_from_record
 from jaxswarm.sweep.store import read_results
 
 CHECKED = ("cost", "iterations", "moves", "evaluations", "fingerprint")
-"""The stored figures a replay must reproduce bit for bit."""
+"""The stored figures a replay of a store's row must reproduce bit for bit."""
+TABLE_CHECKED = ("cost", "fingerprint")
+"""The stored figures a replay of a table's row must reproduce bit for bit."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -40,7 +47,8 @@ class Replayed:
       sweep_map: the row's map, resolved again.
       task: its start and goal as the swarm's Task.
       state, trace: what the replayed run returned.
-      figures: the replayed values of :data:`CHECKED`.
+      figures: the replayed values of the checked figures (:data:`CHECKED` for a store's row,
+        :data:`TABLE_CHECKED` for a table's).
       differences: ``"column: stored X, replayed Y"`` for every figure that differs (empty when
         the replay reproduces the row).
     """
@@ -56,45 +64,87 @@ class Replayed:
 
     @property
     def reproduced(self) -> bool:
-        """Whether every figure of :data:`CHECKED` is the stored one, bit for bit."""
+        """Whether every checked figure is the stored one, bit for bit."""
         return not self.differences
+
+    @property
+    def title(self) -> str:
+        """``"SWARM on MAP, seed S"`` (``run R`` too for a store's row)."""
+        run_index = f", run {self.row['run']}" if "map_index" in self.row else ""
+        return (f"{self.swarm.name} on {self.sweep_map.label}{run_index}, "
+                f"seed {self.row.get('seed', '?')}")
 
 
 def replay_row(store, row: int) -> Replayed:
-    """Run row ``row`` of the store at ``store`` again, alone, and compare it with the row.
+    """Run row ``row`` of a sweep store or of a results table again, alone, and compare it with
+    the row.
 
     Args:
-      store: a store directory (:func:`jaxswarm.sweep.run_sweep`'s ``out``).
-      row: the row's position in :func:`jaxswarm.sweep.read_results` of the store (from 0).
+      store: a store directory (:func:`jaxswarm.sweep.run_sweep`'s ``out``), or a folder of
+        ``results/`` whose ``runs.csv`` has a ``run_record`` column.
+      row: the row's position (from 0) in :func:`jaxswarm.sweep.read_results` of the store, or
+        in ``runs.csv``.
 
     Raises:
-      ValueError: ``store`` is not a store with rows, or ``row`` is not one of its rows.
+      ValueError: ``store`` is neither, ``row`` is not one of its rows, or a table's row has no
+        run record.
     """
     store = Path(store)
+    if not (store / "metadata.json").is_file() and (store / "runs.csv").is_file():
+        return _replay_table_row(store / "runs.csv", row)
     metadata_path = store / "metadata.json"
     frame = read_results(store)
     if not metadata_path.is_file() or frame.empty:
-        raise ValueError(f"{store} is not a sweep store with finished rows")
-    if not 0 <= row < len(frame):
-        raise ValueError(f"{store} has rows 0 to {len(frame) - 1}, not row {row}")
-    stored = frame.iloc[row].to_dict()
+        raise ValueError(f"{store} is not a sweep store with finished rows, nor a results "
+                         "folder with a runs.csv")
+    stored = _stored_row(frame, row, store)
     spec = spec_from_record(json.loads(metadata_path.read_text())["spec"],
                             source=str(metadata_path))
     swarm = make(spec.algorithm, **spec.config)
-    sweep_map = resolve_map(spec.maps[int(stored["map_index"])])
-    task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
     params = swarm.default_params._replace(**{
         name: np.float32(stored[name]) for name in spec.params})
-    state, trace = run(swarm, jax.random.key(int(stored["seed"])), sweep_map.world, task, params,
-                       iterations=spec.iterations, patience=spec.patience)
+    return _replayed(stored, swarm, params, resolve_map(spec.maps[int(stored["map_index"])]),
+                     jax.random.key(int(stored["seed"])), spec.iterations, spec.patience,
+                     CHECKED)
+
+
+def _replay_table_row(table: Path, row: int) -> Replayed:
+    """Row ``row`` of a results table (``runs.csv``) replayed from its ``run`` record."""
+    frame = pd.read_csv(table, dtype={"run_record": str, "fingerprint": str},
+                        keep_default_na=False)
+    missing = [name for name in ("run_record", *TABLE_CHECKED) if name not in frame]
+    if missing:
+        raise ValueError(f"{table} has no {', '.join(missing)} column: its rows are not "
+                         "replayable")
+    stored = _stored_row(frame, row, table)
+    record = read_run_record(stored["run_record"], source=f"{table} row {row}")
+    return _replayed(stored, record.swarm, record.params, resolve_map(record.entry), record.key,
+                     record.iterations, record.patience, TABLE_CHECKED)
+
+
+def _stored_row(frame: pd.DataFrame, row: int, source: Path) -> dict:
+    """Row ``row`` of ``frame`` as a dict, or a ValueError naming ``source``'s rows."""
+    if not 0 <= row < len(frame):
+        raise ValueError(f"{source} has rows 0 to {len(frame) - 1}, not row {row}")
+    return frame.iloc[row].to_dict()
+
+
+def _replayed(stored: dict, swarm: Swarm, params, sweep_map: SweepMap, key: jax.Array,
+              iterations: int, patience: int | None, checked: tuple[str, ...]) -> Replayed:
+    """Run ``swarm`` alone on ``sweep_map`` with ``key`` and compare ``checked`` figures with
+    the ``stored`` row."""
+    task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
+    state, trace = run(swarm, key, sweep_map.world, task, params, iterations=iterations,
+                       patience=patience)
     figures = dict(cost=float(swarm.best(state).cost), iterations=int(trace.iterations),
                    moves=int(np.sum(np.asarray(trace.moves), dtype=np.int64)),
                    evaluations=int(np.sum(np.asarray(trace.evaluations), dtype=np.int64)),
                    fingerprint=hex_fingerprint(run_fingerprint(state, trace)))
+    figures = {name: figures[name] for name in checked}
     return Replayed(row=stored, swarm=swarm, sweep_map=sweep_map, task=task, state=state,
                     trace=trace, figures=figures,
                     differences=[f"{name}: stored {stored[name]!r}, replayed {figures[name]!r}"
-                                 for name in CHECKED if not _same(stored[name], figures[name])])
+                                 for name in checked if not _same(stored[name], figures[name])])
 
 
 def _same(stored, replayed) -> bool:

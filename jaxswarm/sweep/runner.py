@@ -41,6 +41,7 @@ import pandas as pd
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 from tqdm.auto import tqdm
 
+from jaxswarm.runtime.programs import release_if_crowded
 from jaxswarm.swarm import definition, make, make_task, run
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.swarm.walking import LANES
@@ -208,6 +209,8 @@ def _compiled(chunks: _SweepChunks, sweep_map: SweepMap, world, task):
     on the devices): compiled and logged the first time a shape comes, reused after."""
     program = _program_key(sweep_map.world)
     if program not in chunks.compiled:
+        if release_if_crowded():  # the process holds too many programs' pages: drop ours too
+            chunks.compiled.clear()
         began = time.perf_counter()
         example = _chunk_inputs(chunks.params, chunks.seeds, 0, chunks.padded, chunks.num_runs,
                                 chunks.batch_sharding)
