@@ -7,7 +7,7 @@ INSTALLED := $(VENV)/.installed
 # run, the slow checks after the default ones and the scripts and notebooks the tests start reuse
 # them (jaxswarm.runtime.cache); CACHE= (empty) runs without.
 CACHE ?= $(HOME)/.cache/jaxswarm
-PYTEST := JAXSWARM_CACHE=$(CACHE) $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadfile --durations=25
+PYTEST := JAXSWARM_CACHE=$(CACHE) $(BIN)/python -m pytest -p no:cacheprovider -n 2 --dist loadscope --durations=25
 
 .PHONY: demo test test-slow docs bench performance reproduce reproduce-quick clean
 

@@ -1,4 +1,4 @@
-"""The worlds the conformance tests share (``test_swarm.py``, ``test_one_key.py``): the RFD
+"""The worlds the conformance tests share (``test_conformance.py``, ``test_swarm.py``): the RFD
 paper's maze of :data:`sizes.MAP` for the walkers, the 6 x 6 plane of :func:`sizes.plane` for the
 bees, each as ``(world, task, optimum)``."""
 import pytest

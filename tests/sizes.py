@@ -11,8 +11,9 @@ AGENTS = 32
 :data:`ITERATIONS` iterations)."""
 ITERATIONS = 8
 """The static iteration budget T of a run."""
-RUNS = 8
-"""Runs of a vmapped batch (keys or params)."""
+RUNS = 3
+"""Runs of a vmapped batch (keys or params): one of the one-key check's widths, so the
+conformance checks of a swarm share that program."""
 CONFIG = dict(num_agents=AGENTS)
 """The swarm options of the shared size: ``make(name, **CONFIG)``."""
 

@@ -1,4 +1,5 @@
-"""Protocol conformance of every registered swarm, and RFD's own rules."""
+"""The conformance checks catch a swarm that breaks them, and RFD's own rules (every swarm's
+conformance: ``test_conformance.py``)."""
 import dataclasses
 import math
 
@@ -7,41 +8,20 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import sizes
-from conformance import field, maze, world_of  # noqa: F401 (fixtures)
+from conformance import maze  # noqa: F401 (fixture)
 
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
-from jaxswarm.swarm.testing import (Compilations, check_compiles_once, check_reproducible,
-                                     check_valid_results)
+from jaxswarm.swarm.testing import Compilations, check_reproducible, check_valid_results
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
-
-
-@pytest.mark.parametrize("name", swarms.registered())
-def test_same_key_is_bit_identical_and_vmap_matches_loop(name, maze, field):
-    world, task, _ = world_of(name, maze, field)
-    check_reproducible(make(name, **SMALL), world, task, iterations=ITERATIONS,
-                       runs=sizes.RUNS)
-
-
-@pytest.mark.parametrize("name", swarms.registered())
-def test_results_are_valid_and_never_beat_the_optimum(name, maze, field):
-    world, task, optimum = world_of(name, maze, field)
-    check_valid_results(make(name, **SMALL), world, task, optimum, iterations=ITERATIONS)
-
-
-@pytest.mark.parametrize("name", swarms.registered())
-def test_a_batch_over_params_compiles_once(name, maze, field):
-    world, task, _ = world_of(name, maze, field)
-    check_compiles_once(make(name, **SMALL), world, task, iterations=ITERATIONS,
-                        runs=sizes.RUNS)
 
 
 @pytest.mark.slow  # about 25 s

@@ -109,7 +109,7 @@ def replay_row(store, row: int) -> Replayed:
 
 
 def _replay_table_row(table: Path, row: int) -> Replayed:
-    """Row ``row`` of a results table (``runs.csv``) replayed from its ``run`` record."""
+    """Row ``row`` of a results table (``runs.csv``) replayed from its ``run_record``."""
     frame = pd.read_csv(table, dtype={"run_record": str, "fingerprint": str},
                         keep_default_na=False)
     missing = [name for name in ("run_record", *TABLE_CHECKED) if name not in frame]

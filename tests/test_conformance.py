@@ -1,0 +1,77 @@
+"""Every registered swarm's promises (:mod:`jaxswarm.swarm.testing`) on its conformance world
+(maze20 for the walkers, the 6 x 6 plane for the bees): one key, one result (alone equals the
+same key in batches of 1, 3 and 64 runs; 1,000 in the slow suite), reproducible per key, valid
+results never below the optimum, a batch over params compiled once. Sweep rows on other thread
+and device counts, in processes of their own, are checked in ``test_sweep.py``.
+
+One test class per swarm: under ``--dist loadscope`` (the Makefile's) a class runs on one
+worker, which compiles the swarm's programs (alone, and in batches of 1, 3 and 64) once for all
+its checks, and the swarms spread over the workers, those slowest to compile first."""
+import pytest
+import sizes
+from conformance import field, maze, world_of  # noqa: F401 (fixtures)
+
+from jaxswarm import swarm as swarms
+from jaxswarm.swarm import make
+from jaxswarm.swarm.testing import (check_batch_invariant, check_compiles_once,
+                                     check_reproducible, check_valid_results)
+
+SMALL = sizes.CONFIG
+ITERATIONS = sizes.ITERATIONS
+KEYS = 4
+"""Keys of the default one-key check, each alone and in every width (the width 64 batch holds
+them and copies of the last): a width's program is compiled once whatever the count."""
+FIRST = ("iwd_pg", "cabc")
+"""The swarms whose programs take longest to compile, whose classes come first."""
+
+
+class Conformance:
+    """The checks of one swarm (``name``), in the order that compiles each program first where
+    the later checks reuse it."""
+
+    name: str
+
+    def _world(self, maze, field):
+        return world_of(self.name, maze, field)
+
+    def test_a_key_gives_one_result_alone_and_in_batches_of_1_3_and_64(self, maze, field):
+        world, task, _ = self._world(maze, field)
+        check_batch_invariant(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
+                              keys=KEYS)
+
+    def test_same_key_is_bit_identical_and_vmap_matches_loop(self, maze, field):
+        world, task, _ = self._world(maze, field)
+        check_reproducible(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
+                           runs=sizes.RUNS)
+
+    def test_results_are_valid_and_never_beat_the_optimum(self, maze, field):
+        world, task, optimum = self._world(maze, field)
+        check_valid_results(make(self.name, **SMALL), world, task, optimum,
+                            iterations=ITERATIONS)
+
+    def test_a_batch_over_params_compiles_once(self, maze, field):
+        world, task, _ = self._world(maze, field)
+        check_compiles_once(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
+                            runs=sizes.RUNS)
+
+    @pytest.mark.slow  # 1,000 runs alone, of 2 iterations to fit CI: about a minute a swarm
+    def test_a_thousand_keys_alone_equal_them_in_one_batch_of_a_thousand(self, maze, field):
+        world, task, _ = self._world(maze, field)
+        check_batch_invariant(make(self.name, **SMALL), world, task, iterations=2,
+                              widths=(1000,))
+
+
+for _name in [*FIRST, *(n for n in swarms.registered() if n not in FIRST)]:
+    globals()[f"TestSwarm_{_name}"] = type(f"TestSwarm_{_name}", (Conformance,), {"name": _name})
+
+
+def test_every_registered_swarm_has_its_class():
+    assert {n for n in globals() if n.startswith("TestSwarm_")} == {
+        f"TestSwarm_{n}" for n in swarms.registered()}
+
+
+def test_a_hooked_walk_gives_one_result_alone_and_in_batches(maze):
+    # Drops that change the soil as they walk read each other's writes: in a batch, as alone.
+    world, task, _ = maze
+    check_batch_invariant(make("iwd", local_updates="while_walking", **SMALL), world, task,
+                          iterations=ITERATIONS, keys=KEYS)
