@@ -457,3 +457,16 @@ def test_iwd_pg_rows_on_its_own_fields_say_they_cannot_be_replayed(quick):
     first = next(index for index, row in enumerate(rows) if row["map"] in fields)
     with pytest.raises(ValueError, match="no run record"):
         replay_row(folder / "iwd_pg_experiments", first)
+
+
+@pytest.mark.slow  # a 256-drop program compiled (20-30 s cold), then one run of 100 iterations
+def test_a_committed_table_row_replays_bit_for_bit():
+    # results/rfd_static was made with this release's arithmetic (SAME_RESULTS_SINCE): a row of
+    # it runs again alone to the same cost and fingerprint.
+    from jaxswarm.sweep.replay import replay_row
+
+    rows = read_csv(ROOT / "results" / "rfd_static" / "runs.csv")
+    row = next(index for index, row in enumerate(rows)
+               if (row["map"], row["algorithm"], row["seed"]) == ("maze20", "rfd_star", "3"))
+    replayed = replay_row(ROOT / "results" / "rfd_static", row)
+    assert replayed.reproduced, replayed.differences
