@@ -10,7 +10,7 @@ from typing import Any, NamedTuple
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.movingai import load_map, load_scenarios
-from jaxswarm.maps.named import PAPER, map_kind, named_map
+from jaxswarm.maps.named import PAPER, PATH_MAP, map_kind, named_map
 from jaxswarm.studies import provenance
 from jaxswarm.sweep.maps import MOVINGAI_DATA
 from jaxswarm.swarm import Task, make_task
@@ -52,7 +52,9 @@ def named_problem(name: str, *, seed: int = 0,
                   planner: Callable[..., Solution] = dijkstra) -> Problem:
     """The problem of the map ``name`` (a paper map or ``pathmapWxH`` seeded by ``seed``, see
     :func:`jaxswarm.maps.named.named_map`) with its own start and goal."""
-    entry = name if map_kind(name) == PAPER else dict(pathmap=name[len("pathmap"):], seed=seed)
+    kind = map_kind(name)
+    entry = name if kind == PAPER else (
+        dict(pathmap=name.removeprefix("pathmap"), seed=seed) if kind == PATH_MAP else None)
     return make_problem(*named_map(name, seed=seed), planner=planner, entry=entry)
 
 
