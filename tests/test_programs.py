@@ -4,24 +4,21 @@ import sys
 
 import jax
 import pytest
-import sizes
+from conformance import maze  # noqa: F401 (fixture)
 
-from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime import programs
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import make, run
 
 linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's /proc only")
 
 
 @linux
-def test_a_compiled_program_holds_mappings_that_a_release_gives_back():
+def test_a_compiled_program_holds_mappings_that_a_release_gives_back(maze):
+    graph, task, _ = maze
     before = programs.mapped_regions()
     # A swarm's run program, of an agent count no other test compiles.
-    chosen = paper_map(sizes.MAP)
-    graph = chosen.graph()
     swarm = make("aco_star", num_agents=3)
-    jax.block_until_ready(run(swarm, jax.random.key(0), graph,
-                              make_task(graph, chosen.start, chosen.goal), swarm.default_params,
+    jax.block_until_ready(run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                               iterations=2))
     held = programs.mapped_regions()
     added = held - before
