@@ -44,6 +44,17 @@ def test_equal_configs_give_one_swarm(name):
     assert definition(make(name, num_agents=32))["config"]["num_agents"] == 32
 
 
+@pytest.mark.parametrize("name", sorted(REGISTRY))
+def test_params_with_sets_the_named_params_as_float32_and_keeps_the_rest(name):
+    swarm = make(name)
+    first = swarm.default_params._fields[0]
+    params = swarm.params_with(**{first: 0.375})
+    assert params[0] == np.float32(0.375) and params[0].dtype == np.float32
+    assert params[1:] == swarm.default_params[1:]
+    with pytest.raises(ValueError, match="no_such_param"):
+        swarm.params_with(no_such_param=1.0)
+
+
 def test_the_papers_variants_are_the_defaults():
     star = make("rfd_star").config
     assert (star.erosion_law, star.erode, star.greedy_drops, star.fill_blind_alleys,

@@ -243,7 +243,7 @@ def plot_swarm_run(graph: Graph, field, solution: Solution, trace, *, start, goa
     Returns:
       The figure (close it with ``plt.close(fig)``).
     """
-    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.5))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.5), layout="constrained")
     draw_field(left, graph, field, label=field_label)
     _draw_walls(left, graph)
     label = f"best ({float(solution.cost):.2f})" if bool(solution.found) else "best (no path)"

@@ -131,6 +131,13 @@ class Swarm:
     adapt: Callable
     world: type = Graph
 
+    def params_with(self, **values: float):
+        """The swarm's default params with the named ones set to ``values`` (NumPy float32
+        scalars): how a stored setting (a sweep row, a run record, a point of a spec's grid)
+        becomes params. An unknown name raises ValueError."""
+        return self.default_params._replace(**{
+            name: np.float32(value) for name, value in values.items()})
+
 
 @dataclasses.dataclass(frozen=True)
 class Trace:

@@ -199,7 +199,7 @@ def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: i
     first = swarm.default_params._fields[0]
     values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, runs)
     for value in values:  # valid values: every run of the sweep is one the swarm accepts
-        swarm.check_params(swarm.default_params._replace(**{first: np.float32(value)}))
+        swarm.check_params(swarm.params_with(**{first: value}))
     grid = batched_params(swarm.default_params, runs)
     grid = grid._replace(**{first: jnp.asarray(values, jnp.float32)})
     other = grid._replace(**{first: jnp.asarray(values * 0.9, jnp.float32)})

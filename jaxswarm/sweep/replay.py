@@ -101,8 +101,7 @@ def replay_row(store, row: int) -> Replayed:
     spec = spec_from_record(json.loads(metadata_path.read_text())["spec"],
                             source=str(metadata_path))
     swarm = make(spec.algorithm, **spec.config)
-    params = swarm.default_params._replace(**{
-        name: np.float32(stored[name]) for name in spec.params})
+    params = swarm.params_with(**{name: stored[name] for name in spec.params})
     return _replayed(stored, swarm, params, resolve_map(spec.maps[int(stored["map_index"])]),
                      jax.random.key(int(stored["seed"])), spec.iterations, spec.patience,
                      CHECKED)

@@ -93,8 +93,7 @@ def read_run_record(text: str, *, source: str) -> RunRecord:
     if problem:
         raise ValueError(f"{source}: {problem}")
     swarm = make(record["algorithm"], **record["config"])
-    params = swarm.default_params._replace(**{
-        name: np.float32(value) for name, value in record["params"].items()})
+    params = swarm.params_with(**record["params"])
     key = jax.random.wrap_key_data(np.asarray(record["key"], np.uint32))
     return RunRecord(swarm, params, record["map"], key, int(record["iterations"]),
                      record["patience"])

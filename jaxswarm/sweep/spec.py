@@ -274,8 +274,7 @@ def _check_grid(spec: SweepSpec, swarm, fail) -> None:
     swarm's message starts with it."""
     for combination in spec.grid():
         try:
-            swarm.check_params(swarm.default_params._replace(
-                **{k: np.float32(v) for k, v in combination.items()}))
+            swarm.check_params(swarm.params_with(**combination))
         except ValueError as error:
             key = next((k for k in combination if str(error).startswith(k)), "[params]")
             fail(f"params.{key}" if key in combination else key, str(error))
