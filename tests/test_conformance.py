@@ -1,15 +1,20 @@
 """Every registered swarm's promises (:mod:`jaxswarm.swarm.testing`) on its conformance world
 (maze20 for the walkers, the 6 x 6 plane for the bees): one key, one result (alone equals the
 same key in batches of 1, 3 and 64 runs; 1,000 in the slow suite), reproducible per key, valid
-results never below the optimum, a batch over params compiled once. Sweep rows on other thread
-and device counts, in processes of their own, are checked in ``test_sweep.py``.
+results never below the optimum, a batch over params compiled once, and its golden records
+(``tests/golden/swarms.json``) replayed bit for bit. Sweep rows on other thread and device
+counts, in processes of their own, are checked in ``test_sweep.py``.
 
 One test class per swarm: under ``--dist loadscope`` (the Makefile's) a class runs on one
 worker, which compiles the swarm's programs (alone, and in batches of 1, 3 and 64) once for all
-its checks, and the swarms spread over the workers, those slowest to compile first."""
+its checks (the golden records are runs alone at the shared size), and the swarms spread over
+the workers, those slowest to compile first."""
+import json
+
 import pytest
 import sizes
 from conformance import field, maze, world_of  # noqa: F401 (fixtures)
+from golden.swarms import GOLDEN, cases, replay
 
 from jaxswarm import swarm as swarms
 from jaxswarm.swarm import make
@@ -23,6 +28,7 @@ KEYS = 4
 them and copies of the last): a width's program is compiled once whatever the count."""
 FIRST = ("iwd_pg", "cabc")
 """The swarms whose programs take longest to compile, whose classes come first."""
+RECORDS = json.loads(GOLDEN.read_text())
 
 
 class Conformance:
@@ -54,6 +60,18 @@ class Conformance:
         check_compiles_once(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
                             runs=sizes.RUNS)
 
+    def test_replays_its_golden_records(self):
+        # Every leaf's digest, the best cost and the iterations it ran, bit for bit.
+        records = [r for r in RECORDS if r["swarm"] == self.name]
+        for record in records:
+            again = replay(record)
+            described = f"{self.name} on {record['world']}, seed {record['seed']}"
+            assert (again["ran"], again["best_cost"]) == (record["ran"], record["best_cost"]), (
+                described)
+            changed = sorted(leaf for leaf, digest in record["digests"].items()
+                             if again["digests"].get(leaf) != digest)
+            assert not changed, f"{described}: these leaves changed: {changed}"
+
     @pytest.mark.slow  # 1,000 runs alone, of 2 iterations and 8 agents to fit CI: 20-300 s
     def test_a_thousand_keys_alone_equal_them_in_one_batch_of_a_thousand(self, maze, field):
         world, task, _ = self._world(maze, field)
@@ -63,6 +81,12 @@ class Conformance:
 
 for _name in [*FIRST, *(n for n in swarms.registered() if n not in FIRST)]:
     globals()[f"TestSwarm_{_name}"] = type(f"TestSwarm_{_name}", (Conformance,), {"name": _name})
+
+
+def test_every_registered_swarm_has_its_golden_records():
+    described = [{k: v for k, v in r.items() if k not in ("digests", "best_cost", "ran")}
+                 for r in RECORDS]
+    assert described == cases()
 
 
 def test_every_registered_swarm_has_its_class():

@@ -1,5 +1,5 @@
 """Golden records of every registered swarm: small runs replayed bit for bit by
-``tests/test_golden.py``, so that "behaviour unchanged" means the same bits for every swarm.
+``tests/test_conformance.py``, so that "behaviour unchanged" means the same bits for every swarm.
 
 Each record names its swarm, world, config, iterations, patience and seed, and holds the
 SHA-256 of every leaf of what the run returned (state and trace, PRNG keys as their data)
