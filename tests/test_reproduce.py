@@ -30,6 +30,7 @@ from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import check_counts, names_argument, numbers_argument
 from jaxswarm.studies.success import SUCCESS_GAP, at_optimum
 from jaxswarm.studies.timing import compile_then_time, median_milliseconds, seed_keys
+from jaxswarm.sweep.replay import replay_row
 
 pathmaps = load_script("sweeps/aco_pathmaps.py")
 robot_study = load_script("sweeps/robot_study.py")
@@ -435,8 +436,6 @@ def test_seed_keys_split_the_seed_key():
 @pytest.mark.slow
 @pytest.mark.parametrize("table", ["rfd_paper_table1", "rfd_static", "iwd_paper_maps"])
 def test_a_tables_swarm_rows_replay_alone_bit_for_bit(quick, table):
-    from jaxswarm.sweep.replay import replay_row
-
     folder, _, _ = quick
     rows = read_csv(folder / table / "runs.csv")
     replayable = [index for index, row in enumerate(rows) if row["run_record"]]
@@ -448,8 +447,6 @@ def test_a_tables_swarm_rows_replay_alone_bit_for_bit(quick, table):
 
 @pytest.mark.slow
 def test_iwd_pg_rows_on_its_own_fields_say_they_cannot_be_replayed(quick):
-    from jaxswarm.sweep.replay import replay_row
-
     folder, _, _ = quick
     fields = load_script("sweeps/iwd_pg_experiments.py").IWD_PG_MAPS
     rows = read_csv(folder / "iwd_pg_experiments" / "runs.csv")
@@ -463,8 +460,6 @@ def test_iwd_pg_rows_on_its_own_fields_say_they_cannot_be_replayed(quick):
 def test_a_committed_table_row_replays_bit_for_bit():
     # results/rfd_static was made with this release's arithmetic (SAME_RESULTS_SINCE): a row of
     # it runs again alone to the same cost and fingerprint.
-    from jaxswarm.sweep.replay import replay_row
-
     rows = read_csv(ROOT / "results" / "rfd_static" / "runs.csv")
     row = next(index for index, row in enumerate(rows)
                if (row["map"], row["algorithm"], row["seed"]) == ("maze20", "rfd_star", "3"))
