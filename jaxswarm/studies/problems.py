@@ -52,9 +52,9 @@ def named_problem(name: str, *, seed: int = 0,
                   planner: Callable[..., Solution] = dijkstra) -> Problem:
     """The problem of the map ``name`` (a paper map or ``pathmapWxH`` seeded by ``seed``, see
     :func:`jaxswarm.maps.named.named_map`) with its own start and goal."""
-    kind = map_kind(name)
-    entry = name if kind == PAPER else (
-        dict(pathmap=name.removeprefix("pathmap"), seed=seed) if kind == PATH_MAP else None)
+    # The sweep map entry that builds the same map (kinds no entry can name get none).
+    entry = {PAPER: name, PATH_MAP: dict(pathmap=name.removeprefix("pathmap"), seed=seed)}.get(
+        map_kind(name))
     return make_problem(*named_map(name, seed=seed), planner=planner, entry=entry)
 
 
