@@ -69,7 +69,7 @@ def test_walked_soil_is_the_velocity_update_and_eq_4_along_a_path():
     soil = jnp.full(graph.nbr.shape, 10.0).at[1, EAST].set(2.0)
     path = jnp.array([[0, 1, 2], [0, 1, -1]])
     slots = jnp.array([[EAST, EAST], [EAST, -1]], jnp.int8)
-    taken, velocity = walked_soil(graph, soil, path, slots, P)
+    taken, velocity = walked_soil(graph, soil, path[:, :-1], slots, P)
     v1 = 200 + 1 / (0.01 + 100)  # the velocity after 0 -> 1 (soil 10)
     v2 = v1 + 1 / (0.01 + 4)  # after 1 -> 2 (soil 2)
     np.testing.assert_allclose(np.asarray(taken[0]),
@@ -86,7 +86,7 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     slots = jnp.array([[EAST, EAST], [EAST, -1], [EAST, EAST]], jnp.int8)
     taken = jnp.array([[10.0, 20.0], [40.0, 0.0], [30.0, 50.0]])
     arrived = jnp.array([True, False, True])
-    after = np.asarray(arrived_updates(graph, soil, path, slots, taken, arrived, P))
+    after = np.asarray(arrived_updates(graph, soil, path[:, :-1], slots, taken, arrived, P))
     # Drop 1 did not arrive: nothing of it is kept. Drop 0, then drop 2 (eq. 5 twice):
     first = 0.1 * 1000 - 0.9 * 10
     assert after[0, EAST] == pytest.approx(0.1 * first - 0.9 * 30, rel=1e-6)
@@ -96,7 +96,7 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     untouched[[0, 1], EAST] = False
     assert np.all(after[untouched] == 1000.0)
     # The other order gives another soil: the order is part of the rule.
-    swapped = np.asarray(arrived_updates(graph, soil, path[::-1], slots[::-1], taken[::-1],
+    swapped = np.asarray(arrived_updates(graph, soil, path[::-1, :-1], slots[::-1], taken[::-1],
                                          arrived[::-1], P))
     assert swapped[0, EAST] != pytest.approx(after[0, EAST])
 

@@ -31,7 +31,7 @@ from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_updates,
                                      choice_log_weights, global_update, goal_log_desirability,
                                      walked_soil)
-from jaxswarm.swarm.walking import Walk, edge_table, step_budget, walk
+from jaxswarm.swarm.walking import Walk, edge_table, on_moves, step_budget, walk
 from jaxswarm.swarm.walking.backtrack import backtracking_walk
 from jaxswarm.world.graph import Graph
 
@@ -185,11 +185,23 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params)
-    taken, velocity = walked_soil(graph, soil, drops.path, drops.slots, params)
-    return drops._replace(
-        memory=arrived_updates(graph, soil, drops.path, drops.slots, taken, drops.arrived,
-                               params),
-        state=jnp.stack([velocity, ordered_sum(taken, axis=1)], axis=-1))
+    memory, velocity, carried = on_moves(_after_walk, drops.moves,
+                                         (drops.path[:, :-1], drops.slots),
+                                         (soil, drops.arrived, params), graph)
+    return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
+
+
+def _after_walk(moves, run, graph: Graph):
+    """The drops' velocity update and eq. 4 along their walks, and the arrived drops' local
+    updates (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for moves ``(here,
+    slots)`` (i32 and slot dtype ``[A, W]``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
+    params)``: ``(soil f32[N, K], velocity f32[A], carried f32[A])``, the same on any width
+    that holds the moves (:func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    here, slots = moves
+    soil, arrived, params = run
+    taken, velocity = walked_soil(graph, soil, here, slots, params)
+    return (arrived_updates(graph, soil, here, slots, taken, arrived, params), velocity,
+            ordered_sum(taken, axis=1))
 
 
 def soil_choice(graph: Graph, table, soil, params: IWDParams):

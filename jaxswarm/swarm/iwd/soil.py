@@ -119,13 +119,13 @@ SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,
 their updates come after it, :func:`arrived_updates`)."""
 
 
-def walked_soil(graph: Graph, soil, path, slots, params):
+def walked_soil(graph: Graph, soil, here, slots, params):
     """The velocity update and eq. 4 along whole walks over ``soil`` (f32[N, K], as the drops
-    met it): ``(taken f32[A, L - 1], velocity f32[A])``, the soil each move took (0 where
-    ``slots``, i8/i16/i32[A, L - 1], is -1) and each drop's velocity at its end, for paths
-    ``path`` (i32[A, L])."""
+    met it): ``(taken f32[A, S], velocity f32[A])``, the soil each move took (0 where ``slots``,
+    i8/i16/i32[A, S], is -1) and each drop's velocity at its end, for moves leaving the nodes
+    ``here`` (i32[A, S], a path's nodes but its last)."""
     moved = slots >= 0
-    here = jnp.where(moved, path[:, :-1], 0)
+    here = jnp.where(moved, here, 0)
     slot = jnp.maximum(slots, 0).astype(jnp.int32)
     gained = jnp.where(moved, velocity_gain(params, soil[here, slot]), 0.0)
     velocity = params.initial_velocity + ordered_cumsum(gained, axis=1)
@@ -133,7 +133,7 @@ def walked_soil(graph: Graph, soil, path, slots, params):
     return taken, velocity[:, -1]
 
 
-def arrived_updates(graph: Graph, soil, path, slots, taken, arrived, params):
+def arrived_updates(graph: Graph, soil, here, slots, taken, arrived, params):
     """Eq. 5 for the moves of the drops that arrived, applied after the walk: f32[N, K] soil
     after drop 0's moves, then drop 1's, ... (agent order, then move order; a drop crosses a
     directed edge at most once), whatever lanes the drops walked in.
@@ -141,13 +141,14 @@ def arrived_updates(graph: Graph, soil, path, slots, taken, arrived, params):
     Args:
       graph: the map.
       soil: f32[N, K] the soil before.
-      path: i32[A, L] the drops' paths; slots: i8/i16/i32[A, L - 1] their moves' slots.
-      taken: f32[A, L - 1] the soil each move took (:func:`walked_soil`).
+      here: i32[A, S] the node each move leaves (a path's nodes but its last); slots:
+        i8/i16/i32[A, S] the moves' slots.
+      taken: f32[A, S] the soil each move took (:func:`walked_soil`).
       arrived: bool[A] which drops' updates are kept.
       params: the IWD params (scalars).
     """
     keep = 1.0 - params.rho_n
-    rows = jnp.where((slots >= 0) & arrived[:, None], path[:, :-1], graph.num_nodes)
+    rows = jnp.where((slots >= 0) & arrived[:, None], here, graph.num_nodes)
     columns = jnp.maximum(slots, 0).astype(jnp.int32)
 
     def one_drop(soil, drop):

@@ -80,7 +80,8 @@ from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, defaul
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (add_compensated, check_greedy_drops, gradients,
                                       river_swarm, sediment_where_stuck)
-from jaxswarm.swarm.walking import FORCED, Walk, edge_table, goal_log_distance, neighbour_slots
+from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance, neighbour_slots,
+                                    on_moves)
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 
@@ -203,24 +204,35 @@ def erosion_change(graph: Graph, altitude, drops: Walk, eroding, erosion, p_base
     altitude among the nodes its eroding moves go to (nothing if none is lower). Every node then
     gains the eroded total divided by ``N - 1`` (eq. 5).
     """
+    eroded = on_moves(_eroded, drops.moves, (drops.path[:, :-1], drops.path[:, 1:], drops.slots),
+                      (altitude, eroding, erosion, p_base), graph)
+    return ordered_sum(eroded) / (altitude.shape[0] - 1) - eroded
+
+
+def _eroded(moves, run, graph: Graph):
+    """f32[N] what each node gives to the moves ``(here, there, slots)`` (``[A, W]``) of the
+    eroding drops of ``run``'s ``(altitude f32[N], eroding bool[A], erosion, p_base)`` (eq. 4,
+    before eq. 5 shares it out); the same on any width that holds the moves (a move not made
+    asks for nothing, and the scatters add in move order:
+    :func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    here, there, slots = moves
+    altitude, eroding, erosion, p_base = run
     n = altitude.shape[0]
-    num_drops = drops.path.shape[0]
-    moved = (drops.slots >= 0) & eroding[:, None]
-    here = jnp.where(moved, drops.path[:, :-1], 0)
-    there = jnp.where(moved, drops.path[:, 1:], 0)
-    distance = move_lengths(graph, here, drops.slots)
+    moved = (slots >= 0) & eroding[:, None]
+    here = jnp.where(moved, here, 0)
+    there = jnp.where(moved, there, 0)
+    distance = move_lengths(graph, here, slots)
     gradient = (altitude[here] - altitude[there]) / jnp.where(moved, distance, 1.0)
-    rate = erosion / ((n - 1) * num_drops)
+    rate = erosion / ((n - 1) * eroding.shape[0])
     if p_base is None:
         asked = jnp.where(moved, rate * jnp.maximum(gradient, 0.0), 0.0)
-        eroded = jnp.zeros_like(altitude).at[here].add(asked)
-    else:  # p_base ** gradient, capped so that a cliff cannot overflow float32
-        shape = exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
-        asked = jnp.zeros_like(altitude).at[here].add(jnp.where(moved, rate * shape, 0.0))
-        outlet = jnp.full_like(altitude, jnp.inf).at[jnp.where(moved, here, n)].min(
-            altitude[there], mode="drop")
-        eroded = jnp.minimum(asked, jnp.maximum(altitude - outlet, 0.0))
-    return ordered_sum(eroded) / (n - 1) - eroded
+        return jnp.zeros_like(altitude).at[here].add(asked)
+    # p_base ** gradient, capped so that a cliff cannot overflow float32
+    shape = exp(jnp.minimum(gradient * jnp.log(p_base), MAX_LOG_EROSION))
+    asked = jnp.zeros_like(altitude).at[here].add(jnp.where(moved, rate * shape, 0.0))
+    outlet = jnp.full_like(altitude, jnp.inf).at[jnp.where(moved, here, n)].min(
+        altitude[there], mode="drop")
+    return jnp.minimum(asked, jnp.maximum(altitude - outlet, 0.0))
 
 
 def erode(graph: Graph, altitude, residual, drops: Walk, eroding, erosion, p_base=None):

@@ -2,10 +2,12 @@
 one lockstep step of the lanes (:mod:`.lanes`), its random streams (:mod:`.streams`), the masked
 sampler (:mod:`.sampler`), packed visited sets (:mod:`.bits`), what algorithms hand it
 (:mod:`.tables`: edge tables, safe neighbour gathers and values, the goal heuristic, the step
-budget) and the per-step hook for memory that changes while the agents walk (:mod:`.hooks`)."""
+budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), and
+work on a walk's moves cut to the moves the batch made (:mod:`.moves`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, STEPS_PER_REFILL, Walk,
                                          visited_nodes, walk)
+from jaxswarm.swarm.walking.moves import move_widths, on_moves
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
@@ -13,5 +15,5 @@ from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
 
 __all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "STEPS_PER_REFILL",
            "StepHook", "Walk", "edge_groups", "edge_table", "goal_log_distance", "heads",
-           "neighbour_slots", "sample_masked", "step_budget", "uniforms", "visited_nodes",
-           "walk"]
+           "move_widths", "neighbour_slots", "on_moves", "sample_masked", "step_budget",
+           "uniforms", "visited_nodes", "walk"]

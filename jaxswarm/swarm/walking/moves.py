@@ -1,0 +1,112 @@
+"""Work on a walk's moves cut to the moves made in the whole batch.
+
+A walk's per-move outputs are padded to the step budget (``slots`` ``i8[A, S]``, a path's first
+``S`` nodes), yet agents stop long before it: a drop on a 64 x 64 map makes about a hundred
+moves of a budget of 1,023. :func:`on_moves` applies a function to the first ``W`` move columns
+only, ``W`` the smallest of :func:`move_widths` that holds every agent's moves, of every run of
+the batch (a ``vmap`` of walks, nested or not, shares one ``W``: one branch of a
+``lax.switch`` runs, where a ``W`` per run would make ``vmap`` run every branch). Past an
+agent's last move every column is padding; a function that gives padding no weight (a move that
+was not made takes no soil and deposits nothing) returns the same bits on ``W`` columns as on
+all of them, when it reduces the columns by scans, scatters in column order, or
+:func:`~jaxswarm.runtime.arithmetic.ordered_sum` and
+:func:`~jaxswarm.runtime.arithmetic.ordered_cumsum` (their zero-padded power-of-two trees add
+the same terms in the same order on any power-of-two width that holds them, and a running sum's
+first ``W`` terms do not depend on the length).
+"""
+from __future__ import annotations
+
+import functools
+from typing import Any, Callable
+
+import jax
+import jax.numpy as jnp
+from jax.custom_batching import custom_vmap
+
+NARROWEST = 64
+"""The narrowest width :func:`~jaxswarm.swarm.walking.moves.move_widths` offers."""
+
+
+def move_widths(columns: int) -> tuple[int, ...]:
+    """The widths (static, ascending) :func:`on_moves` chooses from for ``columns`` move
+    columns: the powers of two from :data:`~jaxswarm.swarm.walking.moves.NARROWEST` below
+    ``columns``, then ``columns``. Each is a branch of the program to compile."""
+    widths = []
+    width = NARROWEST
+    while width < columns:
+        widths.append(width)
+        width *= 2
+    return tuple(widths) + (columns,)
+
+
+def on_moves(function: Callable, moves: jax.Array, columns: Any, per_run: Any = None,
+             shared: Any = None):
+    """``function(cut, per_run, shared)`` for one run's walk, ``cut`` its move ``columns`` cut to
+    the width that holds the moves of every agent of the batch.
+
+    Args:
+      function: ``(cut, per_run, shared) -> outputs``, ``cut`` the leaves of ``columns`` with
+        their axis 1 cut to some width ``W >= max(moves)``; its outputs must not depend on ``W``
+        (module docstring), in values or shapes.
+      moves: i32[A] the moves each agent made.
+      columns: a pytree of ``[A, C, ...]`` arrays, one column per move (C the step budget).
+      per_run: a pytree of this run's other inputs (batched like the walk).
+      shared: a pytree of inputs every run of a batch shares (the map); when a ``vmap`` batches
+        one of its leaves, each run of that ``vmap`` picks its own width.
+
+    Returns:
+      ``function``'s outputs.
+    """
+    count = jax.tree_util.tree_leaves(columns)[0].shape[1]
+    apply = _runs(function, move_widths(count))
+    out = apply(moves[None], *(jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
+                               for tree in (columns, per_run)), shared)
+    return jax.tree_util.tree_map(lambda x: x[0], out)
+
+
+def _runs(function: Callable, widths: tuple[int, ...]):
+    """``(moves i32[R, A], columns, per_run, shared) -> outputs`` of R runs (leading axis R on
+    all but ``shared``), whose ``vmap`` folds the mapped axis into R."""
+
+    @custom_vmap
+    def apply(moves, columns, per_run, shared):
+        return _on_runs(function, widths, moves, columns, per_run, shared)
+
+    @apply.def_vmap
+    def fold_runs(axis_size, in_batched, moves, columns, per_run, shared):
+        if any(jax.tree_util.tree_leaves(in_batched[3])):
+            axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
+                         for b in in_batched)
+            out = jax.vmap(functools.partial(_on_runs, function, widths), in_axes=axes)(
+                moves, columns, per_run, shared)
+            return out, jax.tree_util.tree_map(lambda _: True, out)
+
+        def fold(x, batched):
+            """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
+            if not batched:
+                x = jnp.broadcast_to(x, (axis_size,) + x.shape)
+            return x.reshape((x.shape[0] * x.shape[1],) + x.shape[2:])
+
+        folded = (jax.tree_util.tree_map(fold, tree, batched)
+                  for tree, batched in zip((moves, columns, per_run), in_batched))
+        out = jax.tree_util.tree_map(
+            lambda x: x.reshape((axis_size, x.shape[0] // axis_size) + x.shape[1:]),
+            apply(*folded, shared))
+        return out, jax.tree_util.tree_map(lambda _: True, out)
+
+    return apply
+
+
+def _on_runs(function: Callable, widths: tuple[int, ...], moves, columns, per_run, shared):
+    """``function`` of each of R runs on the narrowest of ``widths`` that holds every move of
+    ``moves`` (i32[R, A])."""
+    most = jnp.max(moves)
+    index = jnp.sum(most > jnp.asarray(widths[:-1], most.dtype), dtype=jnp.int32)
+
+    def within(width):
+        def run(columns, per_run):
+            cut = jax.tree_util.tree_map(lambda x: x[:, :, :width], columns)
+            return jax.vmap(lambda c, p: function(c, p, shared))(cut, per_run)
+        return run
+
+    return jax.lax.switch(index, [within(width) for width in widths], columns, per_run)
