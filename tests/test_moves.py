@@ -23,10 +23,10 @@ def walk_columns(moves, columns=1023, agents=4, seed=0):
     return values
 
 
-def test_widths_are_powers_of_two_then_the_whole():
-    assert move_widths(1023) == (64, 128, 256, 512, 1023)
-    assert move_widths(64) == (64,)
-    assert move_widths(65) == (64, 65)
+def test_widths_are_powers_of_four_times_128_then_the_whole():
+    assert move_widths(1023) == (128, 512, 1023)
+    assert move_widths(128) == (128,)
+    assert move_widths(129) == (128, 129)
     assert move_widths(10) == (10,)
 
 
@@ -51,7 +51,7 @@ def test_a_batch_shares_one_width_at_any_nesting():
     width, total, _ = jax.jit(jax.vmap(one))(moves, values, jnp.arange(3.0))
     np.testing.assert_array_equal(width, [512, 512, 512])
     alone = [one(m, v, jnp.float32(r)) for r, (m, v) in enumerate(zip(moves, values))]
-    assert [int(a[0]) for a in alone] == [64, 512, 64]
+    assert [int(a[0]) for a in alone] == [128, 512, 128]
     np.testing.assert_array_equal(total, np.stack([a[1] for a in alone]))
     nested = jax.jit(jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(0, 0, 0)))(
         moves.reshape(3, 1, 4), values.reshape(3, 1, 4, -1), jnp.arange(3.0))
@@ -64,7 +64,7 @@ def test_a_batched_shared_input_lets_each_run_pick_its_own_width():
     values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])
     width, total, _ = jax.vmap(lambda m, v, s: on_moves(width_and_sum, m, (v,), 1.0, s))(
         moves, values, jnp.array([1.0, 2.0]))
-    np.testing.assert_array_equal(width, [64, 512])
+    np.testing.assert_array_equal(width, [128, 512])
     np.testing.assert_allclose(total[1], 2 * values[1].astype(np.float64).sum(1), rtol=1e-5)
 
 
@@ -73,5 +73,18 @@ def test_no_moves_and_a_whole_budget(moves):
     values = walk_columns(moves, agents=2)
     width, total, _ = on_moves(width_and_sum, jnp.array(moves, jnp.int32), (values,),
                                jnp.float32(1.0), jnp.float32(1.0))
-    assert int(width) == (64 if max(moves) == 0 else 1023)
+    assert int(width) == (128 if max(moves) == 0 else 1023)
     np.testing.assert_array_equal(total, ordered_sum(values, axis=1))
+
+
+def test_it_runs_inside_a_vmapped_cond():
+    # A vmapped lax.cond with a batched predicate batches every constant of its branches.
+    def branch(values):
+        moves = jnp.sum(values > 0, axis=1, dtype=jnp.int32)
+        return on_moves(width_and_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0))[1]
+
+    values = np.stack([walk_columns([3, 9], agents=2, seed=i) for i in range(3)])
+    got = jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(2), v))(
+        values, jnp.array([True, False, True]))
+    np.testing.assert_array_equal(got[1], [0.0, 0.0])
+    np.testing.assert_array_equal(got[2], branch(values[2]))

@@ -18,8 +18,8 @@ from typing import NamedTuple
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.iwd.memory import (join, last_position, prefix_lengths, reverse,
-                                       width_index, widths)
+from jaxswarm.swarm.iwd.memory import join, last_position, prefix_lengths, reverse
+from jaxswarm.swarm.walking import on_moves
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
 
@@ -79,18 +79,19 @@ def closest_inner_pair(graph: Graph, a: jax.Array, b: jax.Array):
 
 def closest_inner_pairs(graph: Graph, a: jax.Array, others: jax.Array):
     """``(i, j)`` i32[P]: :func:`closest_inner_pair` of ``a`` (i32[L]) and each of ``others``
-    (i32[P, L]), worked on the smallest of :func:`~.memory.widths` that holds them all (the
-    positions past their ends are not inner, and the first nearest pair in row-major order is
-    the same on fewer columns)."""
-    length = a.shape[0]
+    (i32[P, L]), worked on the narrowest width that holds them all in the batch
+    (:func:`~jaxswarm.swarm.walking.moves.on_moves`: the positions past their ends are not
+    inner, and the first nearest pair in row-major order is the same on fewer columns)."""
+    rows = jnp.concatenate([a[None], others])
+    return on_moves(_closest_within, jnp.sum(rows >= 0, axis=1, dtype=jnp.int32), (rows,),
+                    None, graph)
 
-    def within(width):
-        def closest(a, others):
-            return jax.vmap(lambda b: closest_inner_pair(graph, a[:width], b[:width]))(others)
-        return closest
 
-    return jax.lax.switch(width_index(jnp.concatenate([a[None], others])),
-                          [within(width) for width in widths(length)], a, others)
+def _closest_within(columns, _, graph: Graph):
+    """:func:`closest_inner_pairs` of the first of the paths ``columns`` (one i32[P + 1, W])
+    and each of the others."""
+    (rows,) = columns
+    return jax.vmap(lambda b: closest_inner_pair(graph, rows[0], b))(rows[1:])
 
 
 def second_intersection(graph: Graph, a, b, i, j, connection) -> Children:

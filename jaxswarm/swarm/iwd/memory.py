@@ -54,25 +54,6 @@ def remember(memory: Memory, paths: jax.Array, costs: jax.Array) -> Memory:
     return Memory(paths=kept_paths, costs=kept_costs)
 
 
-def widths(length: int) -> tuple[int, ...]:
-    """The widths (static, ascending) that operators on paths of ``length`` nodes work on: about
-    an eighth of ``length`` (a multiple of 32, at least 64) for short paths when that is at
-    most half of ``length``, and ``length``. Past a path's last node every position is
-    padding, so an operator that reads no position past it gives the same result on the first
-    ``W`` positions as on all of them, with less work; each width is a program of its own to
-    compile."""
-    short = max(64, -(-length // 8 // 32) * 32)
-    return (short, length) if 2 * short <= length else (length,)
-
-
-def width_index(paths: jax.Array) -> jax.Array:
-    """i32[]: the index in ``widths(L)`` of the smallest width that holds every path of
-    ``paths`` (i32[P, L], -1 padded)."""
-    choices = widths(paths.shape[-1])
-    nodes = jnp.max(jnp.sum(paths >= 0, axis=-1))
-    return jnp.sum(nodes > jnp.asarray(choices[:-1], jnp.int32), dtype=jnp.int32)
-
-
 def node_count(path: jax.Array) -> jax.Array:
     """i32[]: the nodes of a padded path."""
     return jnp.sum(path >= 0, dtype=jnp.int32)

@@ -13,11 +13,11 @@ middle nodes meet). A smoothed path is never longer, and stays simple when it wa
 
 How it is computed (the result is the same function of each path): :func:`smooth_paths`
 smooths a batch's distinct paths only, :data:`ROWS` at a time (under ``vmap`` a ``while_loop``
-runs until its slowest path), on the first ``W`` positions of the paths (the smallest of
-:func:`~.memory.widths` that holds them all: past a path's end every position is padding,
-where a pass finds nothing to replace). On grids and path maps a move's edge is found from
-the cells' coordinates and the slots' fixed directions (:func:`lattice_costs`) instead of a
-search of the node's slots.
+runs until its slowest path), on the first ``W`` positions of the paths (the narrowest width
+of :func:`~jaxswarm.swarm.walking.moves.on_moves` that holds them all in the batch: past a
+path's end every position is padding, where a pass finds nothing to replace). On grids and
+path maps a move's edge is found from the cells' coordinates and the slots' fixed directions
+(:func:`lattice_costs`) instead of a search of the node's slots.
 """
 from __future__ import annotations
 
@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.iwd.memory import width_index, widths
+from jaxswarm.swarm.walking import on_moves
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import DIRECTIONS, ORTHOGONAL_SLOTS, slot_lengths
 
@@ -213,20 +213,20 @@ def smooth_path(graph: Graph, path: jax.Array) -> jax.Array:
 def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array) -> jax.Array:
     """i32[A, L]: each path of ``paths`` (i32[A, L], -1 padded, walks on the current map) where
     ``which`` (bool[A]) after the global smooth operator (:func:`smooth_path`), the others as
-    they were; worked on the smallest of :func:`~.memory.widths` that holds every path of
-    ``which``."""
-    length = paths.shape[1]
-    costs_at = costs_of(graph)
-
-    def within(width):
-        def smooth(paths):
-            smoothed = _smooth_distinct(graph.num_nodes, costs_at, paths[:, :width], which)
-            return jnp.pad(smoothed, ((0, 0), (0, length - width)), constant_values=NO_NODE)
-        return smooth
-
-    smoothed = jax.lax.switch(width_index(jnp.where(which[:, None], paths, NO_NODE)),
-                              [within(width) for width in widths(length)], paths)
+    they were; worked on the narrowest width that holds every path of ``which`` in the batch
+    (:func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    nodes = jnp.where(which, jnp.sum(paths >= 0, axis=1, dtype=jnp.int32), 0)
+    smoothed = on_moves(functools.partial(_smooth_within, paths.shape[1]), nodes, (paths,),
+                        which, graph)
     return jnp.where(which[:, None], smoothed, paths)
+
+
+def _smooth_within(length: int, columns, which, graph: Graph) -> jax.Array:
+    """i32[A, length]: the paths ``columns`` (one i32[A, W]) where ``which`` (bool[A]) smoothed,
+    -1 padded to ``length``."""
+    (paths,) = columns
+    smoothed = _smooth_distinct(graph.num_nodes, costs_of(graph), paths, which)
+    return jnp.pad(smoothed, ((0, 0), (0, length - paths.shape[1])), constant_values=NO_NODE)
 
 
 def _smooth_distinct(num_nodes: int, costs_at: Callable, paths: jax.Array, which: jax.Array):

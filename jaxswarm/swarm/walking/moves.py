@@ -23,19 +23,26 @@ import jax
 import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
-NARROWEST = 64
+NARROWEST = 128
 """The narrowest width :func:`~jaxswarm.swarm.walking.moves.move_widths` offers."""
+
+GROWTH = 4
+"""Each width of :func:`~jaxswarm.swarm.walking.moves.move_widths` is this times the one
+before. Every width is a branch to compile: on mosaic50 IWD_PG (smoothing, closest pairs and
+the drops' soil on these widths) compiled in about 20 s with 128, 512 and 800 columns, as
+with the two widths it used before, and in about 25 s with 64, 128, 256, 512 and 800, for a
+few milliseconds an iteration (``benchmarks/iwd_pg.py``)."""
 
 
 def move_widths(columns: int) -> tuple[int, ...]:
     """The widths (static, ascending) :func:`on_moves` chooses from for ``columns`` move
-    columns: the powers of two from :data:`~jaxswarm.swarm.walking.moves.NARROWEST` below
-    ``columns``, then ``columns``. Each is a branch of the program to compile."""
+    columns: :data:`~jaxswarm.swarm.walking.moves.NARROWEST` times the powers of
+    :data:`~jaxswarm.swarm.walking.moves.GROWTH` below ``columns``, then ``columns``."""
     widths = []
     width = NARROWEST
     while width < columns:
         widths.append(width)
-        width *= 2
+        width *= GROWTH
     return tuple(widths) + (columns,)
 
 
@@ -47,8 +54,11 @@ def on_moves(function: Callable, moves: jax.Array, columns: Any, per_run: Any = 
     Args:
       function: ``(cut, per_run, shared) -> outputs``, ``cut`` the leaves of ``columns`` with
         their axis 1 cut to some width ``W >= max(moves)``; its outputs must not depend on ``W``
-        (module docstring), in values or shapes.
-      moves: i32[A] the moves each agent made.
+        (module docstring), in values or shapes. It takes its arrays as arguments: one it
+        closes over, or a NumPy array it turns into a constant, is refused by ``custom_vmap``
+        where a vmapped ``lax.cond`` has batched it.
+      moves: i32[A] the columns each agent's row uses: its moves (its nodes, where the
+        columns are a path's nodes).
       columns: a pytree of ``[A, C, ...]`` arrays, one column per move (C the step budget).
       per_run: a pytree of this run's other inputs (batched like the walk).
       shared: a pytree of inputs every run of a batch shares (the map); when a ``vmap`` batches
@@ -101,7 +111,9 @@ def _on_runs(function: Callable, widths: tuple[int, ...], moves, columns, per_ru
     """``function`` of each of R runs on the narrowest of ``widths`` that holds every move of
     ``moves`` (i32[R, A])."""
     most = jnp.max(moves)
-    index = jnp.sum(most > jnp.asarray(widths[:-1], most.dtype), dtype=jnp.int32)
+    # Scalar comparisons: an array of the widths would be a constant of the traced function,
+    # which custom_vmap refuses once a vmapped lax.cond has batched its constants.
+    index = sum((most > width).astype(jnp.int32) for width in widths[:-1])
 
     def within(width):
         def run(columns, per_run):
