@@ -3,7 +3,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.runtime.batching import one_at_a_time
+from jaxswarm.runtime.batching import fold_runs, one_at_a_time, unfold_runs
 
 
 def halvings(x, floor):
@@ -46,3 +46,12 @@ def test_nested_vmap_and_pytree_arguments():
 def test_unbatched_call_is_the_function_itself():
     value, count = one_at_a_time(halvings)(jnp.float32(40.0), 2.0)
     assert float(value) == 1.25 and int(count) == 5
+
+
+def test_fold_runs_puts_the_mapped_axis_before_the_runs_and_unfold_runs_undoes_it():
+    x = np.arange(2 * 3 * 4).reshape(2, 3, 4)
+    folded = fold_runs(x, True, 2)
+    np.testing.assert_array_equal(folded, x.reshape(6, 4))
+    np.testing.assert_array_equal(unfold_runs(folded, 2), x)
+    shared = fold_runs(x[0], False, 2)  # not batched: every member the same
+    np.testing.assert_array_equal(shared, np.concatenate([x[0], x[0]]))

@@ -3,13 +3,16 @@
 Under ``vmap`` a ``lax.while_loop`` runs until its last member is done, and every iteration
 works on the whole batch: a relaxation that needs 1 sweep in most runs of a sweep and 30 in a
 few costs 30 sweeps for each. :func:`one_at_a_time` gives such a function a batching rule that
-maps it over the batch one member at a time instead, so each member pays for its own loop.
+maps it over the batch one member at a time instead, so each member pays for its own loop. :func:`fold_runs` and :func:`unfold_runs` serve the
+other kind of rule, which folds a ``vmap``'s axis into a function's own leading run axis (the
+walker's, and the work after it) so that the whole batch runs as one.
 """
 from __future__ import annotations
 
 import functools
 
 import jax
+import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 
@@ -42,3 +45,18 @@ def one_at_a_time(fun):
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return mapped
+
+
+def fold_runs(x: jax.Array, batched: bool, axis_size: int) -> jax.Array:
+    """``[axis_size * R, ...]``: a vmapped ``x`` (``[axis_size, R, ...]``, or ``[R, ...]`` when
+    not ``batched``, then the same for every member) with the mapped axis folded into its leading
+    run axis R."""
+    if not batched:
+        x = jnp.broadcast_to(x, (axis_size,) + x.shape)
+    return x.reshape((x.shape[0] * x.shape[1],) + x.shape[2:])
+
+
+def unfold_runs(x: jax.Array, axis_size: int) -> jax.Array:
+    """``[axis_size, R, ...]``: :func:`fold_runs` undone on a result ``x`` (``[axis_size * R,
+    ...]``)."""
+    return x.reshape((axis_size, x.shape[0] // axis_size) + x.shape[1:])

@@ -51,6 +51,7 @@ import jax
 import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
+from jaxswarm.runtime.batching import fold_runs, unfold_runs
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import Lanes, WalkInputs, initial_state, start_visited, step
@@ -167,7 +168,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         return _walk_runs(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
 
     @walk_runs.def_vmap
-    def fold_runs(axis_size, in_batched, seed, graph, log_weights, start, goal, memory,
+    def batch_rule(axis_size, in_batched, seed, graph, log_weights, start, goal, memory,
                   hook_params):
         seed_b, graph_b, weights_b, start_b, goal_b, memory_b, params_b = in_batched
         if any(jax.tree_util.tree_leaves(graph_b)):
@@ -179,12 +180,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
                                                 hook_params)
             return out, jax.tree_util.tree_map(lambda _: True, out)
 
-        def fold(x, batched):
-            """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
-            if not batched:
-                x = jnp.broadcast_to(x, (axis_size,) + x.shape)
-            return x.reshape((x.shape[0] * x.shape[1],) + x.shape[2:])
-
+        fold = functools.partial(fold_runs, axis_size=axis_size)
         seed, start, goal = fold(seed, seed_b), fold(start, start_b), fold(goal, goal_b)
         # One table for the whole batch stays one table (the walk reads it for every run).
         if weights_b or log_weights.shape[0] > 1:
@@ -194,7 +190,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         hook_params = jax.tree_util.tree_map(lambda p, b: fold(p, b) if b else p, hook_params,
                                              params_b)
         out = jax.tree_util.tree_map(  # sizes spelled out: a hook's state may be empty
-            lambda x: x.reshape((axis_size, x.shape[0] // axis_size) + x.shape[1:]),
+            lambda x: unfold_runs(x, axis_size),
             walk_runs(seed, graph, log_weights, start, goal, memory, hook_params))
         return out, jax.tree_util.tree_map(lambda _: True, out)
 

@@ -23,6 +23,8 @@ import jax
 import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
+from jaxswarm.runtime.batching import fold_runs, unfold_runs
+
 NARROWEST = 128
 """The narrowest width :func:`~jaxswarm.swarm.walking.moves.move_widths` offers."""
 
@@ -83,7 +85,7 @@ def _runs(function: Callable, widths: tuple[int, ...]):
         return _on_runs(function, widths, moves, columns, per_run, shared)
 
     @apply.def_vmap
-    def fold_runs(axis_size, in_batched, moves, columns, per_run, shared):
+    def batch_rule(axis_size, in_batched, moves, columns, per_run, shared):
         if any(jax.tree_util.tree_leaves(in_batched[3])):
             axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
                          for b in in_batched)
@@ -91,17 +93,10 @@ def _runs(function: Callable, widths: tuple[int, ...]):
                 moves, columns, per_run, shared)
             return out, jax.tree_util.tree_map(lambda _: True, out)
 
-        def fold(x, batched):
-            """[axis_size, R, ...] (or [R, ...] when not batched) -> [axis_size * R, ...]."""
-            if not batched:
-                x = jnp.broadcast_to(x, (axis_size,) + x.shape)
-            return x.reshape((x.shape[0] * x.shape[1],) + x.shape[2:])
-
+        fold = functools.partial(fold_runs, axis_size=axis_size)
         folded = (jax.tree_util.tree_map(fold, tree, batched)
                   for tree, batched in zip((moves, columns, per_run), in_batched))
-        out = jax.tree_util.tree_map(
-            lambda x: x.reshape((axis_size, x.shape[0] // axis_size) + x.shape[1:]),
-            apply(*folded, shared))
+        out = jax.tree_util.tree_map(lambda x: unfold_runs(x, axis_size), apply(*folded, shared))
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return apply
