@@ -3,9 +3,10 @@
 Under ``vmap`` a ``lax.while_loop`` runs until its last member is done, and every iteration
 works on the whole batch: a relaxation that needs 1 sweep in most runs of a sweep and 30 in a
 few costs 30 sweeps for each. :func:`one_at_a_time` gives such a function a batching rule that
-maps it over the batch one member at a time instead, so each member pays for its own loop. :func:`fold_runs` and :func:`unfold_runs` serve the
-other kind of rule, which folds a ``vmap``'s axis into a function's own leading run axis (the
-walker's, and the work after it) so that the whole batch runs as one.
+maps it over the batch one member at a time instead, so each member pays for its own loop.
+:func:`fold_runs` and :func:`unfold_runs` serve the other kind of rule, which folds a
+``vmap``'s axis into a function's own leading run axis (the walker's, and the work after it)
+so that the whole batch runs as one.
 """
 from __future__ import annotations
 
