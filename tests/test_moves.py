@@ -77,11 +77,18 @@ def test_no_moves_and_a_whole_budget(moves):
     np.testing.assert_array_equal(total, ordered_sum(values, axis=1))
 
 
-def test_it_runs_inside_a_vmapped_cond():
+def weighted_sum(moves, run, shared):
+    """Each row's sum of its moves' values weighted by their column (a NumPy constant)."""
+    (values,) = moves
+    return jnp.sum(values * np.arange(values.shape[1], dtype=np.float32), axis=1) * run * shared
+
+
+def test_it_runs_inside_a_vmapped_cond_with_constants():
     # A vmapped lax.cond with a batched predicate batches every constant of its branches.
     def branch(values):
         moves = jnp.sum(values > 0, axis=1, dtype=jnp.int32)
-        return on_moves(width_and_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0))[1]
+        return (on_moves(width_and_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0))[1]
+                + on_moves(weighted_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0)))
 
     values = np.stack([walk_columns([3, 9], agents=2, seed=i) for i in range(3)])
     got = jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(2), v))(

@@ -56,9 +56,8 @@ def on_moves(function: Callable, moves: jax.Array, columns: Any, per_run: Any = 
     Args:
       function: ``(cut, per_run, shared) -> outputs``, ``cut`` the leaves of ``columns`` with
         their axis 1 cut to some width ``W >= max(moves)``; its outputs must not depend on ``W``
-        (module docstring), in values or shapes. It takes its arrays as arguments: one it
-        closes over, or a NumPy array it turns into a constant, is refused by ``custom_vmap``
-        where a vmapped ``lax.cond`` has batched it.
+        (module docstring), in values or shapes. It takes the traced arrays it needs as
+        arguments (``per_run``, ``shared``) rather than closing over them.
       moves: i32[A] the columns each agent's row uses: its moves (its nodes, where the
         columns are a path's nodes).
       columns: a pytree of ``[A, C, ...]`` arrays, one column per move (C the step budget).
@@ -80,17 +79,21 @@ def _runs(function: Callable, widths: tuple[int, ...]):
     """``(moves i32[R, A], columns, per_run, shared) -> outputs`` of R runs (leading axis R on
     all but ``shared``), whose ``vmap`` folds the mapped axis into R."""
 
+    # Jitted, the traced function keeps its constants (the widths, NumPy arrays the function
+    # uses) inside its own program: custom_vmap refuses constants of its own once a vmapped
+    # lax.cond has batched them.
+    on_runs = jax.jit(functools.partial(_on_runs, function, widths))
+
     @custom_vmap
     def apply(moves, columns, per_run, shared):
-        return _on_runs(function, widths, moves, columns, per_run, shared)
+        return on_runs(moves, columns, per_run, shared)
 
     @apply.def_vmap
     def batch_rule(axis_size, in_batched, moves, columns, per_run, shared):
         if any(jax.tree_util.tree_leaves(in_batched[3])):
             axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
                          for b in in_batched)
-            out = jax.vmap(functools.partial(_on_runs, function, widths), in_axes=axes)(
-                moves, columns, per_run, shared)
+            out = jax.vmap(on_runs, in_axes=axes)(moves, columns, per_run, shared)
             return out, jax.tree_util.tree_map(lambda _: True, out)
 
         fold = functools.partial(fold_runs, axis_size=axis_size)
@@ -106,9 +109,7 @@ def _on_runs(function: Callable, widths: tuple[int, ...], moves, columns, per_ru
     """``function`` of each of R runs on the narrowest of ``widths`` that holds every move of
     ``moves`` (i32[R, A])."""
     most = jnp.max(moves)
-    # Scalar comparisons: an array of the widths would be a constant of the traced function,
-    # which custom_vmap refuses once a vmapped lax.cond has batched its constants.
-    index = sum((most > width).astype(jnp.int32) for width in widths[:-1])
+    index = jnp.sum(most > jnp.asarray(widths[:-1], most.dtype), dtype=jnp.int32)
 
     def within(width):
         def run(columns, per_run):
