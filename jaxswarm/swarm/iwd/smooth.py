@@ -12,8 +12,9 @@ candidate's, and the first replacement through a middle node (one per pass, so n
 middle nodes meet). A smoothed path is never longer, and stays simple when it was simple.
 
 How it is computed (the result is the same function of each path): :func:`smooth_paths`
-smooths a batch's distinct paths only, :data:`ROWS` at a time (under ``vmap`` a ``while_loop``
-runs until its slowest path), on the first ``W`` positions of the paths (the narrowest width
+smooths a run's distinct paths only, one at a time (passes over several paths at once, in a
+``vmap`` of the ``while_loop``, run until the slowest path and cost each path four to five times
+as much), on the first ``W`` positions of the paths (the narrowest width
 of :func:`~jaxswarm.swarm.walking.moves.on_moves` that holds them all in the batch: past a
 path's end every position is padding, where a pass finds nothing to replace). On grids and
 path maps a move's edge is found from the cells' coordinates and the slots' fixed directions
@@ -34,10 +35,6 @@ from jaxswarm.world.lattice import DIRECTIONS, ORTHOGONAL_SLOTS, slot_lengths
 
 IMPROVEMENT = 1e-4
 """How much shorter (in length units) a replacement must be: float rounding is no improvement."""
-
-ROWS = 8
-"""Distinct paths smoothed together (one ``vmap`` of the passes' ``while_loop``)."""
-
 
 class Costs(NamedTuple):
     """The lengths a pass compares, at each position ``t`` of a path (i32[W]); inf where
@@ -231,21 +228,17 @@ def _smooth_within(length: int, columns, which, graph: Graph) -> jax.Array:
 
 def _smooth_distinct(num_nodes: int, costs_at: Callable, paths: jax.Array, which: jax.Array):
     """i32[A, W]: the paths (i32[A, W]) where ``which`` (bool[A]) smoothed, each distinct one
-    once, :data:`ROWS` at a time (rows of a batch not in ``which`` as they were)."""
+    once and one at a time (rows of a batch not in ``which`` as they were)."""
     count = paths.shape[0]
-    rows = jnp.arange(count)
     same = jnp.all(paths[:, None, :] == paths[None, :, :], axis=-1) & which[None, :]
     first = jnp.argmax(same, axis=1)  # the first row of ``which`` with the same path
-    distinct = which & (first == rows)
-    batches = -(-count // ROWS)
-    order = jnp.nonzero(distinct, size=batches * ROWS, fill_value=count)[0]
+    distinct = which & (first == jnp.arange(count))
+    order = jnp.nonzero(distinct, size=count, fill_value=count)[0]
 
-    def batch(b, done):
-        chosen = jax.lax.dynamic_slice(order, (b * ROWS,), (ROWS,))
-        batch_paths = jnp.where((chosen < count)[:, None], paths[jnp.minimum(chosen, count - 1)],
-                                NO_NODE)
-        smoothed = jax.vmap(functools.partial(_passes, num_nodes, costs_at))(batch_paths)
-        return done.at[chosen].set(smoothed, mode="drop")
+    def one(index, done):
+        row = order[index]
+        smoothed = _passes(num_nodes, costs_at, paths[jnp.minimum(row, count - 1)])
+        return done.at[row].set(smoothed, mode="drop")
 
-    done = jax.lax.fori_loop(0, -(-jnp.sum(distinct) // ROWS), batch, paths)
+    done = jax.lax.fori_loop(0, jnp.sum(distinct), one, paths)
     return jnp.where(which[:, None], done[first], paths)
