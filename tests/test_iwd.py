@@ -169,6 +169,25 @@ def test_edge_groups_match_a_count_by_brute_force():
     assert np.all(np.asarray(claims) == UNCLAIMED)  # ready for the next step
 
 
+def test_edge_groups_of_more_lanes_than_one_sort_key_holds():
+    # 2^15 lanes of 8 slots: groups need 19 bits and lanes 15, more than one u32 sort key.
+    graph = grid_graph(np.zeros((2, 2), bool))
+    rng = np.random.default_rng(5)
+    lanes, runs = 1 << 15, 2
+    run, here = rng.integers(0, runs, lanes), rng.integers(0, 4, lanes)
+    slot, moving = rng.integers(0, 3, lanes), rng.random(lanes) < 0.9
+    groups, _ = step_groups(run, here, slot, moving, runs, graph)
+    edge = np.where(moving, (run * 4 + here) * 3 + slot, -1)
+    order = np.argsort(edge, kind="stable")
+    sorted_edge = edge[order]
+    starts = np.searchsorted(sorted_edge, sorted_edge, side="left")
+    rank, count = np.zeros(lanes, int), np.zeros(lanes, int)
+    rank[order] = np.arange(lanes) - starts
+    count[order] = np.searchsorted(sorted_edge, sorted_edge, side="right") - starts
+    assert groups.rank.tolist() == np.where(moving, rank, 0).tolist()
+    assert groups.count.tolist() == np.where(moving, count, 0).tolist()
+
+
 def test_drops_on_one_edge_in_one_step_update_it_in_lane_order():
     graph = grid_graph(np.zeros((1, 3), bool))
     soil = jnp.full((2,) + graph.nbr.shape, 50.0)

@@ -132,9 +132,8 @@ def edge_groups(run, here, slot, moving, claims, num_nodes: int, max_degree: int
     Returns:
       ``(EdgeGroups, claims)``, the claims ``UNCLAIMED`` again. The lanes on one node of one
       run are named by the first of them (a scatter-min of lane numbers into the nodes'
-      claims); a group is such a name and a slot, and a lane's rank is its place in one sort
-      of ``(group, lane)`` packed into one i32 (a sort of a single operand is several times
-      cheaper on CPU than a sort of several).
+      claims); a group is such a name and a slot, and a lane's rank is its place in the sort
+      of the ``(group, lane)`` pairs (packed into one u32 key where they fit).
     """
     width = run.shape[0]
     lane = jnp.arange(width, dtype=jnp.int32)
@@ -146,11 +145,7 @@ def edge_groups(run, here, slot, moving, claims, num_nodes: int, max_degree: int
     claims = claims.at[at].set(jnp.where(first_on_node >= 0, UNCLAIMED, 0), mode="drop")
     num_groups = (width + 1) * max_degree  # lanes not moving: group ``width * K``
     group = first_on_node * max_degree + jnp.where(moving, slot, 0)
-    lane_bits = max(width - 1, 1).bit_length()
-    if num_groups.bit_length() + lane_bits > 31:
-        raise ValueError(f"{width} lanes of {max_degree} slots do not fit one i32 sort key")
-    ordered = jnp.sort((group << lane_bits) | lane)
-    ordered_lane, ordered_group = ordered & ((1 << lane_bits) - 1), ordered >> lane_bits
+    ordered_group, ordered_lane = _sorted_pairs(group, lane, num_groups, width)
     position = jnp.arange(width, dtype=jnp.int32)
     group_start = jnp.full((num_groups,), width, jnp.int32).at[ordered_group].min(position)
     rank = jnp.zeros((width,), jnp.int32).at[ordered_lane].set(
@@ -159,3 +154,16 @@ def edge_groups(run, here, slot, moving, claims, num_nodes: int, max_degree: int
     return EdgeGroups(group=group, rank=jnp.where(moving, rank, 0),
                       count=jnp.where(moving, count[group], 0), moving=moving,
                       num_groups=num_groups), claims
+
+
+def _sorted_pairs(group: jax.Array, lane: jax.Array, num_groups: int, width: int):
+    """``(group, lane)`` (i32[l] each, ``group < num_groups``, ``lane`` the numbers ``0 ..
+    width - 1``) sorted by group, then lane: two i32[l]. Packed into one u32 key when both fit
+    its 32 bits (a sort of a single operand is several times cheaper on CPU than a sort of
+    several), else sorted as two keys."""
+    lane_bits = max(width - 1, 1).bit_length()
+    if (num_groups - 1).bit_length() + lane_bits > 32:
+        return jax.lax.sort((group, lane), num_keys=2)
+    packed = jnp.sort((group.astype(jnp.uint32) << lane_bits) | lane.astype(jnp.uint32))
+    return ((packed >> lane_bits).astype(jnp.int32),
+            (packed & ((1 << lane_bits) - 1)).astype(jnp.int32))

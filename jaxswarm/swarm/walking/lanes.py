@@ -57,33 +57,74 @@ class WalkInputs(NamedTuple):
     offsets: jax.Array | None
 
 
+POSITION, MOVES, DIAGONAL, FLAGS = range(4)
+"""Columns of :attr:`Lanes.status`."""
+
+WALKING, ARRIVED, STUCK = 1, 2, 4
+"""Bits of a lane's ``FLAGS`` column."""
+
+
 class Lanes(NamedTuple):
     """The state of the loop's lanes (a pytree; leading axis ``l``, the lanes).
+
+    A lane's counters and flags share one array, ``status``: a step then writes them with one
+    kernel instead of one kernel per field (XLA:CPU emits a kernel per output array), which at
+    a few lanes is most of a step's cost. Read them through the properties.
 
     Attributes:
       agent: i32[l] the lane's agent, as its row in the loop's results; the number of rows
         when the lane holds none.
       run: i32[l] the run (of a batch of walks) the agent belongs to.
-      position: i32[l] the node the agent is at.
+      status: i32[l, 4] per lane its ``POSITION`` (the node the agent is at), ``MOVES`` (moves
+        made), ``DIAGONAL`` (diagonal moves among them, on grids and path maps) and ``FLAGS``
+        (bits ``WALKING``, ``ARRIVED``, ``STUCK``); see :func:`lane_status`.
       visited: u32[l, ceil(N / 32)] the nodes on its path (:mod:`.bits`).
-      moves: i32[l] moves made.
-      diagonal: i32[l] diagonal moves among them (grids and path maps).
-      walking: bool[l] still moving.
-      arrived: bool[l] reached the goal.
-      stuck: bool[l] stopped with no admissible neighbour.
       state: f32[l, E] the agent's own state (with a hook; else None).
     """
 
     agent: jax.Array
     run: jax.Array
-    position: jax.Array
+    status: jax.Array
     visited: jax.Array
-    moves: jax.Array
-    diagonal: jax.Array
-    walking: jax.Array
-    arrived: jax.Array
-    stuck: jax.Array
     state: Any = None
+
+    @property
+    def position(self) -> jax.Array:
+        """i32[l] the node each agent is at."""
+        return self.status[:, POSITION]
+
+    @property
+    def moves(self) -> jax.Array:
+        """i32[l] the moves each agent made."""
+        return self.status[:, MOVES]
+
+    @property
+    def diagonal(self) -> jax.Array:
+        """i32[l] the diagonal moves among them."""
+        return self.status[:, DIAGONAL]
+
+    @property
+    def walking(self) -> jax.Array:
+        """bool[l] the agent still moves."""
+        return (self.status[:, FLAGS] & WALKING) != 0
+
+    @property
+    def arrived(self) -> jax.Array:
+        """bool[l] the agent reached the goal."""
+        return (self.status[:, FLAGS] & ARRIVED) != 0
+
+    @property
+    def stuck(self) -> jax.Array:
+        """bool[l] the agent stopped with no admissible neighbour."""
+        return (self.status[:, FLAGS] & STUCK) != 0
+
+
+def lane_status(position, moves, diagonal, walking, arrived, stuck) -> jax.Array:
+    """i32[l, 4] the :attr:`Lanes.status` of lanes with these counters (i32[l] each) and flags
+    (bool[l] each)."""
+    flags = (walking.astype(jnp.int32) * WALKING | arrived.astype(jnp.int32) * ARRIVED
+             | stuck.astype(jnp.int32) * STUCK)
+    return jnp.stack([position, moves, diagonal, flags], axis=-1)
 
 
 def start_visited(inputs: WalkInputs, nodes: jax.Array) -> jax.Array:
@@ -185,12 +226,11 @@ def step(inputs: WalkInputs, lanes: Lanes, memory, claims):
             state=lanes.state, groups=groups), graph)
         lanes = lanes._replace(state=state)
     lanes = lanes._replace(
-        position=there,
-        visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there),
-        moves=moves,
-        diagonal=lanes.diagonal + (moving & (choice >= ORTHOGONAL_SLOTS)),
-        walking=moving & ~arrived_now & (moves < inputs.max_steps),
-        arrived=lanes.arrived | arrived_now,
-        stuck=lanes.stuck | (lanes.walking & ~has_choice))
+        status=lane_status(
+            position=there, moves=moves,
+            diagonal=lanes.diagonal + (moving & (choice >= ORTHOGONAL_SLOTS)),
+            walking=moving & ~arrived_now & (moves < inputs.max_steps),
+            arrived=lanes.arrived | arrived_now, stuck=lanes.stuck | (lanes.walking & ~has_choice)),
+        visited=bits.mark(lanes.visited, jnp.arange(here.shape[0]), there))
     return (lanes, memory, claims, jnp.where(moving, choice, -1).astype(inputs.slot_dtype),
             jnp.where(moving, there, NO_NODE))

@@ -54,7 +54,8 @@ from jax.custom_batching import custom_vmap
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
-from jaxswarm.swarm.walking.lanes import Lanes, WalkInputs, initial_state, start_visited, step
+from jaxswarm.swarm.walking.lanes import (FLAGS, WALKING, Lanes, WalkInputs, initial_state,
+                                          lane_status, start_visited, step)
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
@@ -340,11 +341,11 @@ def _fresh_lanes(inputs: WalkInputs, queue: Queue, queued: jax.Array) -> Lanes:
     holds = queued < queue.live
     agent = jnp.where(holds, queue.order[jnp.minimum(queued, count - 1)], count)
     run = queue.run_of_row[jnp.minimum(agent, count - 1)]
-    zeros = jnp.zeros(queued.shape, jnp.int32)
-    return Lanes(agent=agent, run=run, position=inputs.start[run],
-                 visited=start_visited(inputs, inputs.start[run]), moves=zeros, diagonal=zeros,
-                 walking=holds, arrived=jnp.zeros(queued.shape, bool),
-                 stuck=jnp.zeros(queued.shape, bool), state=initial_state(inputs, run))
+    zeros, no = jnp.zeros(queued.shape, jnp.int32), jnp.zeros(queued.shape, bool)
+    return Lanes(agent=agent, run=run,
+                 status=lane_status(inputs.start[run], zeros, zeros, holds, no, no),
+                 visited=start_visited(inputs, inputs.start[run]),
+                 state=initial_state(inputs, run))
 
 
 def _block(inputs: WalkInputs, loop: Loop) -> Loop:
@@ -358,7 +359,10 @@ def _block(inputs: WalkInputs, loop: Loop) -> Loop:
     def step_into_blocks(i, inner):
         lanes, memory, claims, slots, nodes = inner
         lanes, memory, claims, slot, node = step(inputs, lanes, memory, claims)
-        return lanes, memory, claims, slots.at[i].set(slot), nodes.at[i].set(node)
+        # Row ``i`` as a slice update (``.at[i].set`` would bound and wrap ``i`` first: three
+        # more kernels at every step).
+        return (lanes, memory, claims, jax.lax.dynamic_update_index_in_dim(slots, slot, i, 0),
+                jax.lax.dynamic_update_index_in_dim(nodes, node, i, 0))
 
     first_move = lanes.moves
     slots = jnp.full((STEPS_PER_REFILL, width), -1, inputs.slot_dtype)
@@ -437,6 +441,10 @@ def _compact(queue: Queue, loop: Loop, few: int) -> Loop:
     num_lanes = loop.lanes.agent.shape[0]
     which = jnp.nonzero(loop.lanes.walking, size=few, fill_value=num_lanes)[0]
     lanes = jax.tree_util.tree_map(lambda x: x[jnp.minimum(which, num_lanes - 1)], loop.lanes)
-    lanes = lanes._replace(walking=lanes.walking & (which < num_lanes),
-                           agent=jnp.where(which < num_lanes, lanes.agent, queue.count))
+    # A spare lane keeps the copy of some lane's status: only its walking bit is cleared.
+    spare = which >= num_lanes
+    lanes = lanes._replace(
+        status=lanes.status.at[:, FLAGS].set(
+            jnp.where(spare, lanes.status[:, FLAGS] & ~WALKING, lanes.status[:, FLAGS])),
+        agent=jnp.where(spare, queue.count, lanes.agent))
     return loop._replace(lanes=lanes)

@@ -37,17 +37,18 @@ def sample_masked(uniform: jax.Array, log_weights: jax.Array, mask: jax.Array,
     if greedy is not None:
         weights = jnp.where(greedy[..., None], (masked == top).astype(weights.dtype), weights)
     # The first slot whose cumulative weight exceeds u (a slot of positive weight), capped at the
-    # last slot of positive weight in case rounding made u reach the total. The cumulative sums
-    # are unrolled over the (small, static) slots and counted on the fly: on CPU this fuses into
-    # one loop, cheaper than a cumsum (a reduce-window) and argmax (a variadic reduce).
+    # last slot of positive weight in case rounding made u reach the total: the cumulative sums
+    # never decrease, so both "at most u" and "below the total" hold on a prefix of the slots,
+    # and the slot is the length of the shorter prefix. The sums are unrolled over the (small,
+    # static) slots and the prefix counted by one reduction: one kernel, cheaper than a cumsum
+    # (a reduce-window) and argmax (a variadic reduce), whose result XLA keeps (an elementwise
+    # count would be computed again in each of the step's consumers of the slot).
     columns = [weights[..., k] for k in range(weights.shape[-1])]
     total = functools.reduce(operator.add, columns)
     u = uniform * total
-    below_u = below_total = jnp.zeros(total.shape, jnp.int32)
-    running = jnp.zeros_like(total)
+    running, prefix = jnp.zeros_like(total), []
     for column in columns:
         running = running + column
-        below_u = below_u + (running <= u)
-        below_total = below_total + (running < total)
-    choice = jnp.minimum(below_u, below_total)
+        prefix.append((running <= u) & (running < total))
+    choice = jnp.sum(jnp.stack(prefix, axis=-1), axis=-1, dtype=jnp.int32)
     return jnp.where(has_choice, choice, NO_NODE).astype(jnp.int32), has_choice
