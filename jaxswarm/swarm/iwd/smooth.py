@@ -236,6 +236,8 @@ def _smooth_distinct(num_nodes: int, costs_at: Callable, paths: jax.Array, which
     order = jnp.nonzero(distinct, size=count, fill_value=count)[0]
 
     def one(index, done):
+        # Under ``vmap`` the loop runs to the batch's largest count: past a run's own, ``row``
+        # is ``count``, read clamped and written nowhere.
         row = order[index]
         smoothed = _passes(num_nodes, costs_at, paths[jnp.minimum(row, count - 1)])
         return done.at[row].set(smoothed, mode="drop")

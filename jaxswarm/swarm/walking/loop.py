@@ -54,8 +54,8 @@ from jax.custom_batching import custom_vmap
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
 from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
-from jaxswarm.swarm.walking.lanes import (FLAGS, WALKING, Lanes, WalkInputs, initial_state,
-                                          lane_status, start_visited, step)
+from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
+                                          start_visited, step)
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
@@ -441,10 +441,9 @@ def _compact(queue: Queue, loop: Loop, few: int) -> Loop:
     num_lanes = loop.lanes.agent.shape[0]
     which = jnp.nonzero(loop.lanes.walking, size=few, fill_value=num_lanes)[0]
     lanes = jax.tree_util.tree_map(lambda x: x[jnp.minimum(which, num_lanes - 1)], loop.lanes)
-    # A spare lane keeps the copy of some lane's status: only its walking bit is cleared.
-    spare = which >= num_lanes
+    spare = which >= num_lanes  # holds a copy of some lane: not walking, no agent
     lanes = lanes._replace(
-        status=lanes.status.at[:, FLAGS].set(
-            jnp.where(spare, lanes.status[:, FLAGS] & ~WALKING, lanes.status[:, FLAGS])),
+        status=lane_status(lanes.position, lanes.moves, lanes.diagonal, lanes.walking & ~spare,
+                           lanes.arrived, lanes.stuck),
         agent=jnp.where(spare, queue.count, lanes.agent))
     return loop._replace(lanes=lanes)
