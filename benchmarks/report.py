@@ -23,13 +23,17 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 BENCHMARKS = [
-    ("Walks: moves per second against a scalar C loop", "walk.py", [], ["--repeats", "2",
-                                                                       "--layouts", "64x4"],
-     "Moves per second of one jitted call of the walker on maze100 (all seeds' walks share one "
-     "queue over the lanes), from the swarm's first memory and from its memory after 30 "
-     "iterations, beside `benchmarks/scalar/walk.c` on one core and on all cores. `busy` is the "
-     "share of lane-steps that moved an agent; `same` counts the agents whose paths equal the C "
-     "loop's (it draws the walker's own uniforms)."),
+    ("Walks: moves per second against a scalar C loop", "walk.py", [],
+     ["--repeats", "2", "--layouts", "64x4", "--maps", "maze20"],
+     "Moves per second of one jitted call of the walker on maze100 and on the 256 x 256 Moving AI "
+     "map Berlin_1_256 (all seeds' walks share one queue over the lanes), from the swarm's first "
+     "memory and from its memory after 30 iterations, beside `benchmarks/scalar/walk.c` on one "
+     "core and on all cores, which writes the walker's outputs in its layout. `busy` is the "
+     "share of lane-steps that moved an agent; `same` counts the agents whose outputs all equal "
+     "the C loop's (it draws the walker's own uniforms); `MiB` is the compiled walk's own memory "
+     "(outputs and temporary buffers) at the default step budget and `x2` at twice that budget. "
+     "Water drops: IWD's walk as the swarm walks by default and with `while_walking` updates, "
+     "beside ACO*'s."),
     ("rfd_graded on the paper maps", "rfd.py", [], ["--maps", "maze20,maze100", "--seeds", "3"],
      "Median wall time of one `rfd_graded` run (100 iterations at most, patience 30, 256 drops, "
      "one XLA thread) per paper map over 20 seeds, beside the RFD paper's C# time of RFD*, and "

@@ -1,12 +1,15 @@
-"""Moves per second of the walker with the rfd_graded and ACO* transition rules on maze100,
-beside a scalar C loop of the same rule.
+"""Moves per second of the walker with the rfd_graded and ACO* transition rules, beside a
+scalar C loop of the same rule doing the same work, and the walker's memory.
 
-For each swarm (``--swarms``), each memory (``initial``: the swarm's first altitudes or pheromone;
-``converged``: its memory after ``--converge`` iterations of a run, when most agents follow a
-river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 and 16,384 =
-256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents share one
-queue over the walker's lanes), jitted, after one warm-up call (compile excluded). Printed, the
-median over ``--repeats`` runs:
+Maps (``--maps``): paper maps (default maze100) and Moving AI MAPF maps by name (default
+Berlin_1_256, 256 x 256, from ``$JAXSWARM_MOVINGAI/mapf`` or ``../shared/benchdata/movingai/mapf``,
+start and goal from the mid-length row of its even scenario file, as the studies take them).
+For each swarm (``--swarms``), each memory (``initial``: the swarm's first altitudes or
+pheromone; ``converged``: its memory after ``--converge`` iterations of a run, when most agents
+follow a river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 and
+16,384 = 256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents
+share one queue over the walker's lanes), jitted, after one warm-up call (compile excluded).
+Printed, the median over ``--repeats`` runs:
 
 (ACO* finds no path on maze100 in 30 iterations, so its pheromone stays uniform up to a
 factor and both memories give the same walks.)
@@ -16,22 +19,29 @@ factor and both memories give the same walks.)
   lane's next refill, and the last agents' lanes wait for the slowest),
 * ``M moves/s``: moves / wall time,
 * ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
-  (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -fopenmp``, agents
-  shared out over threads; it fills a path buffer with -1 and writes each path's nodes into it,
-  as the walker does), and ``share``: ours as a share of the reference on all cores. The
-  reference draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents
-  whose paths are identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may
-  send an agent elsewhere at a tie of cumulative weights).
+  (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -ffp-contract=off
+  -fopenmp``, agents shared out over threads), and ``share``: ours as a share of the reference
+  on all cores. The reference writes what the walker returns, in its layout (each agent's
+  padded path and slots, visited set, moves, length, position, arrival and stop), and draws the
+  walker's uniforms, so it walks the same paths: ``same`` counts the agents whose outputs are
+  all identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may send an agent
+  elsewhere at a tie of cumulative weights),
+* ``MiB`` and ``x2``: the compiled walk's own memory (its outputs and temporary buffers, from
+  XLA's memory analysis; the map, the table and the keys excluded) at the default step budget
+  and at twice that budget: what a longer possible path costs.
 
-Water drops (``iwd``) change their soil at every step through the walker's hook, so the table
-is not fixed and the scalar reference does not apply: a second table times IWD's walks (soil at
-its start) beside ACO*'s (pheromone at its start) on the same map and layouts, and prints IWD's
-moves per second as a share of ACO*'s (``iwd / aco``: what the hook costs).
+Water drops (``iwd``) read their soil at every step through the walker's hook, so the table
+alone does not give their walk and the scalar reference does not apply: a second table times
+IWD's walks (soil at its start) beside ACO*'s (pheromone at its start) on the same maps and
+layouts: ``iwd`` as the swarm walks by default (the soil read during the walk, the arrived
+drops' updates after it, :func:`jaxswarm.swarm.iwd.iwd.drop_walk`) and ``iwd ww`` with
+``local_updates="while_walking"`` (every drop writes the soil as it moves), each as a share of
+ACO*'s moves per second (``/ aco``: what the hook costs).
 
 Run from the repository root::
 
     python benchmarks/walk.py
-    python benchmarks/walk.py --layouts 256x1,256x16 --repeats 3 --swarms rfd_graded
+    python benchmarks/walk.py --maps maze100 --layouts 256x1,256x16 --repeats 3 --swarms rfd_graded
 """
 from __future__ import annotations
 
@@ -51,10 +61,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.maps.paper import paper_map
+from jaxswarm.maps.named import PAPER, map_kind, named_map
+from jaxswarm.studies.problems import movingai_folder, scenario_problem
 from jaxswarm.swarm import aco, make, make_task, rfd, run
-from jaxswarm.swarm.iwd.soil import SOIL, goal_log_desirability
-from jaxswarm.swarm.walking import edge_table, step_budget, walk
+from jaxswarm.swarm.core import Task
+from jaxswarm.swarm.iwd.iwd import drop_walk
+from jaxswarm.swarm.walking import Walk, step_budget, walk
+from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import slot_offsets
 
 SCALAR_SOURCE = Path(__file__).parent / "scalar" / "walk.c"
@@ -66,17 +79,37 @@ TRANSITION_RULES = {
 }
 """The walks measured: each swarm's transition table of its memory, and its memory."""
 
+OUTPUTS = ("path", "slots", "visited", "moves", "length", "position", "arrived", "stuck")
+"""The walker's outputs (:class:`~jaxswarm.swarm.walking.Walk` fields) the reference writes, in
+the order of its ``Outputs`` struct."""
+
+MIB = 2 ** 20
+
+
+class _Outputs(ctypes.Structure):
+    _fields_ = [(name, ctypes.c_void_p) for name in OUTPUTS]
+
 
 def machine() -> str:
     return (f"{platform.platform()} | {os.cpu_count()} CPUs | python "
             f"{platform.python_version()} | jax {jax.__version__} ({jax.default_backend()})")
 
 
+def load_problem(name: str) -> tuple[Graph, Task]:
+    """A paper map with its own start and goal, or a Moving AI MAPF map by name with the
+    mid-length row of its even scenario file."""
+    if map_kind(name) == PAPER:
+        chosen = named_map(name)
+        return chosen.graph, make_task(chosen.graph, chosen.start, chosen.goal)
+    problem = scenario_problem(movingai_folder(), name)
+    return problem.graph, problem.task
+
+
 def build_scalar(directory: str) -> ctypes.CDLL:
     """The scalar reference, compiled into ``directory``; exits naming the compiler's error."""
     library = Path(directory) / "walk.so"
-    command = [os.environ.get("CC", "cc"), "-O3", "-march=native", "-fopenmp", "-shared",
-               "-fPIC", str(SCALAR_SOURCE), "-o", str(library), "-lm"]
+    command = [os.environ.get("CC", "cc"), "-O3", "-march=native", "-ffp-contract=off",
+               "-fopenmp", "-shared", "-fPIC", str(SCALAR_SOURCE), "-o", str(library), "-lm"]
     try:
         subprocess.run(command, check=True, capture_output=True, text=True)
     except (OSError, subprocess.CalledProcessError) as error:
@@ -85,10 +118,55 @@ def build_scalar(directory: str) -> ctypes.CDLL:
     scalar = ctypes.CDLL(str(library))
     pointer, i32, u32 = ctypes.c_void_p, ctypes.c_int32, ctypes.c_uint32
     scalar.walk_all.argtypes = [pointer, i32, i32, pointer, i32, i32, i32, i32, u32, u32,
-                                pointer, pointer]
+                                _Outputs]
     scalar.walk_all.restype = ctypes.c_int64
     scalar.set_threads.argtypes = [i32]
     return scalar
+
+
+def seed_words(keys: jax.Array) -> np.ndarray:
+    """u32[S, 2]: the walker's per-walk seeds, two words drawn from each walk's key."""
+    return np.asarray(jax.vmap(lambda key: jax.random.bits(key, (1, 2), jnp.uint32))(keys))[:, 0]
+
+
+def scalar_outputs(graph: Graph, agents: int, steps: int) -> dict[str, np.ndarray]:
+    """The reference's output buffers for ``agents`` agents, each as the walker lays it out."""
+    words = (graph.num_nodes + 31) // 32
+    return dict(path=np.empty((agents, steps + 1), np.int32),
+                slots=np.empty((agents, steps), np.int8),
+                visited=np.empty((agents, words), np.uint32),
+                moves=np.empty(agents, np.int32), length=np.empty(agents, np.float32),
+                position=np.empty(agents, np.int32), arrived=np.empty(agents, np.bool_),
+                stuck=np.empty(agents, np.bool_))
+
+
+def scalar_walks(scalar, graph: Graph, task: Task, table: np.ndarray, words: np.ndarray,
+                 out: dict[str, np.ndarray], agents: int, steps: int) -> int:
+    """Every seed's ``agents`` walks by the reference into ``out`` (leading axis seed x agent,
+    reset first as the walker's buffers start); returns the moves made."""
+    out["path"].fill(-1)
+    out["slots"].fill(-1)
+    out["visited"].fill(0)
+    offsets = np.ascontiguousarray(np.asarray(slot_offsets(graph), np.int32))
+    total = 0
+    for s, (word_0, word_1) in enumerate(words):
+        rows = slice(s * agents, (s + 1) * agents)
+        fields = _Outputs(*(out[name][rows].ctypes.data for name in OUTPUTS))
+        total += scalar.walk_all(table.ctypes.data, graph.num_nodes, graph.max_degree,
+                                 offsets.ctypes.data, int(task.start), int(task.goal), agents,
+                                 steps, int(word_0), int(word_1), fields)
+    return total
+
+
+def same_agents(result: Walk, out: dict[str, np.ndarray]) -> int:
+    """How many agents have every output of the walker's ``result`` equal to the reference's."""
+    agree = None
+    for name in OUTPUTS:
+        ours = np.asarray(getattr(result, name))
+        ours = ours.reshape((-1,) + ours.shape[2:])
+        equal = np.all((ours == out[name]).reshape(len(ours), -1), axis=1)
+        agree = equal if agree is None else agree & equal
+    return int(agree.sum())
 
 
 def memories(swarm_name: str, graph, task, drops: int, converge: int) -> dict:
@@ -101,101 +179,92 @@ def memories(swarm_name: str, graph, task, drops: int, converge: int) -> dict:
     return {"initial": memory(state), "converged": memory(later)}
 
 
+def batched_walks(drops: int, steps: int):
+    """``(keys key[S], table f32[N, K], graph, task) -> Walk``: S seeds' walks under ``vmap``,
+    jitted (the map an argument, not constants for XLA to fold)."""
+    return jax.jit(lambda keys, table, graph, task: jax.vmap(lambda key: walk(
+        key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps))(keys))
+
+
+def own_bytes(walks, *args) -> int:
+    """Bytes the compiled ``walks(*args)`` holds beyond its arguments: its outputs and temporary
+    buffers, from XLA's memory analysis (compiles without running)."""
+    analysis = walks.lower(*args).compile().memory_analysis()
+    return analysis.output_size_in_bytes + analysis.temp_size_in_bytes
+
+
 def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int,
             repeats: int) -> dict:
     params = make(swarm_name, num_agents=drops).default_params
     rule, _ = TRANSITION_RULES[swarm_name]
     table = rule(graph, task, memory, params)
     steps = step_budget(graph, None)
-
-    @jax.jit
-    def walks(keys):
-        return jax.vmap(lambda key: walk(key, graph, table, task.start, task.goal,
-                                         num_agents=drops, max_steps=steps))(keys)
-
     keys = jax.random.split(jax.random.key(1), seeds)
-    jax.block_until_ready(walks(keys))  # warm-up
-    times = []
-    for _ in range(repeats):
-        began = time.perf_counter()
-        result = jax.block_until_ready(walks(keys))
-        times.append(time.perf_counter() - began)
-    seconds = statistics.median(times)
-    moves = int(result.moves.sum())
+    walks = batched_walks(drops, steps)
+    seconds, result = timed(lambda: walks(keys, table, graph, task), repeats)
+    memory_bytes = own_bytes(walks, keys, table, graph, task)
+    longer_bytes = own_bytes(batched_walks(drops, 2 * steps), keys, table, graph, task)
 
-    # The walker's per-walk seeds: two words drawn from each walk's key.
-    words = np.asarray(jax.vmap(lambda key: jax.random.bits(key, (1, 2), jnp.uint32))(keys))
+    words = seed_words(keys)
     flat_table = np.ascontiguousarray(np.asarray(table, np.float32))
-    offsets = np.ascontiguousarray(np.asarray(slot_offsets(graph), np.int32))
-    scalar_moves = np.zeros((seeds, drops), np.int32)
-    paths = np.full((seeds, drops, steps + 1), -1, np.int32)
-
-    def run_scalar(threads: int) -> float:
-        scalar.set_threads(threads)
-        began = time.perf_counter()
-        paths.fill(-1)  # padded paths, as the walker returns them
-        for s in range(seeds):
-            scalar.walk_all(
-                flat_table.ctypes.data, graph.num_nodes, graph.max_degree, offsets.ctypes.data,
-                int(task.start), int(task.goal), drops, steps, int(words[s, 0, 0]),
-                int(words[s, 0, 1]), scalar_moves[s].ctypes.data,
-                paths[s].ctypes.data)
-        return time.perf_counter() - began
-
+    out = scalar_outputs(graph, seeds * drops, steps)
     reference = {}
     for threads in (1, os.cpu_count()):
-        wall = statistics.median(run_scalar(threads) for _ in range(repeats))
-        reference[threads] = scalar_moves.sum() / wall
-    same = int(np.all(paths == np.asarray(result.path), axis=-1).sum())
+        scalar.set_threads(threads)
+        walls = []
+        for _ in range(repeats):
+            began = time.perf_counter()
+            scalar_moves = scalar_walks(scalar, graph, task, flat_table, words, out, drops, steps)
+            walls.append(time.perf_counter() - began)
+        reference[threads] = scalar_moves / statistics.median(walls)
+    moves = int(result.moves.sum())
     return dict(agents=drops * seeds, seconds=seconds, moves=moves,
                 busy=moves / int(result.lane_steps[0]), rate=moves / seconds,
-                one_core=reference[1], all_cores=reference[os.cpu_count()], same=same)
+                one_core=reference[1], all_cores=reference[os.cpu_count()],
+                same=same_agents(result, out), memory=memory_bytes, longer=longer_bytes)
 
 
-def timed_walks(walks, keys, repeats: int) -> tuple[float, int]:
-    """``(median seconds, moves)`` of ``walks(keys)`` over ``repeats`` runs after a warm-up."""
-    jax.block_until_ready(walks(keys))
+def timed(call, repeats: int):
+    """``(median seconds, result)`` of ``call()`` over ``repeats`` runs after a warm-up."""
+    jax.block_until_ready(call())
     times = []
     for _ in range(repeats):
         began = time.perf_counter()
-        result = jax.block_until_ready(walks(keys))
+        result = jax.block_until_ready(call())
         times.append(time.perf_counter() - began)
-    return statistics.median(times), int(result.moves.sum())
+    return statistics.median(times), result
 
 
 def measure_drops(graph, task, drops: int, seeds: int, repeats: int) -> dict:
-    """Moves per second of IWD's walks (the soil hook) and of ACO*'s, same keys and layout."""
-    steps = step_budget(graph, None)
+    """``{name: (seconds, moves)}`` of IWD's walks (as it walks by default, and with
+    ``while_walking`` updates) and of ACO*'s, same keys and layout, from each swarm's start."""
     keys = jax.random.split(jax.random.key(1), seeds)
     iwd_swarm, aco_swarm = make("iwd", num_agents=drops), make("aco_star", num_agents=drops)
-    soil = iwd_swarm.init(jax.random.key(0), graph, task, iwd_swarm.default_params).soil
-    drop_table = edge_table(graph, iwd_swarm.default_params.beta
-                            * goal_log_desirability(graph, task.goal))
-    aco_params = aco_swarm.default_params
+    iwd_params, aco_params = iwd_swarm.default_params, aco_swarm.default_params
+    soil = iwd_swarm.init(jax.random.key(0), graph, task, iwd_params).soil
     pheromone = aco_swarm.init(jax.random.key(0), graph, task, aco_params).pheromone
     ant_table = aco.transition_rule(graph, task, pheromone, aco_params, goal_distance=True)
 
-    @jax.jit
-    def drop_walks(keys):
-        return jax.vmap(lambda key: walk(key, graph, drop_table, task.start, task.goal,
-                                         num_agents=drops, max_steps=steps, hook=SOIL,
-                                         memory=soil, hook_params=iwd_swarm.default_params))(keys)
+    def drop_walks(local_updates):
+        walks = jax.jit(lambda keys, graph, task, soil: jax.vmap(lambda key: drop_walk(
+            key, graph, task, soil, iwd_params, num_agents=drops, max_steps=None,
+            local_updates=local_updates))(keys))
+        return lambda keys: walks(keys, graph, task, soil)
 
-    @jax.jit
-    def ant_walks(keys):
-        return jax.vmap(lambda key: walk(key, graph, ant_table, task.start, task.goal,
-                                         num_agents=drops, max_steps=steps))(keys)
-
+    ant_walks = batched_walks(drops, step_budget(graph, None))
+    walks = {"iwd": drop_walks("arrived"), "iwd ww": drop_walks("while_walking"),
+             "aco_star": lambda keys: ant_walks(keys, ant_table, graph, task)}
     rates = {}
-    for name, walks in (("iwd", drop_walks), ("aco_star", ant_walks)):
-        seconds, moves = timed_walks(walks, keys, repeats)
-        rates[name] = (seconds, moves, moves / seconds)
+    for name, call in walks.items():
+        seconds, result = timed(lambda: call(keys), repeats)
+        rates[name] = (seconds, int(result.moves.sum()))
     return rates
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--map", default="maze100")
+    parser.add_argument("--maps", default="maze100,Berlin_1_256",
+                        help="comma-separated paper maps or Moving AI MAPF map names")
     parser.add_argument("--swarms", default="rfd_graded,aco_star",
                         help=f"comma-separated, from {', '.join(TRANSITION_RULES)}")
     parser.add_argument("--layouts", default="256x4,256x64", help="comma-separated DROPSxSEEDS")
@@ -203,39 +272,42 @@ def main(argv: list[str] | None = None) -> int:
                         help="iterations run for the converged memory")
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args(argv)
-    chosen = paper_map(args.map)
-    graph = chosen.graph()
-    task = make_task(graph, chosen.start, chosen.goal)
     layouts = [tuple(int(part) for part in layout.split("x"))
                for layout in args.layouts.split(",")]
+    problems = {name: load_problem(name) for name in args.maps.split(",")}
     print(f"machine: {machine()}")
-    print(f"walks on {args.map}, median of {args.repeats} runs after a warm-up compile; "
-          f"reference: {SCALAR_SOURCE.name} on 1 and {os.cpu_count()} cores")
-    print(f"{'swarm':10} {'memory':9} {'agents':>7} {'ms':>8} {'moves':>9} {'busy':>5} "
-          f"{'M moves/s':>9} {'ref 1 / all':>12} {'share':>6} {'same':>12}")
+    print(f"median of {args.repeats} runs after a warm-up compile; reference: "
+          f"{SCALAR_SOURCE.name} on 1 and {os.cpu_count()} cores")
+    print(f"{'map':13} {'swarm':10} {'memory':9} {'agents':>7} {'ms':>8} {'moves':>9} "
+          f"{'busy':>5} {'M moves/s':>9} {'ref 1 / all':>12} {'share':>6} {'same':>12} "
+          f"{'MiB':>7} {'x2':>7}")
     with tempfile.TemporaryDirectory() as directory:
         scalar = build_scalar(directory)
-        for swarm_name in args.swarms.split(","):
-            states = memories(swarm_name, graph, task, layouts[0][0], args.converge)
-            for memory_name, memory in states.items():
-                for drops, seeds in layouts:
-                    r = measure(scalar, swarm_name, graph, task, memory, drops, seeds,
-                                args.repeats)
-                    print(f"{swarm_name:10} {memory_name:9} {r['agents']:>7} "
-                          f"{1e3 * r['seconds']:>8.1f} {r['moves']:>9} {r['busy']:>5.2f} "
-                          f"{r['rate'] / 1e6:>9.1f} "
-                          f"{r['one_core'] / 1e6:>5.1f} / {r['all_cores'] / 1e6:<5.1f} "
-                          f"{r['rate'] / r['all_cores']:>6.2f} "
-                          f"{r['same']:>6}/{r['agents']:<5}", flush=True)
-    print(f"\nwater drops (iwd, soil hook) beside ACO* on {args.map}, from their initial memory")
-    print(f"{'agents':>7} {'iwd ms':>8} {'moves':>9} {'M moves/s':>9} {'aco ms':>8} "
-          f"{'moves':>9} {'M moves/s':>9} {'iwd / aco':>9}")
-    for drops, seeds in layouts:
-        r = measure_drops(graph, task, drops, seeds, args.repeats)
-        (iwd_s, iwd_moves, iwd_rate), (aco_s, aco_moves, aco_rate) = r["iwd"], r["aco_star"]
-        print(f"{drops * seeds:>7} {1e3 * iwd_s:>8.1f} {iwd_moves:>9} {iwd_rate / 1e6:>9.2f} "
-              f"{1e3 * aco_s:>8.1f} {aco_moves:>9} {aco_rate / 1e6:>9.2f} "
-              f"{iwd_rate / aco_rate:>9.2f}", flush=True)
+        for map_name, (graph, task) in problems.items():
+            for swarm_name in args.swarms.split(","):
+                states = memories(swarm_name, graph, task, layouts[0][0], args.converge)
+                for memory_name, memory in states.items():
+                    for drops, seeds in layouts:
+                        r = measure(scalar, swarm_name, graph, task, memory, drops, seeds,
+                                    args.repeats)
+                        print(f"{map_name:13} {swarm_name:10} {memory_name:9} {r['agents']:>7} "
+                              f"{1e3 * r['seconds']:>8.1f} {r['moves']:>9} {r['busy']:>5.2f} "
+                              f"{r['rate'] / 1e6:>9.1f} "
+                              f"{r['one_core'] / 1e6:>5.1f} / {r['all_cores'] / 1e6:<5.1f} "
+                              f"{r['rate'] / r['all_cores']:>6.2f} "
+                              f"{r['same']:>6}/{r['agents']:<5} {r['memory'] / MIB:>7.1f} "
+                              f"{r['longer'] / MIB:>7.1f}", flush=True)
+    print("\nwater drops (iwd, soil hook) beside ACO*, from their initial memory: M moves/s")
+    print(f"{'map':13} {'agents':>7} {'iwd':>7} {'iwd ww':>7} {'aco':>7} {'iwd / aco':>9} "
+          f"{'ww / aco':>8}")
+    for map_name, (graph, task) in problems.items():
+        for drops, seeds in layouts:
+            rates = {name: moves / seconds / 1e6 for name, (seconds, moves)
+                     in measure_drops(graph, task, drops, seeds, args.repeats).items()}
+            print(f"{map_name:13} {drops * seeds:>7} {rates['iwd']:>7.2f} "
+                  f"{rates['iwd ww']:>7.2f} {rates['aco_star']:>7.2f} "
+                  f"{rates['iwd'] / rates['aco_star']:>9.2f} "
+                  f"{rates['iwd ww'] / rates['aco_star']:>8.2f}", flush=True)
     return 0
 
 

@@ -167,8 +167,9 @@ def test_excluded_and_invalid_edges_are_never_taken():
     assert bool(result.arrived.any())
 
 
-@pytest.mark.parametrize("lanes, compact", [(8, 4), (64, 10 ** 9), (5, 2)])
-def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact):
+@pytest.mark.parametrize("lanes, compact, smallest",
+                         [(8, 4, 16), (64, 10 ** 9, 16), (5, 2, 16), (64, 2, 2)])
+def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact, smallest):
     import jaxswarm.swarm.walking.loop as walk_module
 
     graph = grid_graph(np.zeros((16, 16), bool))
@@ -184,6 +185,7 @@ def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact)
     assert moves.max() - moves.min() > 4 * STEPS_PER_REFILL
     monkeypatch.setattr(walk_module, "LANES", lanes)
     monkeypatch.setattr(walk_module, "COMPACT_SHARE", compact)
+    monkeypatch.setattr(walk_module, "SMALLEST_COMPACTION", smallest)  # (64, 2, 2): five narrowings
     shared = walks()
     assert int(shared.lane_steps) != int(default.lane_steps)  # another schedule ...
     for name, value in default._asdict().items():  # ... the same walks

@@ -1,6 +1,11 @@
 /* A scalar reference of jaxswarm's walk on grids: one agent at a time, the same transition
  * rule (inverse CDF over exp(log-weight - max) of the admissible slots), visited sets as bits,
- * the same counter-based uniforms (jaxswarm.swarm.walking.streams.uniforms), so it walks the same paths.
+ * the same counter-based uniforms (jaxswarm.swarm.walking.streams.uniforms), so it walks the
+ * same paths. It writes what the walker returns (jaxswarm.swarm.walking.Walk), in the same
+ * layout, so that the two do the same work: each agent's path and slots (padded with -1 by
+ * the caller, as the walker's buffers are), its visited set, moves, length, position, and
+ * whether it arrived or got stuck. Build it without floating-point contraction
+ * (-ffp-contract=off): the walker's arithmetic has none.
  * Built and timed by benchmarks/walk.py; agents are shared out over threads with OpenMP. */
 #include <math.h>
 #include <stdint.h>
@@ -9,6 +14,8 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+
+#define ORTHOGONAL_SLOTS 4
 
 /* Threads for the next walk_all (OpenMP; one when built without it). */
 void set_threads(int32_t threads) {
@@ -29,25 +36,36 @@ static inline float uniform(uint32_t s0, uint32_t s1, uint32_t agent, uint32_t m
   return (float)(finalise(finalise(counter ^ s0) ^ s1) >> 8) * 0x1p-24f;
 }
 
-/* Walks agents 0..agents-1 from start; writes each agent's moves and its path into paths
- * (i32[agents, max_steps + 1], filled with -1 by the caller) and returns the total number of
+/* What walk_all writes, one row or entry per agent (the caller fills path and slots with -1
+ * and visited with zeros). */
+typedef struct {
+  int32_t *path;     /* i32[agents, max_steps + 1] */
+  int8_t *slots;     /* i8[agents, max_steps] */
+  uint32_t *visited; /* u32[agents, ceil(num_nodes / 32)] */
+  int32_t *moves;    /* i32[agents] */
+  float *length;     /* f32[agents]: orthogonal moves + diagonal moves * sqrt(2) in float32 */
+  int32_t *position; /* i32[agents] */
+  int8_t *arrived;   /* bool[agents] */
+  int8_t *stuck;     /* bool[agents] */
+} Outputs;
+
+/* Walks agents 0..agents-1 from start, writes their Outputs and returns the total number of
  * moves. */
 int64_t walk_all(const float *log_weights, int32_t num_nodes, int32_t degree,
                  const int32_t *offsets, int32_t start, int32_t goal, int32_t agents,
-                 int32_t max_steps, uint32_t s0, uint32_t s1, int32_t *moves_out,
-                 int32_t *paths) {
+                 int32_t max_steps, uint32_t s0, uint32_t s1, Outputs out) {
   int32_t words = (num_nodes + 31) / 32;
   int64_t total = 0;
 #pragma omp parallel reduction(+ : total)
   {
-    uint32_t *visited = malloc(sizeof(uint32_t) * words);
     float weight[64];
     int32_t neighbour[64];
 #pragma omp for schedule(dynamic, 16)
     for (int32_t a = 0; a < agents; a++) {
-      int32_t *path = paths + (int64_t)a * (max_steps + 1);
-      memset(visited, 0, sizeof(uint32_t) * words);
-      int32_t here = start, moves = 0;
+      int32_t *path = out.path + (int64_t)a * (max_steps + 1);
+      int8_t *slots = out.slots + (int64_t)a * max_steps;
+      uint32_t *visited = out.visited + (int64_t)a * words;
+      int32_t here = start, moves = 0, diagonal = 0, stuck = 0;
       path[0] = here;
       visited[here >> 5] |= 1u << (here & 31);
       while (here != goal && moves < max_steps) {
@@ -61,7 +79,7 @@ int64_t walk_all(const float *log_weights, int32_t num_nodes, int32_t degree,
           weight[k] = (row[k] > -INFINITY && !seen) ? row[k] : -INFINITY;
           if (weight[k] > top) top = weight[k];
         }
-        if (!isfinite(top)) break; /* stuck */
+        if (!isfinite(top)) { stuck = 1; break; }
         float sum = 0.0f;
         for (int32_t k = 0; k < degree; k++) {
           weight[k] = expf(weight[k] - top);
@@ -77,12 +95,17 @@ int64_t walk_all(const float *log_weights, int32_t num_nodes, int32_t degree,
         int32_t choice = below_u < below_total ? below_u : below_total;
         here = neighbour[choice];
         visited[here >> 5] |= 1u << (here & 31);
+        slots[moves] = (int8_t)choice;
+        diagonal += choice >= ORTHOGONAL_SLOTS;
         path[++moves] = here;
       }
-      moves_out[a] = moves;
+      out.moves[a] = moves;
+      out.length[a] = (float)(moves - diagonal) + (float)diagonal * (float)M_SQRT2;
+      out.position[a] = here;
+      out.arrived[a] = here == goal;
+      out.stuck[a] = (int8_t)stuck;
       total += moves;
     }
-    free(visited);
   }
   return total;
 }

@@ -5,15 +5,15 @@ sampler (:mod:`.sampler`), packed visited sets (:mod:`.bits`), what algorithms h
 budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), and
 work on a walk's moves cut to the moves the batch made (:mod:`.moves`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
-from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, STEPS_PER_REFILL, Walk,
-                                         visited_nodes, walk)
+from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, SMALLEST_COMPACTION,
+                                         STEPS_PER_REFILL, Walk, visited_nodes, walk)
 from jaxswarm.swarm.walking.moves import move_widths, on_moves
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
                                            neighbour_slots, step_budget)
 
-__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "STEPS_PER_REFILL",
-           "StepHook", "Walk", "edge_groups", "edge_table", "goal_log_distance", "heads",
-           "move_widths", "neighbour_slots", "on_moves", "sample_masked", "step_budget",
-           "uniforms", "visited_nodes", "walk"]
+__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "SMALLEST_COMPACTION",
+           "STEPS_PER_REFILL", "StepHook", "Walk", "edge_groups", "edge_table",
+           "goal_log_distance", "heads", "move_widths", "neighbour_slots", "on_moves",
+           "sample_masked", "step_budget", "uniforms", "visited_nodes", "walk"]

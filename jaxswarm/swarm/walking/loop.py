@@ -15,7 +15,9 @@ Agents do not each keep a lane until the slowest one finishes. The loop steps a 
 lanes (at most ``LANES``) ``STEPS_PER_REFILL`` moves at a time; then up to a quarter of the lanes
 whose agent stopped hand its results to the output buffers and take the next agent of the queue.
 Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, those go on in a
-batch of that many lanes.
+batch of that many lanes, and so on each time a ``COMPACT_SHARE``-th of those lanes is left, down
+to ``SMALLEST_COMPACTION`` lanes: a walk's last agents (the few that wander for hundreds of
+steps) do not keep every lane stepping.
 
 Random streams belong to agents, not lanes: agent ``a``'s ``m``-th move draws a uniform hashed
 from the walk's key, ``a`` and ``m`` (:func:`.streams.uniforms`). So without a hook neither the
@@ -74,9 +76,20 @@ REFILL_SHARE = 4
 visited set out costs a row of words, so the copy is sized for the usual number of stops, and
 any more stopped lanes wait for the next refill."""
 
-COMPACT_SHARE = 8
+COMPACT_SHARE = 4
 """When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
-goes on with only them, in a batch of that many lanes."""
+goes on with only them, in a batch of that many lanes; again and again as agents stop (see
+``SMALLEST_COMPACTION``). Measured on maze100 (2 cores, ``benchmarks/walk.py``'s walks of 1,024
+agents from the first memory, where the last tenth of the agents walk for most of the steps):
+with a share of 8 and one narrowing, 0.36-0.40 of the lane-steps moved an agent and a walk took
+15.0 ms (ACO*) and 22.3 ms (rfd_graded); with 4 and narrowing down to 16 lanes, 0.61-0.67 and
+10.6 / 15.4 ms (a share of 2: 0.68-0.77, 9.8 / 15.1 ms, for twice the narrowed loops to compile).
+Walks of 16,384 agents spend their time while the queue is full, and were as fast."""
+
+SMALLEST_COMPACTION = 16
+"""The lanes a walk narrows to, after its first narrowing, are at least this many: below that
+a step costs about the same however few lanes it has, and every narrowing is one more loop to
+compile."""
 
 
 class Walk(NamedTuple):
@@ -273,7 +286,7 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     """Walk the ``count`` agents of a batch of runs in one loop: the agents of runs with
     somewhere to go are queued, the others keep their initial results. The lanes take queued
     agents until the queue is empty and at most ``lanes // COMPACT_SHARE`` of them walk; those
-    then go on in that many lanes.
+    then go on in that many lanes, narrowed again as they stop (``SMALLEST_COMPACTION``).
 
     Args:
       inputs: the walk's inputs (R runs).
@@ -298,10 +311,13 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     loop = _flush(inputs, queue, jax.lax.while_loop(
         functools.partial(_keeps_queueing, queue, few),
         lambda loop: _refill(inputs, queue, _block(inputs, loop)), loop))
-    if few:
+    while few:  # one narrower loop each, statically unrolled
+        fewer = few // COMPACT_SHARE
+        fewer = fewer if fewer >= SMALLEST_COMPACTION else 0
         loop = _flush(inputs, queue, jax.lax.while_loop(
-            lambda loop: _walking_count(loop.lanes) > 0, functools.partial(_block, inputs),
-            _compact(queue, loop, few)))
+            lambda loop, fewer=fewer: _walking_count(loop.lanes) > fewer,
+            functools.partial(_block, inputs), _compact(queue, loop, few)))
+        few = fewer
     # The start column goes into the loop's output, in place: set in the initial buffer, it
     # makes XLA fill the whole buffer element by element (a third of a large walk's time).
     results = loop.results._replace(path=loop.results.path.at[:, 0].set(initial.position))
