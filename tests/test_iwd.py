@@ -101,6 +101,32 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     assert swapped[0, EAST] != pytest.approx(after[0, EAST])
 
 
+def test_arrived_updates_of_a_batch_equal_each_run_alone_and_a_sequential_loop():
+    # Runs with 3, 0 and 5 arrived drops: a batch loops over arrivals, each run's in its order.
+    graph = grid_graph(np.zeros((6, 6), bool))
+    rng = np.random.default_rng(5)
+    soil = jnp.asarray(rng.uniform(100, 1000, (3,) + graph.nbr.shape).astype(np.float32))
+    # A drop crosses an edge at most once: distinct nodes along each drop's moves.
+    here = jnp.asarray(np.array([[rng.permutation(graph.num_nodes)[:9] for _ in range(6)]
+                                 for _ in range(3)], np.int32))
+    moved = rng.random((3, 6, 9)) < 0.8
+    slots = jnp.asarray(np.where(moved, rng.integers(0, 8, (3, 6, 9)), -1).astype(np.int8))
+    taken = jnp.asarray(rng.uniform(0, 50, (3, 6, 9)).astype(np.float32))
+    arrived = jnp.asarray([[1, 0, 1, 0, 1, 0], [0] * 6, [1, 1, 1, 0, 1, 1]], bool)
+    batch = np.asarray(jax.jit(jax.vmap(lambda *a: arrived_updates(graph, *a, P)))(
+        soil, here, slots, taken, arrived))
+    keep, rho = np.float32(1) - np.float32(P.rho_n), np.float32(P.rho_n)
+    for r in range(3):
+        alone = np.asarray(arrived_updates(graph, soil[r], here[r], slots[r], taken[r],
+                                           arrived[r], P))
+        expected = np.asarray(soil[r]).copy()
+        for a, m in np.argwhere(np.asarray(arrived[r])[:, None] & moved[r]):
+            node, slot = int(here[r, a, m]), int(slots[r, a, m])
+            expected[node, slot] = keep * expected[node, slot] - rho * np.float32(taken[r, a, m])
+        np.testing.assert_array_equal(alone, expected)
+        np.testing.assert_array_equal(batch[r], alone)
+
+
 def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
     # A dead end above the corridor's middle: drops that enter it get stuck.
     free = np.zeros((2, 5), bool)

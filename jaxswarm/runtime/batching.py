@@ -6,7 +6,8 @@ few costs 30 sweeps for each. :func:`one_at_a_time` gives such a function a batc
 maps it over the batch one member at a time instead, so each member pays for its own loop.
 :func:`fold_runs` and :func:`unfold_runs` serve the other kind of rule, which folds a
 ``vmap``'s axis into a function's own leading run axis (the walker's, and the work after it)
-so that the whole batch runs as one.
+so that the whole batch runs as one; :func:`runs_folded` gives a function written for a leading
+run axis that rule.
 """
 from __future__ import annotations
 
@@ -46,6 +47,29 @@ def one_at_a_time(fun):
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return mapped
+
+
+def runs_folded(fun):
+    """``fun`` (positional array or pytree arguments, each leaf with a leading run axis R; a
+    pytree result likewise) with a vmap rule that folds the mapped axis into R: a batch is one
+    call of ``fun`` over all its runs, so a loop inside it runs as often as its longest run needs
+    and the loop's predicate is never batched (a batched one makes every iteration select every
+    leaf of the carry). Arguments not batched are broadcast to every member."""
+
+    @custom_vmap
+    @functools.wraps(fun)
+    def folded(*args):
+        return fun(*args)
+
+    @folded.def_vmap
+    def rule(axis_size, in_batched, *args):
+        fold = functools.partial(fold_runs, axis_size=axis_size)
+        out = folded(*(jax.tree_util.tree_map(fold, arg, batched)
+                       for arg, batched in zip(args, in_batched)))
+        out = jax.tree_util.tree_map(lambda x: unfold_runs(x, axis_size), out)
+        return out, jax.tree_util.tree_map(lambda _: True, out)
+
+    return folded
 
 
 def fold_runs(x: jax.Array, batched: bool, axis_size: int) -> jax.Array:

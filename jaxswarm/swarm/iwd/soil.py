@@ -40,10 +40,13 @@ Two functions the paper leaves open, and ours:
 """
 from __future__ import annotations
 
+import functools
+
 import jax
 import jax.numpy as jnp
 
 from jaxswarm.runtime.arithmetic import ordered_cumsum
+from jaxswarm.runtime.batching import runs_folded
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
 from jaxswarm.swarm.walking.hooks import Move, StepHook
 from jaxswarm.world.graph import Graph
@@ -147,16 +150,37 @@ def arrived_updates(graph: Graph, soil, here, slots, taken, arrived, params):
       arrived: bool[A] which drops' updates are kept.
       params: the IWD params (scalars).
     """
-    keep = 1.0 - params.rho_n
-    rows = jnp.where((slots >= 0) & arrived[:, None], here, graph.num_nodes)
-    columns = jnp.maximum(slots, 0).astype(jnp.int32)
+    one_run = [jnp.asarray(x)[None] for x in (soil, here, slots, taken, arrived, params.rho_n)]
+    return _arrived_runs(graph.num_nodes)(*one_run)[0]
 
-    def one_drop(soil, drop):
-        row, column, amount = drop
-        before = soil[jnp.minimum(row, graph.num_nodes - 1), column]
-        return soil.at[row, column].set(keep * before - params.rho_n * amount, mode="drop"), None
 
-    return jax.lax.scan(one_drop, soil, (rows, columns, taken))[0]
+@functools.lru_cache(maxsize=None)
+def _arrived_runs(num_nodes: int):
+    """:func:`_apply_arrived` of R runs (leading axis R on every argument), a vmap folded into
+    R (:func:`~jaxswarm.runtime.batching.runs_folded`)."""
+    return runs_folded(functools.partial(_apply_arrived, num_nodes))
+
+
+def _apply_arrived(num_nodes: int, soil, here, slots, taken, arrived, rho_n):
+    """Eq. 5 for R runs' arrived drops (:func:`arrived_updates` with a leading run axis R on
+    every argument, ``rho_n`` f32[R]): the k-th arrived drop of every run at once, for k up to
+    the most drops that arrived in one run, so a batch loops over arrivals, not over drops."""
+    runs, agents = arrived.shape
+    order = jax.vmap(lambda a: jnp.nonzero(a, size=agents, fill_value=0)[0])(arrived)
+    count = jnp.sum(arrived, axis=1)
+    keep = (1.0 - rho_n)[:, None]
+    run = jnp.arange(runs)
+
+    def one_drop(k, soil):
+        drop = order[:, k]  # every run's k-th arrived drop, i32[R]
+        slot = slots[run, drop]
+        row = jnp.where((k < count)[:, None] & (slot >= 0), here[run, drop], num_nodes)
+        column = jnp.maximum(slot, 0).astype(jnp.int32)
+        before = soil[run[:, None], jnp.minimum(row, num_nodes - 1), column]
+        updated = keep * before - rho_n[:, None] * taken[run, drop]
+        return soil.at[run[:, None], row, column].set(updated, mode="drop")
+
+    return jax.lax.fori_loop(0, jnp.max(count), one_drop, soil)
 
 
 def goal_log_desirability(graph: Graph, goal) -> jax.Array:
