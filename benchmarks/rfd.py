@@ -35,6 +35,7 @@ import jax
 
 from jaxswarm.maps.paper import PAPER_TABLE1_MS, paper_map_names
 from jaxswarm.runtime.cpu import configure
+from jaxswarm.studies.problems import named_problem
 
 
 def _rfd_static():
@@ -69,16 +70,17 @@ def main(argv: list[str] | None = None) -> int:
         parser.error(f"--maps: {error}")
 
     paper_ms = PAPER_TABLE1_MS["RFD*"]  # the paper's Table 1, RFD* time [ms], static
-    solve_map = _rfd_static().solve_map
+    run_algorithm = _rfd_static().run_algorithm
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
           f"({jax.default_backend()}, {args.threads} XLA thread(s))")
     print(f"{'map':10} {'paper ms':>9} {'ours ms':>9} {'speed-up':>9} {'optimal':>8} "
           f"{'mean iterations':>16} {'range ms':>12} {'M moves/s':>9} {'busy':>5}")
     for name in maps:
+        problem = named_problem(name)
         medians, first = [], None
         for _ in range(args.repeats):
-            rows = solve_map(name, "rfd_graded", args.seeds, iterations=100,
-                             patience=args.patience, num_agents=args.agents)
+            rows = run_algorithm(problem, "rfd_graded", args.seeds, iterations=100,
+                                 patience=args.patience, num_agents=args.agents)
             medians.append(1e3 * statistics.median(r["seconds"] for r in rows))
             outcome = [(r["cost"], r["iterations"]) for r in rows]
             if first is not None and outcome != first:
