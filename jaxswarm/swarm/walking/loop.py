@@ -80,16 +80,16 @@ COMPACT_SHARE = 4
 """When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
 goes on with only them, in a batch of that many lanes; again and again as agents stop (see
 ``SMALLEST_COMPACTION``). Measured on maze100 (2 cores, ``benchmarks/walk.py``'s walks of 1,024
-agents from the first memory, where the last tenth of the agents walk for most of the steps):
+agents from the first memory, where a few agents walk on long after the others stopped):
 with a share of 8 and one narrowing, 0.36-0.40 of the lane-steps moved an agent and a walk took
 15.0 ms (ACO*) and 22.3 ms (rfd_graded); with 4 and narrowing down to 16 lanes, 0.61-0.67 and
 10.6 / 15.4 ms (a share of 2: 0.68-0.77, 9.8 / 15.1 ms, for twice the narrowed loops to compile).
 Walks of 16,384 agents spend their time while the queue is full, and were as fast."""
 
 SMALLEST_COMPACTION = 16
-"""The lanes a walk narrows to, after its first narrowing, are at least this many: below that
-a step costs about the same however few lanes it has, and every narrowing is one more loop to
-compile."""
+"""The lanes a walk narrows to, after its first narrowing, are at least this many: every
+narrowing is one more loop to compile, and on maze100 narrowing on down to 2 lanes made the
+walks above no faster (a step of a few lanes costs its kernels' fixed overhead)."""
 
 
 class Walk(NamedTuple):
