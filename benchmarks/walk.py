@@ -61,9 +61,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.maps.named import PAPER, map_kind, named_map
-from jaxswarm.studies.problems import movingai_folder, scenario_problem
-from jaxswarm.swarm import aco, make, make_task, rfd, run
+from jaxswarm.maps.named import PAPER, map_kind
+from jaxswarm.studies.problems import movingai_folder, named_problem, scenario_problem
+from jaxswarm.swarm import aco, make, rfd, run
 from jaxswarm.swarm.core import Task
 from jaxswarm.swarm.iwd.iwd import drop_walk
 from jaxswarm.swarm.walking import Walk, step_budget, walk
@@ -98,10 +98,8 @@ def machine() -> str:
 def load_problem(name: str) -> tuple[Graph, Task]:
     """A paper map with its own start and goal, or a Moving AI MAPF map by name with the
     mid-length row of its even scenario file."""
-    if map_kind(name) == PAPER:
-        chosen = named_map(name)
-        return chosen.graph, make_task(chosen.graph, chosen.start, chosen.goal)
-    problem = scenario_problem(movingai_folder(), name)
+    problem = (named_problem(name) if map_kind(name) == PAPER
+               else scenario_problem(movingai_folder(), name))
     return problem.graph, problem.task
 
 
@@ -186,10 +184,10 @@ def batched_walks(drops: int, steps: int):
         key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps))(keys))
 
 
-def own_bytes(walks, *args) -> int:
-    """Bytes the compiled ``walks(*args)`` holds beyond its arguments: its outputs and temporary
-    buffers, from XLA's memory analysis (compiles without running)."""
-    analysis = walks.lower(*args).compile().memory_analysis()
+def own_bytes(compiled) -> int:
+    """Bytes a compiled walk holds beyond its arguments: its outputs and temporary buffers,
+    from XLA's memory analysis."""
+    analysis = compiled.memory_analysis()
     return analysis.output_size_in_bytes + analysis.temp_size_in_bytes
 
 
@@ -200,10 +198,10 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
     table = rule(graph, task, memory, params)
     steps = step_budget(graph, None)
     keys = jax.random.split(jax.random.key(1), seeds)
-    walks = batched_walks(drops, steps)
-    seconds, result = timed(lambda: walks(keys, table, graph, task), repeats)
-    memory_bytes = own_bytes(walks, keys, table, graph, task)
-    longer_bytes = own_bytes(batched_walks(drops, 2 * steps), keys, table, graph, task)
+    args = (keys, table, graph, task)
+    walks = batched_walks(drops, steps).lower(*args).compile()  # timed and measured
+    seconds, result = timed(lambda: walks(*args), repeats)
+    longer = batched_walks(drops, 2 * steps).lower(*args).compile()
 
     words = seed_words(keys)
     flat_table = np.ascontiguousarray(np.asarray(table, np.float32))
@@ -221,7 +219,7 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
     return dict(agents=drops * seeds, seconds=seconds, moves=moves,
                 busy=moves / int(result.lane_steps[0]), rate=moves / seconds,
                 one_core=reference[1], all_cores=reference[os.cpu_count()],
-                same=same_agents(result, out), memory=memory_bytes, longer=longer_bytes)
+                same=same_agents(result, out), memory=own_bytes(walks), longer=own_bytes(longer))
 
 
 def timed(call, repeats: int):
