@@ -69,10 +69,10 @@ BENCHMARKS = [
      "per-time-step hash check in pure Python on 1,000 agents x 1,000 steps of seeded random "
      "walks on `random-64-64-10`, with and without conflicts: both must flag the same vertex "
      "conflicts and swap partners; agent-steps per second and the goal of a 20x speed-up."),
-    ("One key, one result: what it costs", "one_key.py", [],
+    ("One key, one result: what it costs", "one_key.py", ["--runs", "16", "--rounds", "1"],
      ["--swarms", "aco_star,cabc", "--runs", "4", "--iterations", "3", "--repeats", "1",
       "--rounds", "1"],
-     "Moves and evaluations per second of every registered swarm, 64 runs of 30 iterations "
+     "Moves and evaluations per second of every registered swarm, 16 runs of 30 iterations "
      "(32 agents) in one vmapped batch on random-64-64-10 (the bees on plane map1), each "
      "measurement a process of its own; `python benchmarks/one_key.py --baseline REV` puts a "
      "git revision beside it (before 0.7.0: XLA at the host's instruction set, its own `exp` "
