@@ -2,12 +2,15 @@
 from typing import NamedTuple
 
 import jax
+import jax.numpy as jnp
 import numpy as np
 import sizes
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task, run
-from jaxswarm.world.graph import dense_graph
+from jaxswarm.swarm.walking import walk
+from jaxswarm.swarm.walking.moves import NARROWEST
+from jaxswarm.world.graph import dense_graph, grid_graph
 
 
 def geometric_graph(rng, n: int, *, radius: float, density: float, stretch: tuple[float, float]):
@@ -19,6 +22,20 @@ def geometric_graph(rng, n: int, *, radius: float, density: float, stretch: tupl
     weights = np.where((span < radius) & (rng.random((n, n)) < density),
                        span * rng.uniform(*stretch, (n, n)), 0.0)
     return dense_graph(weights, xy=xy)
+
+
+def wandering_walk():
+    """``(graph, walk)``: 32 agents walking uniformly on an open 24 x 24 grid from (0, 0) to
+    (3, 3), whose arrived agents' walks fit the narrowest width of the work after a walk
+    (:data:`~jaxswarm.swarm.walking.moves.NARROWEST` moves) while some that did not arrive walk
+    longer."""
+    graph = grid_graph(np.zeros((24, 24), bool))
+    task = make_task(graph, (0, 0), (3, 3))
+    agents = walk(jax.random.key(0), graph, jnp.where(graph.nbr >= 0, 0.0, -jnp.inf), task.start,
+                  task.goal, num_agents=32, max_steps=575)
+    moves, arrived = np.asarray(agents.moves), np.asarray(agents.arrived)
+    assert moves[arrived].max() <= NARROWEST < moves[~arrived].max()
+    return graph, agents
 
 
 class Solved(NamedTuple):

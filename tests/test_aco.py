@@ -4,9 +4,11 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import sizes
+from graphs import wandering_walk
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, run
+from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import is_valid_path, path_length, step_slots
 
@@ -33,6 +35,19 @@ def test_ant_system_deposits_q_over_length_on_both_directions():
         assert tau[6 + x, west] == pytest.approx(8 * 2.0 / 4)
     # Nothing anywhere else: every other slot holds the floor (rho = 1), about 1.2e-38.
     assert tau.sum() == pytest.approx(2 * 4 * 8 * 2.0 / 4)
+
+
+def test_ants_that_did_not_arrive_leave_the_deposit_unchanged_and_do_not_widen_it():
+    # Some ants that did not arrive walk longer than the arrived ones' width.
+    graph, ants = wandering_walk()
+    pheromone = jax.random.uniform(jax.random.key(1), graph.nbr.shape, minval=0.5, maxval=2.0)
+    params = aco.DEFAULT_ANT_SYSTEM
+    got = ant_system_update(graph, pheromone, ants, None, None, None, params)
+    # Every ant's whole row, as before the cut: the same bits.
+    evaporated = jnp.maximum((1.0 - params.rho) * pheromone, aco.TAU_FLOOR)
+    amount = jnp.where(ants.arrived, params.q / ants.length, 0.0)
+    want = aco.deposit(graph, evaporated, ants.path[:, :-1], ants.slots, amount)
+    np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
 
 
 def test_pheromone_is_symmetric_and_max_min_stays_in_its_bounds():

@@ -18,10 +18,12 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from graphs import wandering_walk
 from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_walk, moves,
                   probabilities, slot, step_length, xy)
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_path_map
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import aco, make, make_task
 from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.swarm.aco.bug2 import first_ant_path
@@ -29,6 +31,7 @@ from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDSta
                                 add_compensated, blind_alleys, carve, erode_banks,
                                 erosion_change, graded_transition, rfd_star_transition,
                                 rfd_transition, settle)
+from jaxswarm.swarm.rfd import paper
 from jaxswarm.swarm.rfd.river import sediment_where_stuck
 from jaxswarm.swarm.walking import FORCED
 from jaxswarm.world.edits import close_edges
@@ -244,6 +247,20 @@ def test_exponential_erosion_stops_at_the_lowest_node_a_node_drains_to():
     assert (np.asarray(ALT4) + np.asarray(change)).tolist() == approx(expected)
     # Unbounded, node 0 would give 4.09 and end 2.6 below node 4.
     assert 2.0 ** (1.5 / R2) + 2.0 > ALT4[0] - ALT4[4] + 2.5
+
+
+@pytest.mark.parametrize("p_base", [None, 2.0])
+def test_drops_that_do_not_erode_leave_the_erosion_as_their_whole_rows_would(p_base):
+    # Only arrived drops erode; some stuck drops walk longer than the arrived ones' width.
+    graph, drops = wandering_walk()
+    altitude = jax.random.uniform(jax.random.key(1), (graph.num_nodes,), minval=0.5, maxval=1.5)
+    p_base = None if p_base is None else np.float32(p_base)
+    got = erosion_change(graph, altitude, drops, drops.arrived, np.float32(3.0), p_base)
+    # Every drop's whole row (the step budget's columns), as before the cut: the same bits.
+    eroded = paper._eroded((drops.path[:, :-1], drops.path[:, 1:], drops.slots),
+                           (altitude, drops.arrived, np.float32(3.0), p_base), graph)
+    want = ordered_sum(eroded) / (graph.num_nodes - 1) - eroded
+    np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
 
 
 CORRIDOR = [1.0, 1.5, 0.0]  # a 1 x 3 corridor, start 0, goal 2: every drop walks 0 -> 1 -> 2

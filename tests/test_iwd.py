@@ -7,6 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
 from jaxswarm.swarm.iwd.iwd import drop_walk
@@ -14,6 +15,7 @@ from jaxswarm.swarm.iwd.soil import (SOIL, arrived_updates, choice_log_weights,
                                      goal_log_desirability, walked_soil)
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, edge_groups
+from jaxswarm.swarm.walking.moves import NARROWEST
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import step_slots
 
@@ -145,6 +147,26 @@ def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
     assert set(zip(rows.tolist(), slots.tolist())) == arrived_moves
     carried = np.asarray(drops.state[:, 1])
     assert np.all(carried[np.asarray(drops.arrived)] > 0)
+
+
+def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_after_the_walk():
+    # On an open grid the arrived drops' walks fit the narrowest width of the work after a
+    # walk (128 moves), some drops that did not arrive walk longer.
+    graph = grid_graph(np.zeros((24, 24), bool))
+    task = make_task(graph, (0, 0), (10, 10))
+    soil = jax.random.uniform(jax.random.key(2), graph.nbr.shape, minval=9_000.0, maxval=11_000.0)
+    drops = drop_walk(jax.random.key(0), graph, task, soil, P, num_agents=32, max_steps=None)
+    moves, arrived = np.asarray(drops.moves), np.asarray(drops.arrived)
+    assert moves[arrived].max() <= NARROWEST < moves[~arrived].max()
+    # Every drop's whole row, as before the cut: the same bits for the arrived drops.
+    here = drops.path[:, :-1]
+    taken, velocity = walked_soil(graph, soil, here, drops.slots, P)
+    want = arrived_updates(graph, soil, here, drops.slots, taken, drops.arrived, P)
+    np.testing.assert_array_equal(np.asarray(drops.memory), np.asarray(want))
+    state = np.asarray(drops.state)
+    np.testing.assert_array_equal(state[arrived, 0], np.asarray(velocity)[arrived])
+    np.testing.assert_array_equal(state[arrived, 1], np.asarray(ordered_sum(taken, axis=1))[arrived])
+    assert np.isnan(state[~arrived]).all()
 
 
 def test_backtracking_drops_back_out_of_dead_ends():

@@ -172,7 +172,9 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
 
     Returns:
       The :class:`~jaxswarm.swarm.walking.Walk`, its ``memory`` the soil after the local
-      updates and its ``state`` f32[A, 2] each drop's velocity and carried soil at its end.
+      updates and its ``state`` f32[A, 2] each drop's velocity and carried soil at its end;
+      when only arrived drops change the soil (``local_updates="arrived"``), NaN for the drops
+      that did not arrive (their soil is not kept, so their walks are not followed further).
     """
     table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
     budget = step_budget(graph, max_steps)
@@ -185,23 +187,25 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params)
-    memory, velocity, carried = on_moves(_after_walk, drops.moves,
+    memory, velocity, carried = on_moves(_after_walk, jnp.where(drops.arrived, drops.moves, 0),
                                          (drops.path[:, :-1], drops.slots),
                                          (soil, drops.arrived, params), graph)
     return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
 
 
 def _after_walk(moves, run, graph: Graph):
-    """The drops' velocity update and eq. 4 along their walks, and the arrived drops' local
-    updates (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for moves ``(here,
-    slots)`` (i32 and slot dtype ``[A, W]``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
-    params)``: ``(soil f32[N, K], velocity f32[A], carried f32[A])``, the same on any width
-    that holds the moves (:func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    """The velocity update and eq. 4 along the arrived drops' walks, and their local updates
+    (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for moves ``(here, slots)``
+    (i32 and slot dtype ``[A, W]``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
+    params)``: ``(soil f32[N, K], velocity f32[A], carried f32[A])``, NaN velocity and carried
+    soil for the drops that did not arrive; the same on any width that holds the arrived drops'
+    moves (:func:`~jaxswarm.swarm.walking.moves.on_moves`: the others' rows may be cut short)."""
     here, slots = moves
     soil, arrived, params = run
     taken, velocity = walked_soil(graph, soil, here, slots, params)
-    return (arrived_updates(graph, soil, here, slots, taken, arrived, params), velocity,
-            ordered_sum(taken, axis=1))
+    carried = ordered_sum(taken, axis=1)
+    return (arrived_updates(graph, soil, here, slots, taken, arrived, params),
+            jnp.where(arrived, velocity, jnp.nan), jnp.where(arrived, carried, jnp.nan))
 
 
 def soil_choice(graph: Graph, table, soil, params: IWDParams):
