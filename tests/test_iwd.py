@@ -350,3 +350,23 @@ def test_drops_that_arrive_find_mosaic50_where_drops_that_all_take_soil_did_not(
                                                    iterations=100, patience=30)))(keys)
         found[reading] = int(np.isfinite(np.asarray(states.best_cost)).sum())
     assert found["arrived"] == 6 and found["while_walking"] <= 2, found
+
+
+def test_hook_params_of_an_inner_vmap_reach_every_member_of_an_outer_one():
+    # Keys outside (params shared), params inside: the outer batch rule meets params that the
+    # inner one folded to one per run; each member must walk with its own.
+    graph = grid_graph(np.zeros((8, 8), bool))
+    task = make_task(graph, (0, 0), (7, 7))
+    soil = jax.random.uniform(jax.random.key(5), graph.nbr.shape, minval=1.0, maxval=10_000.0)
+    keys = jax.random.split(jax.random.key(0), 2)
+    params = jax.tree_util.tree_map(lambda p: jnp.stack([p, p]), P)._replace(
+        alpha=jnp.array([0.0, 3.0], jnp.float32))
+
+    def moves(key, params):
+        return drop_walk(key, graph, task, soil, params, num_agents=8, max_steps=None).moves
+
+    nested = jax.jit(jax.vmap(lambda key: jax.vmap(lambda p: moves(key, p))(params)))(keys)
+    for i in range(2):
+        for j in range(2):
+            alone = moves(keys[i], jax.tree_util.tree_map(lambda x, j=j: x[j], params))
+            np.testing.assert_array_equal(nested[i, j], alone, err_msg=f"key {i}, params {j}")

@@ -200,9 +200,10 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         if weights_b or log_weights.shape[0] > 1:
             log_weights = fold(log_weights, weights_b)
         memory = jax.tree_util.tree_map(fold, memory, memory_b)
-        # Numbers shared by the batch stay one run's (the lanes then need no gather of them).
-        hook_params = jax.tree_util.tree_map(lambda p, b: fold(p, b) if b else p, hook_params,
-                                             params_b)
+        # Numbers shared by the batch stay one run's (the lanes then need no gather of them);
+        # numbers an inner vmap gave each of its runs are shared by this one's members alike.
+        hook_params = jax.tree_util.tree_map(
+            lambda p, b: fold(p, b) if b or p.shape[0] > 1 else p, hook_params, params_b)
         out = jax.tree_util.tree_map(  # sizes spelled out: a hook's state may be empty
             lambda x: unfold_runs(x, axis_size),
             walk_runs(seed, graph, log_weights, start, goal, memory, hook_params))
