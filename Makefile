@@ -32,7 +32,7 @@ docs: $(INSTALLED)  ## the API reference from the docstrings (pdoc) into docs/ap
 bench: $(INSTALLED)  ## benchmark scripts (print figures; not tests)
 	$(BIN)/python benchmarks/exact.py
 
-performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md (~15 min on 2 cores)
+performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md (about 35 min on 2 cores)
 	$(BIN)/python benchmarks/report.py
 
 # The generated tables of results/ (see results/README.md), one script each; every script writes

@@ -3,7 +3,7 @@ process (so each configures JAX's devices and threads its own way), and its prin
 into the document verbatim under a paragraph saying what it measures, with the commit, versions
 and machine of the run at the top. The document is written only once every benchmark finished.
 
-Run from the repository root (about 15 minutes on 2 cores; ``make performance`` does the same)::
+Run from the repository root (about 35 minutes on 2 cores; ``make performance`` does the same)::
 
     python benchmarks/report.py
     python benchmarks/report.py --quick --out /tmp/performance.md   # small sizes, for a smoke run
