@@ -24,6 +24,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.runtime.batching import one_at_a_time
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 from jaxswarm.world.plane import Plane, check_point
@@ -117,6 +118,11 @@ class Swarm:
         :func:`jaxswarm.dynamic.events.change`); each family documents its own.
       world: the kind of world it plans in, :class:`~jaxswarm.world.graph.Graph` or
         :class:`~jaxswarm.world.plane.Plane`.
+      vmap_one_at_a_time: a ``vmap`` of :func:`run` (a sweep's group of runs,
+        :func:`~jaxswarm.swarm.testing.run_batch`) runs its members one after another
+        (:func:`~jaxswarm.runtime.batching.one_at_a_time`) instead of in lockstep: for a swarm
+        whose iterations branch on each run's own state, where lockstep would take every
+        branch for every run (IWD_PG's memory operators). The results are the same either way.
     """
 
     name: str
@@ -130,6 +136,7 @@ class Swarm:
     memory_label: str
     adapt: Callable
     world: type = Graph
+    vmap_one_at_a_time: bool = False
 
     def params_with(self, **values: float):
         """The swarm's default params with the named ones set to ``values`` (NumPy float32
@@ -213,7 +220,18 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)
+    if swarm.vmap_one_at_a_time:
+        return _run_alone(swarm, iterations, patience)(key, world, task, params, state, budget)
     return _run(swarm, key, world, task, params, iterations, patience, state, budget)
+
+
+@functools.lru_cache(maxsize=None)
+def _run_alone(swarm, iterations: int, patience: int | None):
+    """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with these
+    statics, whose ``vmap`` runs the batch's members one after another."""
+    def run_one(key, world, task, params, state, budget):
+        return _run(swarm, key, world, task, params, iterations, patience, state, budget)
+    return one_at_a_time(run_one)
 
 
 @functools.partial(jax.jit, static_argnums=(0, 5, 6))

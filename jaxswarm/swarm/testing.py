@@ -122,7 +122,9 @@ def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: in
                        keys: int = 3, runs: int = 8) -> None:
     """Same key, same result; the first ``keys`` rows of a batch of ``runs`` runs
     (:func:`run_batch`, every run another key) equal those runs one at a time (see
-    :func:`outcome`); keys differ."""
+    :func:`outcome`); keys differ. For a swarm whose ``vmap`` runs its members one at a time
+    (:attr:`~jaxswarm.swarm.core.Swarm.vmap_one_at_a_time`), each row's walks were its own:
+    their lane-steps are those of the run alone (in lockstep they are the batch's)."""
     split = jax.random.split(jax.random.key(7), runs)
     params = swarm.default_params
     one = [run(swarm, k, graph, task, params, iterations=iterations) for k in split[:keys]]
@@ -133,6 +135,9 @@ def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: in
     for i in range(keys):
         assert leaves_equal(outcome(jax.tree_util.tree_map(lambda x: x[i], batch)),
                             outcome(one[i])), f"{swarm.name}: vmap row {i} differs from run"
+        if swarm.vmap_one_at_a_time:
+            assert np.array_equal(batch[1].lane_steps[i], one[i][1].lane_steps), (
+                f"{swarm.name}: vmap row {i} did not walk alone")
     # Another key walks other agents: the memory or the share that arrived differs.
     assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
                             (swarm.memory(one[1][0]), one[1][1].arrived)), (

@@ -8,7 +8,9 @@ share a group of runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` over k
 stacked params inside ``lax.map``. Under that ``vmap`` the walks of a group's runs share one queue
 of agents over the walker's lanes (:func:`jaxswarm.swarm.walking.walk`), and a run that stopped
 walks no more, so small swarms fill the lanes from many runs: the group is ``vmap_size`` runs, by
-default enough to fill the lanes (:func:`group_size`).
+default enough to fill the lanes (:func:`group_size`). A swarm whose ``vmap`` runs its members
+one at a time (:attr:`jaxswarm.swarm.core.Swarm.vmap_one_at_a_time`) goes through its group's
+runs one after another.
 Maps of the same shape share the compiled program; each compile is logged. A run with seed
 ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)`` bit for
 bit whatever the chunk size, the group size and the number of devices or threads (the arithmetic

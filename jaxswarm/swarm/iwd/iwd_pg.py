@@ -561,4 +561,4 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
     return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, setup)), best=best_solution,
                  default_params=DEFAULT_IWD, check_params=check_iwd, memory=soil_per_node,
-                 memory_label=SOIL_LABEL, adapt=_adapt)
+                 memory_label=SOIL_LABEL, adapt=_adapt, vmap_one_at_a_time=True)
