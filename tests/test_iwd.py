@@ -165,7 +165,8 @@ def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_afte
     np.testing.assert_array_equal(np.asarray(drops.memory), np.asarray(want))
     state = np.asarray(drops.state)
     np.testing.assert_array_equal(state[arrived, 0], np.asarray(velocity)[arrived])
-    np.testing.assert_array_equal(state[arrived, 1], np.asarray(ordered_sum(taken, axis=1))[arrived])
+    carried = np.asarray(ordered_sum(taken, axis=1))
+    np.testing.assert_array_equal(state[arrived, 1], carried[arrived])
     assert np.isnan(state[~arrived]).all()
 
 

@@ -41,6 +41,19 @@ def test_one_walk_gets_the_narrowest_width_that_holds_its_moves_and_the_same_bit
     np.testing.assert_array_equal(running, full[2])
 
 
+def test_agents_not_used_do_not_widen_the_cut():
+    moves = jnp.array([3, 700, 0, 12], jnp.int32)
+    used = jnp.array([True, False, True, True])
+    values = walk_columns(moves)
+    values[1] = 0.0  # the function gives the unused agent no weight
+
+    def width(m, v, used):
+        return on_moves(width_and_sum, m, (v,), jnp.float32(1.0), jnp.float32(1.0), used=used)
+
+    assert int(jax.jit(width)(moves, values, used)[0]) == 128
+    assert int(jax.jit(width)(moves, values, None)[0]) == 1023
+
+
 def test_a_batch_shares_one_width_at_any_nesting():
     moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1], [1, 1, 1, 1]], jnp.int32)
     values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])

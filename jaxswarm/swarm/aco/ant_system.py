@@ -77,10 +77,9 @@ def ant_system_update(graph, pheromone, ants, best_path, best_cost, info, params
     """Eq. 9 (kept at least ``TAU_FLOOR``), then eq. 8 for every ant that arrived: f32[N, K]
     pheromone."""
     evaporated = jnp.maximum((1.0 - params.rho) * pheromone, TAU_FLOOR)
-    # Ants that did not arrive deposit nothing: only the arrived ants' moves set the width.
-    return on_moves(_deposit_moves, jnp.where(ants.arrived, ants.moves, 0),
-                    (ants.path[:, :-1], ants.slots),
-                    (evaporated, jnp.where(ants.arrived, params.q / ants.length, 0.0)), graph)
+    return on_moves(_deposit_moves, ants.moves, (ants.path[:, :-1], ants.slots),
+                    (evaporated, jnp.where(ants.arrived, params.q / ants.length, 0.0)), graph,
+                    used=ants.arrived)
 
 
 def _deposit_moves(moves, run, graph):

@@ -187,9 +187,10 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params)
-    memory, velocity, carried = on_moves(_after_walk, jnp.where(drops.arrived, drops.moves, 0),
+    memory, velocity, carried = on_moves(_after_walk, drops.moves,
                                          (drops.path[:, :-1], drops.slots),
-                                         (soil, drops.arrived, params), graph)
+                                         (soil, drops.arrived, params), graph,
+                                         used=drops.arrived)
     return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
 
 

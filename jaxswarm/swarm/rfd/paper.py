@@ -204,10 +204,8 @@ def erosion_change(graph: Graph, altitude, drops: Walk, eroding, erosion, p_base
     altitude among the nodes its eroding moves go to (nothing if none is lower). Every node then
     gains the eroded total divided by ``N - 1`` (eq. 5).
     """
-    # Only the eroding drops' moves set the width (the others ask for nothing).
-    eroded = on_moves(_eroded, jnp.where(eroding, drops.moves, 0),
-                      (drops.path[:, :-1], drops.path[:, 1:], drops.slots),
-                      (altitude, eroding, erosion, p_base), graph)
+    eroded = on_moves(_eroded, drops.moves, (drops.path[:, :-1], drops.path[:, 1:], drops.slots),
+                      (altitude, eroding, erosion, p_base), graph, used=eroding)
     return ordered_sum(eroded) / (altitude.shape[0] - 1) - eroded
 
 

@@ -12,9 +12,9 @@ all of them, when it reduces the columns by scans, scatters in column order, or
 :func:`~jaxswarm.runtime.arithmetic.ordered_sum` and
 :func:`~jaxswarm.runtime.arithmetic.ordered_cumsum` (their zero-padded power-of-two trees add
 the same terms in the same order on any power-of-two width that holds them, and a running sum's
-first ``W`` terms do not depend on the length). An agent whose moves the function gives no
-weight (an ant that did not arrive deposits nothing) counts no columns, so the width is set by
-the walks that matter: the drops of a swarm's first iterations that wander for the whole step
+first ``W`` terms do not depend on the length). Agents whose moves the function gives no
+weight (ants that did not arrive deposit nothing) may be left out of the width (``used``), so
+it is set by the walks that matter: the drops of a swarm's first iterations that wander for the whole step
 budget without arriving do not make every agent's row that long.
 """
 from __future__ import annotations
@@ -52,28 +52,32 @@ def move_widths(columns: int) -> tuple[int, ...]:
 
 
 def on_moves(function: Callable, moves: jax.Array, columns: Any, per_run: Any = None,
-             shared: Any = None):
+             shared: Any = None, *, used: jax.Array | None = None):
     """``function(cut, per_run, shared)`` for one run's walk, ``cut`` its move ``columns`` cut to
-    the width that holds the moves of every agent of the batch.
+    the width that holds the moves of every agent of the batch that ``function`` uses.
 
     Args:
       function: ``(cut, per_run, shared) -> outputs``, ``cut`` the leaves of ``columns`` with
         their axis 1 cut to some width ``W >= max(moves)``; its outputs must not depend on ``W``
         (module docstring), in values or shapes. It takes the traced arrays it needs as
         arguments (``per_run``, ``shared``) rather than closing over them.
-      moves: i32[A] the columns of each agent's row that ``function``'s outputs depend on: its
-        moves (its nodes, where the columns are a path's nodes), or 0 for an agent whose row
-        it gives no weight (a drop whose soil changes are dropped, an ant that deposits
-        nothing), so that a long walk nothing uses does not widen the cut.
+      moves: i32[A] the columns each agent's row uses: its moves (its nodes, where the
+        columns are a path's nodes).
       columns: a pytree of ``[A, C, ...]`` arrays, one column per move (C the step budget).
       per_run: a pytree of this run's other inputs (batched like the walk).
       shared: a pytree of inputs every run of a batch shares (the map); when a ``vmap`` batches
         one of its leaves, each run of that ``vmap`` picks its own width.
+      used: bool[A] the agents whose rows ``function``'s outputs depend on (None: all); the
+        others' rows may be cut short, and ``function`` must give them no weight (a drop whose
+        soil changes are dropped, an ant that deposits nothing), so that a long walk nothing
+        uses does not widen the cut.
 
     Returns:
       ``function``'s outputs.
     """
     count = jax.tree_util.tree_leaves(columns)[0].shape[1]
+    if used is not None:
+        moves = jnp.where(used, moves, 0)
     apply = _runs(function, move_widths(count))
     out = apply(moves[None], *(jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                                for tree in (columns, per_run)), shared)
