@@ -21,14 +21,16 @@ factor and both memories give the same walks.)
 * ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
   (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -ffp-contract=off
   -fopenmp``, agents shared out over threads), and ``share``: ours as a share of the reference
-  on all cores. The reference writes what the walker returns, in its layout (each agent's
-  padded path and slots, visited set, moves, length, position, arrival and stop), and draws the
-  walker's uniforms, so it walks the same paths: ``same`` counts the agents whose outputs are
-  all identical (a last-bit difference between C's ``expf`` and XLA's ``exp`` may send an agent
-  elsewhere at a tie of cumulative weights),
+  on all cores. The reference writes what the walker returns, in its layout (the log of moves,
+  each agent's first block, visited set, moves, length, position, arrival and stop, the blocks
+  journaled as agents finish and laid out agent by agent at the end, as the walker does), and
+  draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents whose
+  outputs (their blocks of the log included) are all identical (a last-bit difference between
+  C's ``expf`` and XLA's ``exp`` may send an agent elsewhere at a tie of cumulative weights),
 * ``MiB`` and ``x2``: the compiled walk's own memory (its outputs and temporary buffers, from
   XLA's memory analysis; the map, the table and the keys excluded) at the default step budget
-  and at twice that budget: what a longer possible path costs.
+  and at twice that budget: what a longer possible path costs (the log's room is set by the
+  map, :func:`jaxswarm.swarm.walking.log.default_log_moves`, not by the budget).
 
 Water drops (``iwd``) read their soil at every step through the walker's hook, so the table
 alone does not give their walk and the scalar reference does not apply: a second table times
@@ -67,6 +69,7 @@ from jaxswarm.swarm import aco, make, rfd, run
 from jaxswarm.swarm.core import Task
 from jaxswarm.swarm.iwd.iwd import drop_walk
 from jaxswarm.swarm.walking import Walk, step_budget, walk
+from jaxswarm.swarm.walking.log import BLOCK, default_log_moves, log_blocks
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import slot_offsets
 
@@ -79,9 +82,15 @@ TRANSITION_RULES = {
 }
 """The walks measured: each swarm's transition table of its memory, and its memory."""
 
-OUTPUTS = ("path", "slots", "visited", "moves", "length", "position", "arrived", "stuck")
-"""The walker's outputs (:class:`~jaxswarm.swarm.walking.Walk` fields) the reference writes, in
-the order of its ``Outputs`` struct."""
+PER_AGENT = ("visited", "moves", "length", "position", "arrived", "stuck")
+"""The walker's per-agent outputs (:class:`~jaxswarm.swarm.walking.Walk` fields) the reference
+writes."""
+
+OUTPUTS = ("nodes", "slots", "offset") + PER_AGENT + ("journal_nodes", "journal_slots",
+                                                        "journaled")
+"""The buffers of the reference's ``Outputs`` struct, in its order: the log
+(:class:`~jaxswarm.swarm.walking.log.MoveLog`'s ``nodes``, ``slots``, ``offset``), the
+per-agent outputs and the journal's scratch."""
 
 MIB = 2 ** 20
 
@@ -116,7 +125,7 @@ def build_scalar(directory: str) -> ctypes.CDLL:
     scalar = ctypes.CDLL(str(library))
     pointer, i32, u32 = ctypes.c_void_p, ctypes.c_int32, ctypes.c_uint32
     scalar.walk_all.argtypes = [pointer, i32, i32, pointer, i32, i32, i32, i32, u32, u32,
-                                _Outputs]
+                                ctypes.c_int64, _Outputs]
     scalar.walk_all.restype = ctypes.c_int64
     scalar.set_threads.argtypes = [i32]
     return scalar
@@ -127,43 +136,76 @@ def seed_words(keys: jax.Array) -> np.ndarray:
     return np.asarray(jax.vmap(lambda key: jax.random.bits(key, (1, 2), jnp.uint32))(keys))[:, 0]
 
 
-def scalar_outputs(graph: Graph, agents: int, steps: int) -> dict[str, np.ndarray]:
-    """The reference's output buffers for ``agents`` agents, each as the walker lays it out."""
+def log_room(graph: Graph, agents: int, steps: int) -> int:
+    """Blocks of a walk's log of ``agents`` agents with budget ``steps``, as the walker sizes
+    it by default."""
+    return log_blocks(agents, steps, default_log_moves(steps, step_budget(graph, None)))
+
+
+def scalar_outputs(graph: Graph, seeds: int, agents: int, steps: int) -> dict[str, np.ndarray]:
+    """The reference's buffers for ``seeds`` walks of ``agents`` agents, each output as the
+    walker lays it out (the log per seed, the rest per agent), and one journal (scratch)."""
     words = (graph.num_nodes + 31) // 32
-    return dict(path=np.empty((agents, steps + 1), np.int32),
-                slots=np.empty((agents, steps), np.int8),
-                visited=np.empty((agents, words), np.uint32),
-                moves=np.empty(agents, np.int32), length=np.empty(agents, np.float32),
-                position=np.empty(agents, np.int32), arrived=np.empty(agents, np.bool_),
-                stuck=np.empty(agents, np.bool_))
+    room = log_room(graph, agents, steps)
+    count = seeds * agents
+    return dict(nodes=np.empty((seeds, room, BLOCK), np.int32),
+                slots=np.empty((seeds, room, BLOCK), np.int8),
+                offset=np.empty((seeds, agents), np.int32),
+                visited=np.empty((count, words), np.uint32),
+                moves=np.empty(count, np.int32), length=np.empty(count, np.float32),
+                position=np.empty(count, np.int32), arrived=np.empty(count, np.bool_),
+                stuck=np.empty(count, np.bool_),
+                journal_nodes=np.empty((room, BLOCK), np.int32),
+                journal_slots=np.empty((room, BLOCK), np.int8),
+                journaled=np.empty(agents, np.int32))
 
 
 def scalar_walks(scalar, graph: Graph, task: Task, table: np.ndarray, words: np.ndarray,
                  out: dict[str, np.ndarray], agents: int, steps: int) -> int:
-    """Every seed's ``agents`` walks by the reference into ``out`` (leading axis seed x agent,
-    reset first as the walker's buffers start); returns the moves made."""
-    out["path"].fill(-1)
-    out["slots"].fill(-1)
+    """Every seed's ``agents`` walks by the reference into ``out`` (visited sets reset first as
+    the walker's start); returns the moves made. Exits when the log had no room (the walker
+    would have made the run again with more)."""
     out["visited"].fill(0)
     offsets = np.ascontiguousarray(np.asarray(slot_offsets(graph), np.int32))
+    room = out["nodes"].shape[1]
     total = 0
     for s, (word_0, word_1) in enumerate(words):
         rows = slice(s * agents, (s + 1) * agents)
-        fields = _Outputs(*(out[name][rows].ctypes.data for name in OUTPUTS))
-        total += scalar.walk_all(table.ctypes.data, graph.num_nodes, graph.max_degree,
-                                 offsets.ctypes.data, int(task.start), int(task.goal), agents,
-                                 steps, int(word_0), int(word_1), fields)
+        buffers = {name: out[name][s] for name in ("nodes", "slots", "offset")}
+        buffers.update({name: out[name][rows] for name in PER_AGENT})
+        buffers.update({name: out[name] for name in ("journal_nodes", "journal_slots",
+                                                     "journaled")})
+        fields = _Outputs(*(buffers[name].ctypes.data for name in OUTPUTS))
+        moves = scalar.walk_all(table.ctypes.data, graph.num_nodes, graph.max_degree,
+                                offsets.ctypes.data, int(task.start), int(task.goal), agents,
+                                steps, int(word_0), int(word_1), room, fields)
+        if moves < 0:
+            sys.exit(f"the reference's log of {room} blocks had no room for seed {s}'s moves")
+        total += moves
     return total
 
 
 def same_agents(result: Walk, out: dict[str, np.ndarray]) -> int:
-    """How many agents have every output of the walker's ``result`` equal to the reference's."""
+    """How many agents have every output of the walker's ``result`` (its log's offset and
+    blocks included) equal to the reference's."""
     agree = None
-    for name in OUTPUTS:
+    for name in PER_AGENT:
         ours = np.asarray(getattr(result, name))
         ours = ours.reshape((-1,) + ours.shape[2:])
         equal = np.all((ours == out[name]).reshape(len(ours), -1), axis=1)
         agree = equal if agree is None else agree & equal
+    offset = np.asarray(result.log.offset)
+    agree &= (offset == out["offset"]).reshape(-1)
+    equal_blocks = np.all(np.asarray(result.log.nodes) == out["nodes"], axis=2) & np.all(
+        np.asarray(result.log.slots) == out["slots"], axis=2)  # [seeds, room]
+    for s, (starts, equal) in enumerate(zip(out["offset"], equal_blocks)):
+        agents = len(starts)
+        owner = np.searchsorted(starts, np.arange(len(equal)), side="right") - 1
+        owned = np.arange(len(equal)) - starts[owner] < (
+            out["moves"][s * agents + owner] + BLOCK - 1) // BLOCK
+        wrong = np.zeros(agents, bool)
+        np.logical_or.at(wrong, owner[owned & ~equal], True)
+        agree[s * agents:(s + 1) * agents] &= ~wrong
     return int(agree.sum())
 
 
@@ -205,7 +247,7 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
 
     words = seed_words(keys)
     flat_table = np.ascontiguousarray(np.asarray(table, np.float32))
-    out = scalar_outputs(graph, seeds * drops, steps)
+    out = scalar_outputs(graph, seeds, drops, steps)
     reference = {}
     for threads in (1, os.cpu_count()):
         scalar.set_threads(threads)

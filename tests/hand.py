@@ -12,6 +12,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.swarm.walking import Walk
+from jaxswarm.swarm.walking.log import from_rows
 
 # Slot order of the library's grids, written out by hand: E S W N SE SW NW NE, y grows down.
 SLOTS = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)]
@@ -98,10 +99,13 @@ def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: 
             lengths[a] += step_length(nodes[t], nodes[t + 1], width)
         for v in nodes:
             visited[a, v // 32] |= np.uint32(1 << (v % 32))
-    return Walk(path=jnp.asarray(path), slots=jnp.asarray(slots), length=jnp.asarray(lengths),
+    moves = np.array([len(p) - 1 for p in paths], np.int32)
+    log = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), paths[0][0],
+                    columns - 1)
+    return Walk(log=log, length=jnp.asarray(lengths),
                 arrived=jnp.asarray(np.array(arrived, bool)),
                 stuck=jnp.asarray(np.array(stuck, bool)),
                 position=jnp.asarray(np.array([p[-1] for p in paths], np.int32)),
                 visited=jnp.asarray(visited),
-                moves=jnp.asarray(np.array([len(p) - 1 for p in paths], np.int32)),
+                moves=jnp.asarray(moves),
                 lane_steps=jnp.int32(agents * (longest - 1)))

@@ -257,7 +257,7 @@ def test_drops_that_do_not_erode_leave_the_erosion_as_their_whole_rows_would(p_b
     p_base = None if p_base is None else np.float32(p_base)
     got = erosion_change(graph, altitude, drops, drops.arrived, np.float32(3.0), p_base)
     # Every drop's whole row (the step budget's columns), as before the cut: the same bits.
-    eroded = paper._eroded((drops.path[:, :-1], drops.path[:, 1:], drops.slots),
+    eroded = paper._eroded((drops.path, drops.slots),
                            (altitude, drops.arrived, np.float32(3.0), p_base), graph)
     want = ordered_sum(eroded) / (graph.num_nodes - 1) - eroded
     np.testing.assert_array_equal(np.asarray(got), np.asarray(want))

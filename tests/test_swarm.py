@@ -17,6 +17,7 @@ from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
 from jaxswarm.swarm.testing import Compilations, check_reproducible, check_valid_results
 from jaxswarm.swarm.walking import Walk
+from jaxswarm.swarm.walking.log import from_rows
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import Solution
 
@@ -139,8 +140,9 @@ def fake_walk(graph, cells, stuck=True):
     visited = np.zeros((1, (graph.num_nodes + 31) // 32), np.uint32)
     for node in nodes:
         visited[0, node // 32] |= np.uint32(1 << (node % 32))
-    return Walk(path=jnp.asarray(path), slots=jnp.full((1, path.shape[1] - 1), -1, jnp.int16),
-                length=jnp.zeros(1), arrived=jnp.zeros(1, bool), stuck=jnp.array([stuck]),
+    log = from_rows(jnp.asarray(path), jnp.full((1, path.shape[1] - 1), -1, jnp.int16),
+                    jnp.array([len(nodes) - 1]), nodes[0], path.shape[1] - 1)
+    return Walk(log=log, length=jnp.zeros(1), arrived=jnp.zeros(1, bool), stuck=jnp.array([stuck]),
                 position=jnp.array([nodes[-1]]), visited=jnp.asarray(visited),
                 moves=jnp.array([len(nodes) - 1]), lane_steps=jnp.int32(len(nodes) - 1))
 
@@ -356,11 +358,13 @@ def test_a_run_stops_when_every_agent_followed_the_same_path(name):
 def test_keep_best_calls_an_iteration_converged_only_on_one_path_of_all_agents():
     def walked(paths, arrived):
         paths = jnp.asarray(paths, jnp.int32)
-        return Walk(path=paths, slots=jnp.zeros((len(paths), paths.shape[1] - 1), jnp.int16),
+        moves = jnp.sum(paths >= 0, axis=1) - 1
+        slots = jnp.where(paths[:, 1:] >= 0, paths[:, 1:], -1).astype(jnp.int16)  # one per node
+        return Walk(log=from_rows(paths, slots, moves, paths[0, 0], paths.shape[1] - 1),
                     length=jnp.sum(paths >= 0, axis=1).astype(jnp.float32) - 1,
                     arrived=jnp.asarray(arrived), stuck=~jnp.asarray(arrived),
                     position=paths[:, -1], visited=jnp.zeros((len(paths), 1), jnp.uint32),
-                    moves=jnp.sum(paths >= 0, axis=1) - 1, lane_steps=jnp.int32(paths.size))
+                    moves=moves, lane_steps=jnp.int32(paths.size))
 
     best_path, best_cost = jnp.full((3,), -1, jnp.int32), jnp.float32(jnp.inf)
     same, other = [[0, 1, 2]] * 3, [[0, 1, 2], [0, 3, 2], [0, 1, 2]]

@@ -202,6 +202,15 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
 
 
+def test_a_chunk_whose_walk_overflowed_its_log_is_made_again_with_room(finished, tmp_path):
+    _, _, frame = finished
+    messages = []
+    cramped = run_sweep(spec_from_dict(tiny(config={"log_moves": 16})), tmp_path / "out",
+                        progress=False, log=messages.append)
+    assert any("no room for its moves" in message for message in messages)
+    pd.testing.assert_frame_equal(cramped[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
+
+
 def test_a_bees_spec_checks_its_params():
     document = {"sweep": {"algorithm": "cabc", "maps": [{"plane": "map1"}], "seeds": 1},
                 "params": {"inner_iterations": [2, 1.5]}}

@@ -34,10 +34,13 @@ def test_walker_writes_what_the_scalar_loop_writes(scalar, swarm_name):
     steps = step_budget(graph, None)
     keys = jax.random.split(jax.random.key(3), seeds)
     ours = walk_bench.batched_walks(AGENTS, steps)(keys, table, graph, task)
-    out = walk_bench.scalar_outputs(graph, seeds * AGENTS, steps)
+    out = walk_bench.scalar_outputs(graph, seeds, AGENTS, steps)
     moves = walk_bench.scalar_walks(scalar, graph, task, np.asarray(table, np.float32),
                                     walk_bench.seed_words(keys), out, AGENTS, steps)
     # The comparison covers agents that arrived and agents that got stuck.
     assert out["arrived"].any() and out["stuck"].any()
     assert moves == int(ours.moves.sum())
     assert walk_bench.same_agents(ours, out) == seeds * AGENTS
+    # The whole logs, the blocks no agent owns included, are the same arrays.
+    np.testing.assert_array_equal(np.asarray(ours.log.nodes), out["nodes"])
+    np.testing.assert_array_equal(np.asarray(ours.log.slots), out["slots"])

@@ -25,6 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.runtime.batching import one_at_a_time
+from jaxswarm.swarm.walking.log import ROOM_FOR_EVERY_MOVE, all_same
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 from jaxswarm.world.plane import Plane, check_point
@@ -80,6 +81,9 @@ class StepInfo(NamedTuple):
       evaluations: i32[] fitness calls: complete paths whose length was evaluated (the agents
         that arrived; the IWD paper's "fitness function calls"), guided-function evaluations of
         the bees.
+      overflowed: bool[] the walk's log had no room for all its moves (:mod:`~jaxswarm.swarm.
+        walking.log`): what the iteration did is wrong, and the run must be made again with
+        more room (:func:`run` does).
     """
 
     iteration_cost: jax.Array
@@ -88,6 +92,7 @@ class StepInfo(NamedTuple):
     moves: jax.Array
     lane_steps: jax.Array
     evaluations: jax.Array
+    overflowed: Any = np.False_
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -123,6 +128,8 @@ class Swarm:
         (:func:`~jaxswarm.runtime.batching.one_at_a_time`) instead of in lockstep: for a swarm
         whose iterations branch on each run's own state, where lockstep would take every
         branch for every run (IWD_PG's memory operators). The results are the same either way.
+      rebuild: ``(config) -> Swarm``: the same algorithm built with another Config (set by the
+        registry; None for a swarm built by hand).
     """
 
     name: str
@@ -137,6 +144,7 @@ class Swarm:
     adapt: Callable
     world: type = Graph
     vmap_one_at_a_time: bool = False
+    rebuild: Callable | None = None
 
     def params_with(self, **values: float):
         """The swarm's default params with the named ones set to ``values`` (NumPy float32
@@ -161,6 +169,9 @@ class Trace:
         :class:`~jaxswarm.swarm.core.StepInfo`).
       evaluations: i32[T] fitness calls in each iteration (see
         :class:`~jaxswarm.swarm.core.StepInfo`).
+      overflowed: bool[] a walk's log had no room for its moves (see
+        :class:`~jaxswarm.swarm.core.StepInfo`): the run is wrong and :func:`run` makes it
+        again with more room; set only in the trace of a run mapped by its caller.
     """
 
     best_cost: jax.Array
@@ -170,11 +181,12 @@ class Trace:
     moves: jax.Array
     lane_steps: jax.Array
     evaluations: jax.Array
+    overflowed: Any = None
 
 
 jax.tree_util.register_dataclass(
     Trace, data_fields=["best_cost", "iteration_cost", "arrived", "iterations", "moves",
-                        "lane_steps", "evaluations"], meta_fields=[])
+                        "lane_steps", "evaluations", "overflowed"], meta_fields=[])
 
 
 def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
@@ -220,9 +232,36 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)
+    result = _run_program(swarm, iterations, patience)(key, world, task, params, state, budget)
+    if not any(isinstance(leaf, jax.core.Tracer)
+               for leaf in jax.tree_util.tree_leaves((key, world, task, params, state, budget))):
+        if bool(np.any(np.asarray(result[1].overflowed))):
+            result = _run_program(with_room(swarm), iterations, patience)(
+                key, world, task, params, state, budget)
+    return result
+
+
+def with_room(swarm: Swarm) -> Swarm:
+    """``swarm`` with room in its walks' logs for every agent's whole step budget, so that no
+    walk overflows (:mod:`~jaxswarm.swarm.walking.log`); the same results, one more compiled
+    program. What :func:`run` and the sweep runner run a run again with when a walk
+    overflowed.
+
+    Raises:
+      ValueError: ``swarm`` cannot be built again (it was not built by the registry).
+    """
+    if swarm.rebuild is None:
+        raise ValueError(f"swarm {swarm.name!r} was not built by the registry, so it cannot be "
+                         "built again with room for every move: give it a larger log_moves")
+    return swarm.rebuild(dataclasses.replace(swarm.config, log_moves=ROOM_FOR_EVERY_MOVE))
+
+
+def _run_program(swarm, iterations: int, patience: int | None):
+    """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with
+    these statics (one after another under ``vmap`` for a swarm that asks for it)."""
     if swarm.vmap_one_at_a_time:
-        return _run_alone(swarm, iterations, patience)(key, world, task, params, state, budget)
-    return _run(swarm, key, world, task, params, iterations, patience, state, budget)
+        return _run_alone(swarm, iterations, patience)
+    return functools.partial(_run, swarm, iterations=iterations, patience=patience)
 
 
 @functools.lru_cache(maxsize=None)
@@ -230,12 +269,13 @@ def _run_alone(swarm, iterations: int, patience: int | None):
     """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with these
     statics, whose ``vmap`` runs the batch's members one after another."""
     def run_one(key, world, task, params, state, budget):
-        return _run(swarm, key, world, task, params, iterations, patience, state, budget)
+        return _run(swarm, key, world, task, params, state, budget, iterations=iterations,
+                    patience=patience)
     return one_at_a_time(run_one)
 
 
-@functools.partial(jax.jit, static_argnums=(0, 5, 6))
-def _run(swarm, key, world, task, params, iterations, patience, state, budget):
+@functools.partial(jax.jit, static_argnames=("swarm", "iterations", "patience"))
+def _run(swarm, key, world, task, params, state, budget, *, iterations, patience):
     if state is None:
         state = swarm.init(key, world, task, params)
     else:
@@ -243,7 +283,8 @@ def _run(swarm, key, world, task, params, iterations, patience, state, budget):
     nan = jnp.full((iterations,), jnp.nan, jnp.float32)
     counts = jnp.zeros((iterations,), jnp.int32)
     trace = Trace(best_cost=nan, iteration_cost=nan, arrived=nan, iterations=jnp.int32(0),
-                  moves=counts, lane_steps=counts, evaluations=counts)
+                  moves=counts, lane_steps=counts, evaluations=counts,
+                  overflowed=jnp.array(False))
     limit = iterations if patience is None else patience
 
     def keep_going(carry):
@@ -268,7 +309,8 @@ def _run(swarm, key, world, task, params, iterations, patience, state, budget):
                       arrived=trace.arrived.at[t].set(info.arrived),
                       iterations=t + 1, moves=trace.moves.at[t].set(info.moves),
                       lane_steps=trace.lane_steps.at[t].set(info.lane_steps),
-                      evaluations=trace.evaluations.at[t].set(info.evaluations))
+                      evaluations=trace.evaluations.at[t].set(info.evaluations),
+                      overflowed=trace.overflowed | info.overflowed)
         stale = jnp.where((after < before) | ~jnp.isfinite(after), 0, stale + 1)
         return state, trace, stale, info.converged
 
@@ -285,13 +327,20 @@ class SwarmConfig:
       num_agents: agents (drops, ants) per iteration.
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
+      log_moves: moves per agent, on average, a walk's log has room for; None:
+        :func:`~jaxswarm.swarm.walking.log.default_log_moves`. Changes no result, only the
+        memory of a walk and how often a run is made again because a walk overflowed
+        (:mod:`~jaxswarm.swarm.walking.log`).
     """
 
     num_agents: int = 256
     max_steps: int | None = None
+    log_moves: int | None = None
 
     def __post_init__(self):
         check_sizes(self.num_agents, self.max_steps)
+        if self.log_moves is not None and self.log_moves < 1:
+            raise ValueError(f"log_moves must be at least 1, got {self.log_moves}")
 
 
 def default_params(params_type, **values):
@@ -316,31 +365,37 @@ def check_sizes(num_agents: int, max_steps: int | None) -> None:
         raise ValueError(f"max_steps must be at least 1, got {max_steps}")
 
 
-def keep_best(walk, best_path, best_cost, *, ties: bool = False):
+def keep_best(walk, best_path, best_cost, *, ties: bool = False, paths=None, lengths=None):
     """The bookkeeping every swarm does after its agents walked.
 
     Args:
       walk: the iteration's :class:`jaxswarm.swarm.walking.Walk`.
       best_path: i32[L] the best path so far; best_cost: f32[] its length.
       ties: take this iteration's best also when it only equals the best so far.
+      paths: i32[A, L] the agents' paths when the swarm changed them after the walk (IWD_PG
+        smooths them), with their ``lengths`` f32[A]; None: the walk's.
 
     Returns:
       ``(best_path, best_cost, StepInfo)`` updated with this iteration's best arrived agent.
     """
-    costs = jnp.where(walk.arrived, walk.length, jnp.inf)
+    costs = jnp.where(walk.arrived, walk.length if lengths is None else lengths, jnp.inf)
     winner = jnp.argmin(costs)
     cost = costs[winner]
     better = ((cost <= best_cost) & jnp.isfinite(cost)) if ties else cost < best_cost
-    # Comparing the [A, L] paths costs a pass over them: only when every agent arrived.
+    # Comparing the paths costs a pass over the moves: only when every agent arrived.
     all_arrived = jnp.all(walk.arrived)
-    same_path = jax.lax.cond(all_arrived, lambda path: jnp.all(path == path[:1]),
-                             lambda path: jnp.array(False), walk.path)
+    if paths is None:
+        same_path = jax.lax.cond(all_arrived, all_same, lambda log: jnp.array(False), walk.log)
+    else:
+        same_path = jax.lax.cond(all_arrived, lambda p: jnp.all(p == p[:1]),
+                                 lambda p: jnp.array(False), paths)
     info = StepInfo(iteration_cost=cost,
                     arrived=jnp.mean(walk.arrived.astype(jnp.float32)),
                     converged=all_arrived & same_path, moves=jnp.sum(walk.moves),
-                    lane_steps=walk.lane_steps, evaluations=jnp.sum(walk.arrived, dtype=jnp.int32))
-    return (jnp.where(better, walk.path[winner], best_path), jnp.where(better, cost, best_cost),
-            info)
+                    lane_steps=walk.lane_steps, evaluations=jnp.sum(walk.arrived, dtype=jnp.int32),
+                    overflowed=walk.log.overflowed)
+    path = walk.agent_path(winner) if paths is None else paths[winner]
+    return jnp.where(better, path, best_path), jnp.where(better, cost, best_cost), info
 
 
 def check_positive(name: str, value, *, allow_zero: bool = False) -> None:

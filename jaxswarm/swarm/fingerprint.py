@@ -35,8 +35,9 @@ def fingerprint(tree) -> jax.Array:
 
 def run_fingerprint(state, trace: Trace) -> jax.Array:
     """u32[2]: the :func:`fingerprint` of a run's final ``state`` and its ``trace`` but for the
-    trace's ``lane_steps`` (the walker's work, shared by the runs of a batch)."""
-    return fingerprint((state, dataclasses.replace(trace, lane_steps=None)))
+    trace's ``lane_steps`` (the walker's work, shared by the runs of a batch) and
+    ``overflowed`` (a run whose walk overflowed is made again)."""
+    return fingerprint((state, dataclasses.replace(trace, lane_steps=None, overflowed=None)))
 
 
 def hex_fingerprint(value) -> str:

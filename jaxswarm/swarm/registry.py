@@ -78,7 +78,8 @@ def make(name: str, **config) -> Swarm:
 
 @functools.lru_cache(maxsize=None)
 def _build(name: str, config) -> Swarm:
-    return REGISTRY[name].build(config)
+    return dataclasses.replace(REGISTRY[name].build(config),
+                               rebuild=functools.partial(_build, name))
 
 
 def config_options(name: str) -> tuple[str, ...]:
@@ -94,9 +95,12 @@ def registered(world: type | None = None) -> tuple[str, ...]:
 
 
 def definition(swarm: Swarm) -> dict:
-    """JSON-ready record of what a swarm is: its name, every Config field and every default
-    param (what a results store compares before it resumes)."""
-    return dict(name=swarm.name, config=dataclasses.asdict(swarm.config),
+    """JSON-ready record of what a swarm is: its name, every Config field but ``log_moves``
+    (which changes no result) and every default param (what a results store compares before it
+    resumes)."""
+    config = dataclasses.asdict(swarm.config)
+    config.pop("log_moves")
+    return dict(name=swarm.name, config=config,
                 default_params={k: float(np.asarray(v))
                                 for k, v in swarm.default_params._asdict().items()})
 

@@ -37,7 +37,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, World, run
+from jaxswarm.swarm.core import Swarm, Task, World, run, with_room
 from jaxswarm.world.paths import is_valid_path, path_length
 from jaxswarm.world.plane import Plane, in_plane, trajectory_length, violations
 
@@ -81,13 +81,21 @@ class Compilations:
         jax.monitoring.unregister_event_duration_listener(self._listen)
 
 
-@functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
 def run_batch(swarm: Swarm, keys: jax.Array, world: World, task: Task, params, *,
               iterations: int):
     """``vmap`` of :func:`~jaxswarm.swarm.core.run` over ``keys`` (key[N]) and ``params`` (a
     Params tuple of f32[N] leaves) in one world (a Graph or a Plane) and task: ``(state,
     trace)`` with a leading axis N on every leaf. The batch the checks share (one program per
-    swarm, N and iterations)."""
+    swarm, N and iterations); made again with room for every move when a walk overflowed its
+    log (:func:`~jaxswarm.swarm.core.with_room`)."""
+    result = _run_batch(swarm, keys, world, task, params, iterations=iterations)
+    if bool(np.any(np.asarray(result[1].overflowed))):
+        return _run_batch(with_room(swarm), keys, world, task, params, iterations=iterations)
+    return result
+
+
+@functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
+def _run_batch(swarm: Swarm, keys, world, task, params, *, iterations: int):
     return jax.vmap(lambda key, p: run(swarm, key, world, task, p, iterations=iterations))(
         keys, params)
 

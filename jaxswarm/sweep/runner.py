@@ -45,6 +45,7 @@ from tqdm.auto import tqdm
 
 from jaxswarm.runtime.programs import release_if_crowded
 from jaxswarm.swarm import definition, make, make_task, run
+from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap, check_query, resolve_map
@@ -119,8 +120,10 @@ class _SweepChunks:
       batch_sharding: the runs axis split over the devices.
       replicated: a whole copy on every device (the world and the task).
       program: the jitted chunk (:func:`_chunk_program`).
-      compiled: :func:`_program_key` -> ``program`` compiled for that map shape, filled as the
-        shapes come.
+      roomy_program: the same with room in the walks' logs for every move
+        (:func:`~jaxswarm.swarm.core.with_room`), for a chunk where a walk overflowed.
+      compiled: ``(`` :func:`_program_key` ``, roomy)`` -> ``program`` (``roomy_program``)
+        compiled for that map shape, filled as the shapes come.
       store: the results store.
       writer: whether this process writes the store (process 0).
       log: where one-line messages go.
@@ -136,6 +139,7 @@ class _SweepChunks:
     batch_sharding: NamedSharding
     replicated: NamedSharding
     program: Callable
+    roomy_program: Callable
     compiled: dict
     store: ResultsStore
     writer: bool
@@ -165,7 +169,7 @@ def _set_up(spec: SweepSpec, maps: list[SweepMap], out: Path,
         params=_stacked_params(swarm.default_params, grid, len(seeds)), padded=padded,
         group=group, batch_sharding=NamedSharding(mesh, P(RUNS_AXIS)),
         replicated=NamedSharding(mesh, P()), program=_chunk_program(swarm, spec, mesh, group),
-        compiled={}, store=store, writer=writer, log=log)
+        roomy_program=_chunk_program(with_room(swarm), spec, mesh, group), compiled={}, store=store, writer=writer, log=log)
 
 
 def _unfinished_chunks(chunks: _SweepChunks, num_maps: int, out: Path) -> tuple[list, int]:
@@ -197,7 +201,12 @@ def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: li
         inputs = _chunk_inputs(chunks.params, chunks.seeds, first, chunks.padded,
                                chunks.num_runs, chunks.batch_sharding)
         began = time.perf_counter()
-        outputs = _gather(compiled(*inputs, world, task))
+        *outputs, overflowed = _gather(compiled(*inputs, world, task))
+        if np.any(overflowed[:count]):
+            chunks.log(f"a walk of chunk {c} of {sweep_map.label} had no room for its moves: "
+                       "the chunk again with room for every move")
+            roomy = _compiled(chunks, sweep_map, world, task, roomy=True)
+            *outputs, _ = _gather(roomy(*inputs, world, task))
         seconds = time.perf_counter() - began
         rows = _rows(spec, chunks.grid, chunks.seeds, sweep_map.label, map_index, c, first,
                      count, *(x[:count] for x in outputs), best, seconds)
@@ -206,17 +215,19 @@ def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: li
         bar.update(count)
 
 
-def _compiled(chunks: _SweepChunks, sweep_map: SweepMap, world, task):
-    """The chunk program compiled for ``sweep_map``'s shape (``world`` and ``task`` already
-    on the devices): compiled and logged the first time a shape comes, reused after."""
-    program = _program_key(sweep_map.world)
+def _compiled(chunks: _SweepChunks, sweep_map: SweepMap, world, task, *, roomy: bool = False):
+    """The chunk program (with ``roomy`` the one with room for every move) compiled for
+    ``sweep_map``'s shape (``world`` and ``task`` already on the devices): compiled and logged
+    the first time a shape comes, reused after."""
+    program = (_program_key(sweep_map.world), roomy)
     if program not in chunks.compiled:
         if release_if_crowded():  # the process holds too many programs' pages: drop ours too
             chunks.compiled.clear()
         began = time.perf_counter()
         example = _chunk_inputs(chunks.params, chunks.seeds, 0, chunks.padded, chunks.num_runs,
                                 chunks.batch_sharding)
-        chunks.compiled[program] = chunks.program.lower(*example, world, task).compile()
+        chosen = chunks.roomy_program if roomy else chunks.program
+        chunks.compiled[program] = chosen.lower(*example, world, task).compile()
         chunks.log(f"compiled {chunks.spec.algorithm} for {sweep_map.label}'s shape, "
                    f"{chunks.padded} runs per chunk on {len(jax.devices())} device(s), "
                    f"{chunks.group} at a time, in {time.perf_counter() - began:.1f} s")
@@ -254,8 +265,9 @@ def group_size(num_agents: int) -> int:
 
 def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
     """The jitted chunk: ``(seeds i32[C], params with leaves f32[C], world, task) -> (cost
-    f32[C], iterations i32[C], moves i32[C], evaluations i32[C], fingerprint u32[C, 2])``
-    (:func:`~jaxswarm.swarm.fingerprint.run_fingerprint`), C a multiple of the mesh
+    f32[C], iterations i32[C], moves i32[C], evaluations i32[C], fingerprint u32[C, 2],
+    overflowed bool[C])`` (:func:`~jaxswarm.swarm.fingerprint.run_fingerprint`; a run whose
+    walk overflowed its log must be made again), C a multiple of the mesh
     size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
     ``group`` at a time."""
     def one(run_input, world, task):
@@ -263,7 +275,7 @@ def _chunk_program(swarm, spec: SweepSpec, mesh: Mesh, group: int):
         state, trace = run(swarm, jax.random.key(seed), world, task, params,
                            iterations=spec.iterations, patience=spec.patience)
         return (swarm.best(state).cost, trace.iterations, jnp.sum(trace.moves),
-                jnp.sum(trace.evaluations), run_fingerprint(state, trace))
+                jnp.sum(trace.evaluations), run_fingerprint(state, trace), trace.overflowed)
 
     def share(seeds, params, world, task):
         return jax.lax.map(lambda run_input: one(run_input, world, task), (seeds, params),

@@ -30,7 +30,7 @@ import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.colony import colony, deposit
 from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
-from jaxswarm.swarm.walking import on_moves
+from jaxswarm.swarm.walking import on_walk
 
 TAU_FLOOR = float(jnp.finfo(jnp.float32).tiny)
 """The least ``tau`` after evaporation: the smallest normal float32 (arithmetic, see above)."""
@@ -77,18 +77,19 @@ def ant_system_update(graph, pheromone, ants, best_path, best_cost, info, params
     """Eq. 9 (kept at least ``TAU_FLOOR``), then eq. 8 for every ant that arrived: f32[N, K]
     pheromone."""
     evaporated = jnp.maximum((1.0 - params.rho) * pheromone, TAU_FLOOR)
-    return on_moves(_deposit_moves, ants.moves, (ants.path[:, :-1], ants.slots),
+    return on_walk(_deposit_moves, ants.log,
                     (evaporated, jnp.where(ants.arrived, params.q / ants.length, 0.0)), graph,
                     used=ants.arrived)
 
 
-def _deposit_moves(moves, run, graph):
+def _deposit_moves(rows, run, graph):
     """:func:`~.colony.deposit` of ``run``'s ``(pheromone f32[N, K], amount f32[A])`` on the
-    moves ``(nodes, slots)`` (``[A, W]``); the same on any width that holds them (a move not
-    made adds nothing, and the scatter adds in move order:
-    :func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    moves of ``rows`` (``(path [A, W + 1], slots [A, W])``); the same on any width that holds
+    them (a move not made adds nothing, and the scatter adds in move order:
+    :func:`~jaxswarm.swarm.walking.moves.on_walk`)."""
+    path, slots = rows
     pheromone, amount = run
-    return deposit(graph, pheromone, *moves, amount)
+    return deposit(graph, pheromone, path[:, :-1], slots, amount)
 
 
 def build_ant_system(config: SwarmConfig) -> Swarm:

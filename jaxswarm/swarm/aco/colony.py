@@ -144,7 +144,7 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
                                 goal_distance=goal_distance)
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
-                    max_steps=step_budget(graph, config.max_steps))
+                    max_steps=step_budget(graph, config.max_steps), log_moves=config.log_moves)
         best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
                                                ties=ties)
         pheromone = update(graph, state.pheromone, ants, best_path, best_cost, info, params)

@@ -71,7 +71,7 @@ def build_max_min_aco(config: MaxMinConfig) -> Swarm:
             path, cost = best_path, best_cost
         else:
             winner = jnp.argmin(jnp.where(ants.arrived, ants.length, jnp.inf))
-            path, cost = ants.path[winner], info.iteration_cost
+            path, cost = ants.agent_path(winner), info.iteration_cost
         pheromone = jnp.maximum((1.0 - params.rho) * pheromone, params.tau_min)
         pheromone = reinforce(graph, pheromone, path,
                               jnp.where(jnp.isfinite(cost), params.q / cost, 0.0))

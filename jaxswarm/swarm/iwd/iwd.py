@@ -19,7 +19,7 @@ edges near 10,000 (choice odds of about 10^5 : 1), and later drops re-walk the o
 from __future__ import annotations
 
 import dataclasses
-from typing import NamedTuple
+from typing import Callable, NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -31,7 +31,7 @@ from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_updates,
                                      choice_log_weights, global_update, goal_log_desirability,
                                      walked_soil)
-from jaxswarm.swarm.walking import Walk, edge_table, on_moves, step_budget, walk
+from jaxswarm.swarm.walking import Walk, edge_table, on_walk, step_budget, walk
 from jaxswarm.swarm.walking.backtrack import backtracking_walk
 from jaxswarm.world.graph import Graph
 
@@ -166,9 +166,10 @@ def initial_soil(graph: Graph, params: IWDParams) -> jax.Array:
 
 def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_agents: int,
               max_steps: int | None, local_updates: str = "arrived",
-              backtrack: bool = False) -> Walk:
+              backtrack: bool = False, log_moves: int | None = None) -> Walk:
     """One iteration's drops walking from ``task.start`` over ``soil`` (f32[N, K]) with their
-    local updates (``local_updates`` and ``backtrack`` as in :class:`IWDConfig`).
+    local updates (``local_updates`` and ``backtrack`` as in :class:`IWDConfig`, ``log_moves``
+    as in :class:`~jaxswarm.swarm.core.SwarmConfig`).
 
     Returns:
       The :class:`~jaxswarm.swarm.walking.Walk`, its ``memory`` the soil after the local
@@ -180,28 +181,30 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     budget = step_budget(graph, max_steps)
     if local_updates == "while_walking":
         return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
-                    max_steps=budget, hook=SOIL, memory=soil, hook_params=params)
+                    max_steps=budget, hook=SOIL, memory=soil, hook_params=params,
+                    log_moves=log_moves)
     if backtrack:
         drops = backtracking_walk(key, graph, soil_choice(graph, table, soil, params),
                                   task.start, task.goal, num_agents=num_agents, max_steps=budget)
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
-                     max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params)
-    memory, velocity, carried = on_moves(_after_walk, drops.moves,
-                                         (drops.path[:, :-1], drops.slots),
+                     max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params,
+                     log_moves=log_moves)
+    memory, velocity, carried = on_walk(_after_walk, drops.log,
                                          (soil, drops.arrived, params), graph,
                                          used=drops.arrived)
     return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
 
 
-def _after_walk(moves, run, graph: Graph):
+def _after_walk(rows, run, graph: Graph):
     """The velocity update and eq. 4 along the arrived drops' walks, and their local updates
-    (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for moves ``(here, slots)``
-    (i32 and slot dtype ``[A, W]``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
+    (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for the moves of ``rows``
+    (``(path i32[A, W + 1], slots [A, W])``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
     params)``: ``(soil f32[N, K], velocity f32[A], carried f32[A])``, NaN velocity and carried
     soil for the drops that did not arrive; the same on any width that holds the arrived drops'
-    moves (:func:`~jaxswarm.swarm.walking.moves.on_moves`: the others' rows may be cut short)."""
-    here, slots = moves
+    moves (:func:`~jaxswarm.swarm.walking.moves.on_walk`: the others' rows may be cut short)."""
+    path, slots = rows
+    here = path[:, :-1]
     soil, arrived, params = run
     taken, velocity = walked_soil(graph, soil, here, slots, params)
     carried = ordered_sum(taken, axis=1)
@@ -222,13 +225,14 @@ def soil_choice(graph: Graph, table, soil, params: IWDParams):
     return choice
 
 
-def soil_after_best(graph: Graph, drops: Walk, paths, costs, params: IWDParams) -> jax.Array:
+def soil_after_best(graph: Graph, drops: Walk, path_of: Callable, costs,
+                    params: IWDParams) -> jax.Array:
     """f32[N, K] the soil after ``drops`` walked and the global update of the shortest of their
-    ``paths`` (i32[A, L]; ``costs`` f32[A], inf for a drop that did not arrive); no global
-    update when none arrived."""
+    paths (``path_of(a)``: i32[L] drop ``a``'s path; ``costs`` f32[A], inf for a drop that did
+    not arrive); no global update when none arrived."""
     winner = jnp.argmin(costs)
     return jnp.where(jnp.isfinite(costs[winner]),
-                     global_update(graph, drops.memory, paths[winner],
+                     global_update(graph, drops.memory, path_of(winner),
                                    drops.state[winner, CARRIED], params),
                      drops.memory)
 
@@ -254,10 +258,11 @@ def build_iwd(config: IWDConfig) -> Swarm:
         key, walk_key = jax.random.split(state.key)
         drops = drop_walk(walk_key, graph, task, state.soil, params,
                           num_agents=config.num_agents, max_steps=config.max_steps,
-                          local_updates=config.local_updates, backtrack=config.backtrack)
+                          local_updates=config.local_updates, backtrack=config.backtrack,
+                          log_moves=config.log_moves)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
-        soil = soil_after_best(graph, drops, drops.path, costs, params)
+        soil = soil_after_best(graph, drops, drops.agent_path, costs, params)
         return IWDState(key=key, soil=soil, best_path=best_path, best_cost=best_cost), info
 
     return Swarm(name="iwd", config=config, init=jax.jit(init), step=jax.jit(step),

@@ -198,12 +198,13 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
     key, walk_key, operator_key = jax.random.split(state.key, 3)
     drops = drop_walk(walk_key, graph, task, state.soil, params,
                       num_agents=config.num_agents, max_steps=config.max_steps,
-                      local_updates=config.local_updates, backtrack=config.backtrack)
+                      local_updates=config.local_updates, backtrack=config.backtrack,
+                      log_moves=config.log_moves)
     paths, lengths = _measured_paths(graph, drops, smooth=config.smooth)
-    _, _, info = keep_best(drops._replace(path=paths, length=lengths), state.best_path,
-                           state.best_cost)
+    _, _, info = keep_best(drops, state.best_path, state.best_cost, paths=paths,
+                           lengths=lengths)
     costs = jnp.where(drops.arrived, lengths, jnp.inf)
-    soil = soil_after_best(graph, drops, paths, costs, params)
+    soil = soil_after_best(graph, drops, lambda drop: paths[drop], costs, params)
     memory = remember(state.memory, paths, costs)
     stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
     run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
@@ -221,7 +222,8 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
 def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool):
     """The drops' paths, with ``smooth`` each one that arrived through the global smooth
     operator, and their lengths: ``(paths i32[A, L], lengths f32[A])`` (a drop that did not
-    arrive keeps its walked length)."""
+    arrive keeps its walked length). IWD_PG's few drops' paths are written out whole: smoothing
+    and the memory take every arrived one."""
     paths = smooth_paths(graph, drops.path, drops.arrived) if smooth else drops.path
     lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
                         drops.length)

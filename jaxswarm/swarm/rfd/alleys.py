@@ -5,6 +5,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.walking import Walk
+from jaxswarm.swarm.walking.log import columns
 from jaxswarm.world.graph import Graph
 
 STEPS_PER_CHECK = 8
@@ -21,9 +22,7 @@ def blind_alleys(graph: Graph, log_weights, drops: Walk):
     the alley.
     """
     n = graph.num_nodes
-    num_agents = drops.path.shape[0]
-    agents = jnp.arange(num_agents)
-    last = jnp.sum(drops.path >= 0, axis=1) - 1  # index of the node where each drop stopped
+    last = drops.log.moves  # index of the node where each drop stopped
     filled = jnp.zeros((n,), bool).at[jnp.where(drops.stuck, drops.position, n)].set(
         True, mode="drop")
 
@@ -33,7 +32,8 @@ def blind_alleys(graph: Graph, log_weights, drops: Walk):
     def one_back(carry):
         back, filling, filled = carry
         index = jnp.maximum(last - back, 1)
-        node, came_from = drops.path[agents, index], drops.path[agents, index - 1]
+        nodes, _ = columns(drops.log, jnp.stack([index, index - 1], axis=1))
+        node, came_from = nodes[:, 0], nodes[:, 1]
         heads = graph.nbr[node]
         way_out = ((log_weights[node] > -jnp.inf) & (heads != came_from[:, None])
                    & ~filled[jnp.where(heads >= 0, heads, 0)])

@@ -50,6 +50,7 @@ from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import RFDState, check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
                                     neighbour_slots, visited_nodes)
+from jaxswarm.swarm.walking.log import columns as path_columns
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 from jaxswarm.world.relax import lowest_neighbour, relax
@@ -187,17 +188,15 @@ def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
     Under ``vmap`` the runs carve one at a time, each over its own walked blocks.
     """
     n = altitude.shape[0]
-    num_agents, width = drops.path.shape
+    num_agents, width = drops.moves.shape[0], drops.log.max_steps + 1
     blocks = -(-width // CARVE_COLUMNS)
     walked_blocks = (jnp.max(drops.moves) + CARVE_COLUMNS) // CARVE_COLUMNS  # holding nodes
 
     def one_block(carry):
         block, after, best, carved = carry
-        # The block's columns, read past the end as -1 (no copy of the paths padded to whole
-        # blocks; the last node has no move, so slots reads one column further as -1).
-        columns = block * CARVE_COLUMNS + jnp.arange(CARVE_COLUMNS)
-        nodes = jnp.take(drops.path, columns, axis=1, mode="fill", fill_value=-1)
-        slot = jnp.take(drops.slots, columns, axis=1, mode="fill", fill_value=-1)
+        # The block's columns of the paths, -1 past each one's end (the last node has no move,
+        # so its slot reads -1).
+        nodes, slot = path_columns(drops.log, block * CARVE_COLUMNS + jnp.arange(CARVE_COLUMNS))
         on_path = nodes >= 0
         node = jnp.where(on_path, nodes, 0)
         edge = move_lengths(graph, node, slot)

@@ -81,7 +81,7 @@ from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (add_compensated, check_greedy_drops, gradients,
                                       river_swarm, sediment_where_stuck)
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance, neighbour_slots,
-                                    on_moves)
+                                    on_walk)
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 
@@ -204,18 +204,19 @@ def erosion_change(graph: Graph, altitude, drops: Walk, eroding, erosion, p_base
     altitude among the nodes its eroding moves go to (nothing if none is lower). Every node then
     gains the eroded total divided by ``N - 1`` (eq. 5).
     """
-    eroded = on_moves(_eroded, drops.moves, (drops.path[:, :-1], drops.path[:, 1:], drops.slots),
-                      (altitude, eroding, erosion, p_base), graph, used=eroding)
+    eroded = on_walk(_eroded, drops.log, (altitude, eroding, erosion, p_base), graph,
+                      used=eroding)
     return ordered_sum(eroded) / (altitude.shape[0] - 1) - eroded
 
 
-def _eroded(moves, run, graph: Graph):
-    """f32[N] what each node gives to the moves ``(here, there, slots)`` (``[A, W]``) of the
-    eroding drops of ``run``'s ``(altitude f32[N], eroding bool[A], erosion, p_base)`` (eq. 4,
+def _eroded(rows, run, graph: Graph):
+    """f32[N] what each node gives to the moves of ``rows`` (``(path [A, W + 1], slots
+    [A, W])``) of the eroding drops of ``run``'s ``(altitude f32[N], eroding bool[A], erosion, p_base)`` (eq. 4,
     before eq. 5 shares it out); the same on any width that holds the moves (a move not made
     asks for nothing, and the scatters add in move order:
-    :func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
-    here, there, slots = moves
+    :func:`~jaxswarm.swarm.walking.moves.on_walk`)."""
+    path, slots = rows
+    here, there = path[:, :-1], path[:, 1:]
     altitude, eroding, erosion, p_base = run
     n = altitude.shape[0]
     moved = (slots >= 0) & eroding[:, None]

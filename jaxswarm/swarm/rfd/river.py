@@ -92,7 +92,7 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
         drops = walk(walk_key, graph, table, task.start, task.goal,
                      num_agents=config.num_agents,
                      max_steps=step_budget(graph, config.max_steps),
-                     greedy_agents=greedy_drops)
+                     greedy_agents=greedy_drops, log_moves=config.log_moves)
         altitude, residual = reshape(graph, task, state.altitude, state.residual, table, drops,
                                      params)
         altitude = jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)

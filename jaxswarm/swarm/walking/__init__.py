@@ -2,18 +2,21 @@
 one lockstep step of the lanes (:mod:`.lanes`), its random streams (:mod:`.streams`), the masked
 sampler (:mod:`.sampler`), packed visited sets (:mod:`.bits`), what algorithms hand it
 (:mod:`.tables`: edge tables, safe neighbour gathers and values, the goal heuristic, the step
-budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), and
-work on a walk's moves cut to the moves the batch made (:mod:`.moves`)."""
+budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), a
+walk's moves as they were made (:mod:`.log`), and work on them cut to the moves the batch made
+(:mod:`.moves`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, SMALLEST_COMPACTION,
                                          STEPS_PER_REFILL, Walk, visited_nodes, walk)
-from jaxswarm.swarm.walking.moves import move_widths, on_moves
+from jaxswarm.swarm.walking.log import MoveLog
+from jaxswarm.swarm.walking.moves import move_widths, on_moves, on_walk
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
                                            neighbour_slots, step_budget)
 
-__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "SMALLEST_COMPACTION",
-           "STEPS_PER_REFILL", "StepHook", "Walk", "edge_groups", "edge_table",
-           "goal_log_distance", "heads", "move_widths", "neighbour_slots", "on_moves",
-           "sample_masked", "step_budget", "uniforms", "visited_nodes", "walk"]
+__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "MoveLog",
+           "SMALLEST_COMPACTION", "STEPS_PER_REFILL", "StepHook", "Walk", "edge_groups",
+           "edge_table", "goal_log_distance", "heads", "move_widths", "neighbour_slots",
+           "on_moves", "on_walk", "sample_masked", "step_budget", "uniforms", "visited_nodes",
+           "walk"]

@@ -22,6 +22,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.walking import bits
+from jaxswarm.swarm.walking.log import from_rows
 from jaxswarm.swarm.walking.loop import Walk
 from jaxswarm.swarm.walking.sampler import sample_masked
 from jaxswarm.world.graph import NO_NODE, Graph
@@ -107,8 +108,8 @@ def backtracking_walk(key: jax.Array, graph: Graph, choice: ChoiceRule, start, g
     :class:`~jaxswarm.swarm.walking.loop.Walk`.
 
     Agent ``a`` draws from ``fold_in(key, a)``; all read the same ``choice`` (a memory that
-    does not change during the walk). Its ``path`` (i32[A, max_steps + 1]) holds the way without
-    its dead ends, so at most ``max_steps`` moves; ``moves`` counts every move the agent made,
+    does not change during the walk). Its log holds the way without its dead ends, so at most
+    ``max_steps`` moves (an agent that found no way: none); ``moves`` counts every move the agent made,
     back-outs included (the work done), ``stuck`` marks an agent that tried every way in vain.
 
     Args:
@@ -132,8 +133,8 @@ def backtracking_walk(key: jax.Array, graph: Graph, choice: ChoiceRule, start, g
     steps = jnp.sum(slots >= 0, axis=1)
     on_path = jnp.zeros((num_agents, graph.num_nodes), bool).at[
         agents[:, None], jnp.where(path >= 0, path, graph.num_nodes)].set(True, mode="drop")
-    return Walk(path=path,
-                slots=slots.astype(jnp.int8 if graph.max_degree <= 127 else jnp.int16),
+    slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
+    return Walk(log=from_rows(path, slots.astype(slot_dtype), steps, start, max_steps),
                 length=jnp.where(walked.found, total_length(graph, jnp.maximum(path[:, :-1], 0),
                                                             slots), 0.0),
                 arrived=walked.found, stuck=~walked.found,

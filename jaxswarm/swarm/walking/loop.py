@@ -39,10 +39,11 @@ function of its key. Hook params shared by a batch stay one run's, so the lanes 
 a gather; with a hook that writes, the loop carries one i32 per node of every run to group each
 step's moves (:func:`.hooks.edge_groups`). A hook that only reads (no ``update``) groups nothing.
 
-Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; the outputs, written
-in place as agents move and stop, are each agent's visited set (same layout), its slots
-``i8[A, max_steps]`` and its path ``i32[A, max_steps + 1]``. Filling the padded outputs is most
-of a large walk's memory traffic (about 40 ms of 120 for 16,384 agents on maze100).
+Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; each agent's visited
+set (same layout) is written when it stops. Its moves go to a journal as it makes them, one
+block of ``STEPS_PER_REFILL`` moves per lane and refill, and after the loop to each run's
+:class:`~.log.MoveLog`, agent by agent: a walk writes the moves its agents made, not rows
+padded to the step budget, in room that does not grow with the budget (:mod:`.log`).
 """
 from __future__ import annotations
 
@@ -51,6 +52,7 @@ from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
@@ -58,6 +60,9 @@ from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for,
+                                        default_log_moves, log_blocks, paths)
+from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
@@ -66,7 +71,7 @@ LANES = 1024
 machine (``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited
 sets leave the caches), fewer leave the loop's fixed cost per step unshared."""
 
-STEPS_PER_REFILL = 16
+STEPS_PER_REFILL = BLOCK
 """Moves a lane makes between two refills (an agent that stops within them idles until then).
 Measured on maze100 (2 cores): 16 against 8 made rfd_graded's runs about 7 % faster (fewer
 loop iterations) and left the walk of 16,384 agents as fast."""
@@ -96,10 +101,10 @@ class Walk(NamedTuple):
     """What a walk produced (a pytree).
 
     Attributes:
-      path: i32[A, L] nodes visited, starting with the start node, -1 padded
-        (``L = max_steps + 1``).
-      slots: i8[A, L - 1] (i16 on graphs of more than 127 slots) neighbour slot of each move
-        (``path[a, t + 1] = nbr[path[a, t], slot]``), -1 after the agent stopped.
+      log: every agent's moves (:class:`~.log.MoveLog`): read them through :func:`.log.paths`,
+        :func:`.log.columns`, :meth:`agent_path` or
+        :func:`~jaxswarm.swarm.walking.moves.on_walk`; :attr:`path` and :attr:`slots` write
+        them out padded to the step budget.
       length: f32[A] walked length (sum of edge costs). On grids and path maps the moves are
         counted by kind (:func:`jaxswarm.world.lattice.lattice_length`), so the same moves in any
         order give the same float; on general graphs the edge costs are summed.
@@ -116,8 +121,7 @@ class Walk(NamedTuple):
       memory: the hook's memory after the walk (with a hook; else None).
     """
 
-    path: jax.Array
-    slots: jax.Array
+    log: MoveLog
     length: jax.Array
     arrived: jax.Array
     stuck: jax.Array
@@ -127,6 +131,41 @@ class Walk(NamedTuple):
     lane_steps: jax.Array
     state: Any = None
     memory: Any = None
+
+    @property
+    def path(self) -> jax.Array:
+        """i32[..., A, L] nodes visited, starting with the start node, -1 padded
+        (``L = max_steps + 1``): the log's moves written out at the full budget, for small
+        walks and tests (a large walk's rules read the log, cut to the moves they need)."""
+        return _padded(self.log)[0]
+
+    @property
+    def slots(self) -> jax.Array:
+        """i8[..., A, L - 1] (i16 on graphs of more than 127 slots) neighbour slot of each move
+        (``path[a, t + 1] = nbr[path[a, t], slot]``), -1 after the agent stopped; like
+        :attr:`path`, written out from the log."""
+        return _padded(self.log)[1]
+
+    def agent_path(self, agent: jax.Array) -> jax.Array:
+        """i32[max_steps + 1] agent ``agent``'s (i32[]) path, -1 padded."""
+        return agent_path(self.log, agent, self.log.max_steps + 1)
+
+
+def _padded(log: MoveLog):
+    """:func:`.log.paths` at the full budget, over any leading batch axes of ``log``.
+
+    Raises:
+      ValueError: the log (concrete, not traced) overflowed: its rows would be wrong.
+    """
+    flag = log.overflowed
+    if not isinstance(flag, jax.core.Tracer) and bool(np.any(np.asarray(flag))):
+        raise ValueError("the walk's log had no room for all its moves: walk again with a "
+                         "larger log_moves (jaxswarm.swarm.walking.log.ROOM_FOR_EVERY_MOVE "
+                         "has room for every move)")
+    read = paths
+    for _ in range(log.moves.ndim - 1):
+        read = jax.vmap(read)
+    return read(log)
 
 
 def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) -> jax.Array:
@@ -138,7 +177,7 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
 
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
          max_steps: int, greedy_agents: int = 0, hook: StepHook | None = None, memory=None,
-         hook_params=None) -> Walk:
+         hook_params=None, log_moves: int | None = None) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal``.
 
     Args:
@@ -156,26 +195,35 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       hook: memory that changes at every step (static; see :mod:`.hooks`), or None.
       memory: the hook's memory before the walk (a pytree).
       hook_params: the hook's numbers (a pytree of traced scalars).
+      log_moves: the moves per agent, on average, the walk's log has room for (static; None:
+        :func:`~.log.default_log_moves`); more, and the log says it overflowed (:mod:`.log`).
 
     Returns:
       A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
     """
+    if log_moves is None:
+        log_moves = default_log_moves(max_steps, step_budget(graph, None))
+    if log_moves < 1:
+        raise ValueError(f"log_moves must be at least 1, got {log_moves}")
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
-    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook)(
+    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook,
+                          log_blocks(num_agents, max_steps, log_moves))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)
 
 
 @functools.lru_cache(maxsize=None)
-def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None):
+def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None,
+                  blocks: int):
     """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R], memory,
     hook_params) -> Walk`` with a leading run axis R on everything but the graph (the table's
-    may be 1), whose ``vmap`` folds the mapped axis into R."""
+    may be 1), whose ``vmap`` folds the mapped axis into R; each run's log has ``blocks``
+    blocks."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
-                 hook=hook)
+                 hook=hook, blocks=blocks)
 
     @custom_vmap
     def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
@@ -213,11 +261,9 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
 
 
 class Results(NamedTuple):
-    """What each agent of a loop did (leading axis: its agents), written as it walks (``path``,
-    ``slots``) and when it stops (the rest); the fields are the :class:`Walk`'s."""
+    """What each agent of a loop did (leading axis: its agents), written when it stops; the
+    fields are the :class:`Walk`'s."""
 
-    path: jax.Array
-    slots: jax.Array
     position: jax.Array
     visited: jax.Array
     moves: jax.Array
@@ -245,13 +291,33 @@ class Queue(NamedTuple):
     live: jax.Array
 
 
+class Journal(NamedTuple):
+    """The blocks of moves of a loop's agents in the order the lanes wrote them (leading axis:
+    the blocks, room for every run's log), before they are laid out agent by agent.
+
+    Attributes:
+      nodes: i32[C, BLOCK] and slots: ``slot_dtype[C, BLOCK]`` a block's moves (as
+        :class:`~.log.MoveLog`'s).
+      row: i32[C] the block's agent (its row in the results; the number of rows: no block).
+      index: i32[C] the block's place among its agent's blocks.
+      written: i32[] blocks written (more than C: the journal overflowed, the last were lost).
+    """
+
+    nodes: jax.Array
+    slots: jax.Array
+    row: jax.Array
+    index: jax.Array
+    written: jax.Array
+
+
 class Loop(NamedTuple):
-    """The loop's carry: the lanes, the results, the queue's next entry, the lane-steps, and
-    with a hook its memory and, when the hook writes, the claims buffer that groups each
-    step's moves (:func:`~.hooks.edge_groups`; None without)."""
+    """The loop's carry: the lanes, the results, the journal of moves, the queue's next entry,
+    the lane-steps, and with a hook its memory and, when the hook writes, the claims buffer
+    that groups each step's moves (:func:`~.hooks.edge_groups`; None without)."""
 
     lanes: Lanes
     results: Results
+    journal: Journal
     next_queued: jax.Array
     lane_steps: jax.Array
     memory: Any = None
@@ -260,9 +326,10 @@ class Loop(NamedTuple):
 
 def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
                num_agents: int, max_steps: int, greedy_agents: int,
-               hook: StepHook | None) -> Walk:
+               hook: StepHook | None, blocks: int) -> Walk:
     """The walks of R runs on one map through one queue (leading axis R on every input; the
-    table's and the hook params' may be 1, shared by every run)."""
+    table's and the hook params' may be 1, shared by every run), each run's log of ``blocks``
+    blocks."""
     runs = start.shape[0]
     inputs = WalkInputs(
         graph=graph, log_weights=log_weights, seed=seed, start=start, goal=goal, hook=hook,
@@ -270,20 +337,59 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
         greedy_agents=greedy_agents,
         slot_dtype=jnp.int8 if graph.max_degree <= 127 else jnp.int16,
         offsets=jnp.asarray(slot_offsets(graph)) if graph.is_grid else None)
-    results, lane_steps, memory = _walk_agents(inputs, runs * num_agents, memory)
+    results, journal, lane_steps, memory = _walk_agents(inputs, runs * num_agents, blocks,
+                                                        memory)
+    logs = _ordered_logs(inputs, journal, results.moves, blocks)
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
-    else:
-        length = total_length(graph, results.path[:, :-1], results.slots)
-    per_agent = dict(path=results.path, slots=results.slots, length=length,
-                     arrived=results.arrived, stuck=results.stuck, position=results.position,
-                     visited=results.visited, moves=results.moves, state=results.state)
+    else:  # general graphs (small): the edge costs summed along the rows
+        length = jax.vmap(lambda log: total_length(graph, *_moves_out_of(paths(log))))(logs)
+        length = length.reshape(-1)
+    per_agent = dict(length=length, arrived=results.arrived, stuck=results.stuck,
+                     position=results.position, visited=results.visited, moves=results.moves,
+                     state=results.state)
     return Walk(**{name: None if x is None else x.reshape((runs, num_agents) + x.shape[1:])
                    for name, x in per_agent.items()},
-                lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
+                log=logs, lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
 
 
-def _walk_agents(inputs: WalkInputs, count: int, memory):
+def _moves_out_of(rows):
+    """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
+    path, slots = rows
+    return path[:, :-1], slots
+
+
+def _ordered_logs(inputs: WalkInputs, journal: Journal, moves: jax.Array,
+                  blocks: int) -> MoveLog:
+    """Each run's :class:`~.log.MoveLog` (leading axis R) of ``blocks`` blocks: the journal's
+    blocks laid out agent by agent (``moves`` i32[R * A], each row's moves, gives each agent's
+    blocks and so their offsets). A run whose agents own more blocks than that, or any run of a
+    journal that overflowed, is marked ``overflowed``."""
+    runs, agents = inputs.start.shape[0], inputs.num_agents
+    owned = blocks_for(moves).reshape(runs, agents)
+    offset = jnp.cumsum(owned, axis=1) - owned
+    overflowed = (jnp.sum(owned, axis=1) > blocks) | (journal.written > journal.row.shape[0])
+    count = runs * agents
+    row = jnp.minimum(journal.row, count - 1)
+    place = offset.reshape(-1)[row] + journal.index
+    target = jnp.where((journal.row < count) & (place < blocks), row // agents * blocks + place,
+                       runs * blocks)
+    # Which journal block each log block is: a scatter of indices, then one gather of the
+    # moves (the log written once, not filled and then overwritten).
+    source = jnp.full((runs * blocks,), journal.row.shape[0], jnp.int32).at[target].set(
+        jnp.arange(journal.row.shape[0], dtype=jnp.int32), mode="drop")
+
+    def laid_out(table, fill):
+        out = jnp.take(table, source, axis=0, mode="fill", fill_value=fill)
+        return out.reshape((runs, blocks, BLOCK))
+
+    return MoveLog(nodes=laid_out(journal.nodes, NO_NODE),
+                   slots=laid_out(journal.slots, -1), offset=offset,
+                   moves=moves.reshape(runs, agents), start=inputs.start,
+                   overflowed=overflowed, max_steps=inputs.max_steps)
+
+
+def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
     """Walk the ``count`` agents of a batch of runs in one loop: the agents of runs with
     somewhere to go are queued, the others keep their initial results. The lanes take queued
     agents until the queue is empty and at most ``lanes // COMPACT_SHARE`` of them walk; those
@@ -292,11 +398,13 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     Args:
       inputs: the walk's inputs (R runs).
       count: R times the agents per run (static).
+      blocks: each run's log's blocks (static): the journal has room for R times as many.
       memory: the hook's memory before the walk, leading axis R (None without a hook).
 
     Returns:
-      ``(Results, lane_steps i32[], memory)``, the results' rows in agent order (agent ``f`` is
-      agent ``f % num_agents`` of run ``f // num_agents``) and the memory after the walk.
+      ``(Results, Journal, lane_steps i32[], memory)``, the results' rows in agent order (agent
+      ``f`` is agent ``f % num_agents`` of run ``f // num_agents``), the blocks of moves, and
+      the memory after the walk.
     """
     queue = _queue(inputs, count)
     initial = _initial_results(inputs, queue)
@@ -305,8 +413,13 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
     num_lanes = count if writes else min(LANES, count)
     claims = None if not writes else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
+    room = inputs.start.shape[0] * blocks
+    journal = Journal(nodes=jnp.zeros((room, BLOCK), jnp.int32),
+                      slots=jnp.zeros((room, BLOCK), inputs.slot_dtype),
+                      row=jnp.full((room,), count, jnp.int32),
+                      index=jnp.zeros((room,), jnp.int32), written=jnp.int32(0))
     loop = Loop(lanes=_fresh_lanes(inputs, queue, jnp.arange(num_lanes)), results=initial,
-                next_queued=jnp.minimum(jnp.int32(num_lanes), queue.live),
+                journal=journal, next_queued=jnp.minimum(jnp.int32(num_lanes), queue.live),
                 lane_steps=jnp.int32(0), memory=memory, claims=claims)
     few = num_lanes // COMPACT_SHARE
     loop = _flush(inputs, queue, jax.lax.while_loop(
@@ -319,10 +432,7 @@ def _walk_agents(inputs: WalkInputs, count: int, memory):
             lambda loop, fewer=fewer: _walking_count(loop.lanes) > fewer,
             functools.partial(_block, inputs), _compact(queue, loop, few)))
         few = fewer
-    # The start column goes into the loop's output, in place: set in the initial buffer, it
-    # makes XLA fill the whole buffer element by element (a third of a large walk's time).
-    results = loop.results._replace(path=loop.results.path.at[:, 0].set(initial.position))
-    return results, loop.lane_steps, loop.memory
+    return loop.results, loop.journal, loop.lane_steps, loop.memory
 
 
 def _queue(inputs: WalkInputs, count: int) -> Queue:
@@ -338,13 +448,10 @@ def _queue(inputs: WalkInputs, count: int) -> Queue:
 
 def _initial_results(inputs: WalkInputs, queue: Queue) -> Results:
     """Every row's results before it walks: at its run's start, which it has visited, no move,
-    arrived when the start is the goal; ``path`` i32[count, max_steps + 1] and ``slots``
-    ``slot_dtype[count, max_steps]`` all -1 (the start column is written after the loop)."""
+    arrived when the start is the goal."""
     count, run_of_row = queue.count, queue.run_of_row
     here = inputs.start[run_of_row]
     return Results(
-        path=jnp.full((count, inputs.max_steps + 1), NO_NODE, jnp.int32),
-        slots=jnp.full((count, inputs.max_steps), -1, inputs.slot_dtype),
         position=here, visited=start_visited(inputs, here),
         moves=jnp.zeros((count,), jnp.int32), diagonal=jnp.zeros((count,), jnp.int32),
         arrived=here == inputs.goal[run_of_row], stuck=jnp.zeros((count,), bool),
@@ -368,8 +475,8 @@ def _fresh_lanes(inputs: WalkInputs, queue: Queue, queued: jax.Array) -> Lanes:
 def _block(inputs: WalkInputs, loop: Loop) -> Loop:
     """``STEPS_PER_REFILL`` lockstep moves of every lane (:func:`.lanes.step`). The moves go to
     small step-major blocks (``slot_dtype`` and i32 ``[STEPS_PER_REFILL, l]``, one contiguous
-    row per step), written into the results' ``slots`` and ``path`` as one window per lane
-    (columns past the budget and rows of empty lanes are dropped)."""
+    row per step); each lane whose agent moved appends its block to the journal (blocks past
+    its room are lost, and counted)."""
     lanes = loop.lanes
     width = lanes.agent.shape[0]
 
@@ -386,12 +493,16 @@ def _block(inputs: WalkInputs, loop: Loop) -> Loop:
     nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
     lanes, memory, claims, slots, nodes = jax.lax.fori_loop(
         0, STEPS_PER_REFILL, step_into_blocks, (lanes, loop.memory, loop.claims, slots, nodes))
-    row = lanes.agent[:, None]  # ``count`` for empty lanes: dropped
-    column = first_move[:, None] + jnp.arange(STEPS_PER_REFILL)
-    results = loop.results._replace(
-        slots=loop.results.slots.at[row, column].set(slots.T, mode="drop"),
-        path=loop.results.path.at[row, column + 1].set(nodes.T, mode="drop"))
-    return loop._replace(lanes=lanes, results=results, memory=memory, claims=claims,
+    journal = loop.journal
+    moved = lanes.moves > first_move
+    place = journal.written + jnp.cumsum(moved) - 1
+    place = jnp.where(moved, place, journal.row.shape[0])  # past the room: dropped
+    journal = Journal(nodes=journal.nodes.at[place].set(nodes.T, mode="drop"),
+                      slots=journal.slots.at[place].set(slots.T, mode="drop"),
+                      row=journal.row.at[place].set(lanes.agent, mode="drop"),
+                      index=journal.index.at[place].set(first_move // BLOCK, mode="drop"),
+                      written=journal.written + jnp.sum(moved, dtype=jnp.int32))
+    return loop._replace(lanes=lanes, journal=journal, memory=memory, claims=claims,
                          lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
 
 

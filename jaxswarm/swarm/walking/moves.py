@@ -1,9 +1,11 @@
 """Work on a walk's moves cut to the moves made in the whole batch.
 
-A walk's per-move outputs are padded to the step budget (``slots`` ``i8[A, S]``, a path's first
-``S`` nodes), yet agents stop long before it: a drop on a 64 x 64 map makes about a hundred
-moves of a budget of 1,023. :func:`on_moves` applies a function to the first ``W`` move columns
-only, ``W`` the smallest of :func:`move_widths` that holds every agent's moves, of every run of
+Rows of moves are as wide as the step budget (a walk's paths written out, a path's nodes), yet
+agents stop long before it: a drop on a 64 x 64 map makes about a hundred moves of a budget of
+1,023. :func:`on_moves` applies a function to the first ``W`` move columns of such rows only,
+and :func:`on_walk` to a walk's paths and slots written out from its log (:mod:`.log`) to ``W``
+columns only, ``W`` the smallest of :func:`move_widths` that holds every agent's moves, of every
+run of
 the batch (a ``vmap`` of walks, nested or not, shares one ``W``: one branch of a
 ``lax.switch`` runs, where a ``W`` per run would make ``vmap`` run every branch). Past an
 agent's last move every column is padding; a function that gives padding no weight (a move that
@@ -27,6 +29,7 @@ import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
+from jaxswarm.swarm.walking.log import MoveLog, paths
 
 NARROWEST = 128
 """The narrowest width :func:`~jaxswarm.swarm.walking.moves.move_widths` offers."""
@@ -76,22 +79,44 @@ def on_moves(function: Callable, moves: jax.Array, columns: Any, per_run: Any = 
       ``function``'s outputs.
     """
     count = jax.tree_util.tree_leaves(columns)[0].shape[1]
+    return _apply(function, _cut_columns, move_widths(count), moves, columns, per_run, shared,
+                  used)
+
+
+def on_walk(function: Callable, log: MoveLog, per_run: Any = None, shared: Any = None, *,
+            used: jax.Array | None = None):
+    """:func:`on_moves` of a walk's moves: ``function((path, slots), per_run, shared)`` with
+    ``(path i32[A, W + 1], slots [A, W])`` the walk's paths and slots written out from its
+    ``log`` to the width ``W`` that holds the moves of every agent of the batch that
+    ``function`` uses (:func:`.log.paths`); arguments and outputs as :func:`on_moves`'s."""
+    return _apply(function, paths, move_widths(log.max_steps), log.moves, log, per_run, shared,
+                  used)
+
+
+def _cut_columns(columns, width: int):
+    """``columns`` (a pytree of ``[A, C, ...]`` arrays) cut to ``width`` columns."""
+    return jax.tree_util.tree_map(lambda x: x[:, :width], columns)
+
+
+def _apply(function: Callable, cut: Callable, widths: tuple[int, ...], moves, columns, per_run,
+           shared, used):
+    """:func:`on_moves` of one run's ``columns``, cut to a width by ``cut(columns, width)``."""
     if used is not None:
         moves = jnp.where(used, moves, 0)
-    apply = _runs(function, move_widths(count))
+    apply = _runs(function, cut, widths)
     out = apply(moves[None], *(jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                                for tree in (columns, per_run)), shared)
     return jax.tree_util.tree_map(lambda x: x[0], out)
 
 
-def _runs(function: Callable, widths: tuple[int, ...]):
+def _runs(function: Callable, cut: Callable, widths: tuple[int, ...]):
     """``(moves i32[R, A], columns, per_run, shared) -> outputs`` of R runs (leading axis R on
     all but ``shared``), whose ``vmap`` folds the mapped axis into R."""
 
     # Jitted, the traced function keeps its constants (the widths, NumPy arrays the function
     # uses) inside its own program: custom_vmap refuses constants of its own once a vmapped
     # lax.cond has batched them.
-    on_runs = jax.jit(functools.partial(_on_runs, function, widths))
+    on_runs = jax.jit(functools.partial(_on_runs, function, cut, widths))
 
     @custom_vmap
     def apply(moves, columns, per_run, shared):
@@ -114,16 +139,16 @@ def _runs(function: Callable, widths: tuple[int, ...]):
     return apply
 
 
-def _on_runs(function: Callable, widths: tuple[int, ...], moves, columns, per_run, shared):
-    """``function`` of each of R runs on the narrowest of ``widths`` that holds every move of
-    ``moves`` (i32[R, A])."""
+def _on_runs(function: Callable, cut: Callable, widths: tuple[int, ...], moves, columns,
+             per_run, shared):
+    """``function`` of each of R runs on its ``columns`` cut (``cut``) to the narrowest of
+    ``widths`` that holds every move of ``moves`` (i32[R, A])."""
     most = jnp.max(moves)
     index = jnp.sum(most > jnp.asarray(widths[:-1], most.dtype), dtype=jnp.int32)
 
     def within(width):
         def run(columns, per_run):
-            cut = jax.tree_util.tree_map(lambda x: x[:, :, :width], columns)
-            return jax.vmap(lambda c, p: function(c, p, shared))(cut, per_run)
+            return jax.vmap(lambda c, p: function(cut(c, width), p, shared))(columns, per_run)
         return run
 
     return jax.lax.switch(index, [within(width) for width in widths], columns, per_run)

@@ -1,0 +1,142 @@
+"""A walk's log of moves: what it holds, reading it, and the room it has (overflow and retry)."""
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.core import with_room
+from jaxswarm.swarm.testing import batched_params, outcome, run_batch
+from jaxswarm.swarm.walking import step_budget, walk
+from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same,
+                                        columns, default_log_moves, from_rows, log_blocks, paths)
+from jaxswarm.world.graph import grid_graph
+
+OPEN = grid_graph(np.zeros((24, 24), bool))
+"""An open grid: uniform walkers wander far before they reach a corner near the start."""
+
+
+def _walk(log_moves, max_steps=300, agents=32):
+    table = jnp.where(OPEN.nbr >= 0, 0.0, -jnp.inf)
+    return jax.jit(lambda key: walk(key, OPEN, table, 0, 3 * 24 + 3, num_agents=agents,
+                                    max_steps=max_steps, log_moves=log_moves))(
+        jax.random.key(0))
+
+
+def test_a_log_without_room_says_so_and_its_size_changes_no_move():
+    tight, default, roomy = (_walk(m) for m in (BLOCK, None, ROOM_FOR_EVERY_MOVE))
+    moves = np.asarray(roomy.moves)
+    assert moves.mean() > 2 * BLOCK  # the case under test: one block an agent is too few
+    assert bool(tight.log.overflowed) and not bool(default.log.overflowed)
+    assert not bool(roomy.log.overflowed)
+    for name in ("moves", "length", "arrived", "stuck", "position", "visited"):
+        for other in (tight, default):
+            np.testing.assert_array_equal(getattr(other, name), getattr(roomy, name), name)
+    np.testing.assert_array_equal(default.path, roomy.path)
+    np.testing.assert_array_equal(default.slots, roomy.slots)
+    assert default.log.nodes.shape[0] < roomy.log.nodes.shape[0]
+    with pytest.raises(ValueError, match="no room for all its moves"):
+        tight.path  # noqa: B018 (a property that checks)
+
+
+def test_reading_the_log_gives_the_padded_rows_it_was_made_of():
+    walked = _walk(ROOM_FOR_EVERY_MOVE, max_steps=100, agents=12)
+    path, slots = np.asarray(walked.path), np.asarray(walked.slots)
+    moves = np.asarray(walked.moves)
+    # Written out, each row holds its moves, then -1; the path starts at the start.
+    for a in range(12):
+        assert (path[a, :moves[a] + 1] >= 0).all() and (path[a, moves[a] + 1:] == -1).all()
+        assert (slots[a, :moves[a]] >= 0).all() and (slots[a, moves[a]:] == -1).all()
+    assert (path[:, 0] == 0).all()
+    # The same rows through from_rows (another layout: a fixed stride per agent).
+    strided = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), 0, 100)
+    for log in (walked.log, strided):
+        for width in (BLOCK - 1, 40, 100):
+            cut_path, cut_slots = paths(log, width)
+            np.testing.assert_array_equal(cut_path, path[:, :width + 1])
+            np.testing.assert_array_equal(cut_slots, slots[:, :width])
+        picked = np.random.default_rng(0).integers(-2, 104, (12, 7))
+        nodes, slot = columns(log, jnp.asarray(picked))
+        padded_path = np.pad(path, ((0, 0), (0, 10)), constant_values=-1)
+        padded_slots = np.pad(slots, ((0, 0), (0, 10)), constant_values=-1)
+        inside = picked >= 0
+        np.testing.assert_array_equal(np.asarray(nodes)[inside],
+                                      np.take_along_axis(padded_path, picked, 1)[inside])
+        np.testing.assert_array_equal(np.asarray(slot)[inside],
+                                      np.take_along_axis(padded_slots, picked, 1)[inside])
+        assert (np.asarray(nodes)[~inside] == -1).all()
+        for a in (0, 5, 11):
+            np.testing.assert_array_equal(agent_path(log, jnp.int32(a), 101), path[a])
+        assert not bool(all_same(log))
+
+
+def test_all_same_sees_one_different_move_anywhere():
+    row = np.arange(1, 41, dtype=np.int32)
+    path = np.tile(np.concatenate([[0], row, [-1] * 4]), (5, 1))
+    slots = np.tile(np.concatenate([row % 8, [-1] * 4]), (5, 1)).astype(np.int8)
+    moves = np.full(5, 40, np.int32)
+
+    def same(path, slots, moves):
+        return bool(all_same(from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves),
+                                       0, 44)))
+
+    assert same(path, slots, moves)
+    for agent, move in [(0, 0), (3, 17), (4, 39)]:
+        changed = slots.copy()
+        changed[agent, move] = (changed[agent, move] + 1) % 8
+        assert not same(path, changed, moves)
+    shorter = moves.copy()
+    shorter[2] = 39
+    cut = slots.copy()
+    cut[2, 39] = -1
+    assert not same(path, cut, shorter)
+
+
+def test_the_log_does_not_grow_with_a_longer_possible_path():
+    graph = grid_graph(np.zeros((32, 32), bool))
+    table = jnp.where(graph.nbr >= 0, 0.0, -jnp.inf)
+    assert default_log_moves(600, step_budget(graph, None)) < 300  # room set by the map
+
+    def own_bytes(max_steps):
+        compiled = jax.jit(lambda key: walk(key, graph, table, 0, 1023, num_agents=64,
+                                            max_steps=max_steps)).lower(jax.random.key(0)).compile()
+        analysis = compiled.memory_analysis()
+        return analysis.output_size_in_bytes + analysis.temp_size_in_bytes
+
+    assert own_bytes(300) == own_bytes(600)
+    assert log_blocks(64, 300, 256) == log_blocks(64, 600, 256) == 64 * 256 // BLOCK
+
+
+@pytest.fixture(scope="module")
+def cramped():
+    """ACO* with one block of room per ant, on an open grid where ants walk far: its walks
+    overflow."""
+    graph = grid_graph(np.zeros((16, 16), bool))
+    task = make_task(graph, (0, 0), (15, 15))
+    return make("aco_star", num_agents=16, log_moves=BLOCK), graph, task
+
+
+def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
+    swarm, graph, task = cramped
+    params = swarm.default_params
+    roomy = make("aco_star", num_agents=16)
+    keys = jax.random.split(jax.random.key(2), 3)
+    mapped = jax.vmap(lambda key: run(swarm, key, graph, task, params, iterations=4))(keys)
+    assert bool(np.asarray(mapped[1].overflowed).any())  # the caller who maps run sees it
+    for key in keys:
+        alone = run(swarm, key, graph, task, params, iterations=4)
+        assert not bool(alone[1].overflowed)
+        want = run(roomy, key, graph, task, params, iterations=4)
+        assert jax.tree_util.tree_all(jax.tree_util.tree_map(
+            lambda x, y: bool(np.array_equal(x, y, equal_nan=True)),
+            outcome(alone), outcome(want)))
+    batch = run_batch(swarm, keys, graph, task, batched_params(params, 3), iterations=4)
+    want = run_batch(roomy, keys, graph, task, batched_params(params, 3), iterations=4)
+    assert not bool(np.asarray(batch[1].overflowed).any())
+    np.testing.assert_array_equal(batch[0].best_cost, want[0].best_cost)
+    assert with_room(swarm).config.log_moves == ROOM_FOR_EVERY_MOVE
+
+
+def test_a_bad_log_room_is_refused():
+    with pytest.raises(ValueError, match="log_moves"):
+        make("aco_star", log_moves=0)
