@@ -4,6 +4,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from jaxswarm.dynamic.events import memory_frames
+from jaxswarm.dynamic.robot import hidden_blocks, swarm_robot
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.testing import batched_params, outcome, run_batch
@@ -140,3 +142,20 @@ def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
 def test_a_bad_log_room_is_refused():
     with pytest.raises(ValueError, match="log_moves"):
         make("aco_star", log_moves=0)
+
+
+def test_memory_frames_and_the_robot_walk_again_with_room(cramped):
+    swarm, graph, task = cramped
+    roomy = make("aco_star", num_agents=16)
+    params = swarm.default_params
+    state = swarm.init(jax.random.key(0), graph, task, params)
+    assert bool(swarm.step(state, graph, task, params)[1].overflowed)  # the case under test
+    got = memory_frames(swarm, state, graph, task, params, 3)
+    want = memory_frames(roomy, state, graph, task, params, 3)
+    np.testing.assert_array_equal(got[1], want[1])
+    hidden = hidden_blocks(graph, (0, 0), (15, 15), count=2, seed=0)
+    got, want = (swarm_robot(s, jax.random.key(1), graph, task, hidden, params, iterations=3,
+                             patience=None, max_plans=2) for s in (swarm, roomy))
+    assert not bool(got.overflowed)
+    np.testing.assert_array_equal(got.trajectory, want.trajectory)
+    np.testing.assert_array_equal(got.plan_paths, want.plan_paths)

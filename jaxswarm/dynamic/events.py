@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.core import Swarm, Task, run, with_room
 from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, is_valid_path
@@ -190,14 +190,20 @@ def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterati
     """Step a swarm ``iterations`` times from ``state`` (static count, no stop rule) and keep its
     memory after each step: ``(state, f32[iterations + 1, N])``, the first row the memory
     given (for a figure or a GIF of it re-forming after a change, see
-    :func:`jaxswarm.plot.graph.animate_field`)."""
-    def one(state, _):
-        state, _ = swarm.step(state, graph, task, params)
-        return state, swarm.memory(state)
+    :func:`jaxswarm.plot.graph.animate_field`). Stepped again with room for every move when a
+    walk overflowed its log (:func:`~jaxswarm.swarm.core.with_room`; concrete inputs)."""
+    def frames_of(swarm):
+        def one(state, _):
+            state, info = swarm.step(state, graph, task, params)
+            return state, (swarm.memory(state), info.overflowed)
 
-    first = swarm.memory(state)
-    state, frames = jax.lax.scan(one, state, None, length=iterations)
-    return state, jnp.concatenate([first[None], frames])
+        after, (frames, overflowed) = jax.lax.scan(one, state, None, length=iterations)
+        return after, jnp.concatenate([swarm.memory(state)[None], frames]), jnp.any(overflowed)
+
+    after, frames, overflowed = frames_of(swarm)
+    if not isinstance(overflowed, jax.core.Tracer) and bool(overflowed):
+        after, frames, _ = frames_of(with_room(swarm))
+    return after, frames
 
 
 def forget_invalid_best(state, graph: Graph, task: Task):

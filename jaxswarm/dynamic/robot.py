@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import functools
 import time
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -31,7 +31,7 @@ import numpy as np
 
 from jaxswarm.dynamic.events import NO_NODE, Event, apply_event, change, make_event
 from jaxswarm.exact import astar, replanner
-from jaxswarm.swarm.core import Swarm, Task, make_task, run
+from jaxswarm.swarm.core import Swarm, Task, make_task, run, with_room
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, path_length, step_slots
 
@@ -71,6 +71,9 @@ class RobotWalk(NamedTuple):
         a plan not made, or one that found no path).
       seen: :class:`~jaxswarm.dynamic.events.Event` with a leading axis P: what it found at the
         end of each plan.
+      overflowed: bool[] a swarm's walk had no room in its log for its moves
+        (:class:`~jaxswarm.swarm.core.Trace`): :func:`swarm_robot` walks again with room for
+        every move; set only where a caller maps it (None for D* Lite).
     """
 
     reached: jax.Array
@@ -81,6 +84,7 @@ class RobotWalk(NamedTuple):
     trajectory: jax.Array
     plan_paths: jax.Array
     seen: Event
+    overflowed: Any = None
 
 
 def nothing_seen(num_nodes) -> Event:
@@ -150,8 +154,11 @@ def swarm_robot(swarm: Swarm, key, known: Graph, task: Task, hidden: Event, para
         raise ValueError(f"unknown memory {memory!r}; choose one of {', '.join(MEMORY)}")
     if max_plans < 1:
         raise ValueError(f"max_plans must be at least 1, got {max_plans}")
-    return _swarm_robot(swarm, key, known, task, hidden, params, iterations, patience,
-                        max_plans, memory)
+    statics = (iterations, patience, max_plans, memory)
+    walk = _swarm_robot(swarm, key, known, task, hidden, params, *statics)
+    if not isinstance(walk.overflowed, jax.core.Tracer) and bool(walk.overflowed):
+        walk = _swarm_robot(with_room(swarm), key, known, task, hidden, params, *statics)
+    return walk
 
 
 @functools.partial(jax.jit, static_argnums=(0, 6, 7, 8, 9))
@@ -167,7 +174,8 @@ def _swarm_robot(swarm, key, known, task, hidden, params, iterations, patience, 
                      trajectory=trajectory.at[0].set(task.start),
                      plan_paths=jnp.full((max_plans, length), NO_NODE, jnp.int32),
                      seen=jax.tree_util.tree_map(lambda x: jnp.stack([x] * max_plans),
-                                                 nothing_seen(known.num_nodes)))
+                                                 nothing_seen(known.num_nodes)),
+                     overflowed=jnp.array(False))
 
     def going(carry):
         walk = carry[0]
@@ -191,7 +199,8 @@ def _swarm_robot(swarm, key, known, task, hidden, params, iterations, patience, 
             trajectory=walk.trajectory.at[stood].set(path, mode="drop"),
             plan_paths=walk.plan_paths.at[p].set(path),
             seen=jax.tree_util.tree_map(lambda all_, one: all_.at[p].set(one), walk.seen,
-                                        leg.seen))
+                                        leg.seen),
+            overflowed=walk.overflowed | trace.overflowed)
 
         def replan_from(state):
             if memory == "keep":
