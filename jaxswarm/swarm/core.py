@@ -218,7 +218,10 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
         happened); None: ``iterations``.
 
     Returns:
-      ``(state, trace)``: the final State and a :class:`~jaxswarm.swarm.core.Trace`.
+      ``(state, trace)``: the final State and a :class:`~jaxswarm.swarm.core.Trace`. Called
+      with concrete inputs, a run whose walk overflowed its log is made again with room for
+      every move (:func:`~jaxswarm.swarm.core.with_room`); mapped or traced by its caller, its
+      trace says so (``Trace.overflowed``).
 
     Raises:
       ValueError: a world of the wrong kind, or concrete params out of range (checked on the

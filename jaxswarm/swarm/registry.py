@@ -95,14 +95,20 @@ def registered(world: type | None = None) -> tuple[str, ...]:
 
 
 def definition(swarm: Swarm) -> dict:
-    """JSON-ready record of what a swarm is: its name, every Config field but ``log_moves``
-    (which changes no result) and every default param (what a results store compares before it
-    resumes)."""
-    config = dataclasses.asdict(swarm.config)
-    config.pop("log_moves")
-    return dict(name=swarm.name, config=config,
+    """JSON-ready record of what a swarm is: its name, its Config
+    (:func:`~jaxswarm.swarm.registry.config_record`) and every default param (what a results
+    store compares before it resumes)."""
+    return dict(name=swarm.name, config=config_record(swarm.config),
                 default_params={k: float(np.asarray(v))
                                 for k, v in swarm.default_params._asdict().items()})
+
+
+def config_record(config: SwarmConfig) -> dict:
+    """JSON-ready record of a swarm's Config: every field but ``log_moves``, the room of its
+    walks' logs, which changes no result."""
+    record = dataclasses.asdict(config)
+    record.pop("log_moves")
+    return record
 
 
 def entry(name: str) -> Entry:

@@ -11,7 +11,6 @@ reads them back. A row whose map has no entry (a map built by the script itself)
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 from typing import Any, NamedTuple
 
@@ -19,6 +18,7 @@ import jax
 import numpy as np
 
 from jaxswarm.swarm import Swarm, make
+from jaxswarm.swarm.registry import config_record
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep.maps import check_map_entry
 
@@ -60,7 +60,7 @@ def run_record(swarm: Swarm, params, entry, key: jax.Array, *, iterations: int,
     if entry is None:
         return ""
     return json.dumps(dict(
-        algorithm=swarm.name, config=dataclasses.asdict(swarm.config),
+        algorithm=swarm.name, config=config_record(swarm.config),
         params={name: float(np.asarray(value)) for name, value in params._asdict().items()},
         map=entry, key=np.asarray(jax.random.key_data(key)).tolist(),
         iterations=int(iterations), patience=patience), separators=(",", ":"))
