@@ -30,7 +30,7 @@ factor and both memories give the same walks.)
 * ``MiB`` and ``x2``: the compiled walk's own memory (its outputs and temporary buffers, from
   XLA's memory analysis; the map, the table and the keys excluded) at the default step budget
   and at twice that budget: what a longer possible path costs (the log's room is set by the
-  map, :func:`jaxswarm.swarm.walking.log.default_log_moves`, not by the budget).
+  map for a large walk, :func:`jaxswarm.swarm.walking.log.room_blocks`, not by the budget).
 
 Water drops (``iwd``) read their soil at every step through the walker's hook, so the table
 alone does not give their walk and the scalar reference does not apply: a second table times
@@ -69,7 +69,7 @@ from jaxswarm.swarm import aco, make, rfd, run
 from jaxswarm.swarm.core import Task
 from jaxswarm.swarm.iwd.iwd import drop_walk
 from jaxswarm.swarm.walking import Walk, step_budget, walk
-from jaxswarm.swarm.walking.log import BLOCK, default_log_moves, log_blocks
+from jaxswarm.swarm.walking.log import BLOCK, room_blocks
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import slot_offsets
 
@@ -137,9 +137,9 @@ def seed_words(keys: jax.Array) -> np.ndarray:
 
 
 def log_room(graph: Graph, agents: int, steps: int) -> int:
-    """Blocks of a walk's log of ``agents`` agents with budget ``steps``, as the walker sizes
-    it by default."""
-    return log_blocks(agents, steps, default_log_moves(steps, step_budget(graph, None)))
+    """Blocks of the log of a walk of ``agents`` agents with budget ``steps``, as the walker
+    sizes it by default."""
+    return room_blocks(agents, steps, None, step_budget(graph, None))
 
 
 def scalar_outputs(graph: Graph, seeds: int, agents: int, steps: int) -> dict[str, np.ndarray]:

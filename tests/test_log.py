@@ -11,7 +11,8 @@ from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.testing import batched_params, outcome, run_batch
 from jaxswarm.swarm.walking import step_budget, walk
 from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same,
-                                        columns, default_log_moves, from_rows, log_blocks, paths)
+                                        columns, default_log_moves, from_rows, log_blocks, paths,
+                                        room_blocks)
 from jaxswarm.world.graph import grid_graph
 
 OPEN = grid_graph(np.zeros((24, 24), bool))
@@ -36,7 +37,7 @@ def test_a_log_without_room_says_so_and_its_size_changes_no_move():
             np.testing.assert_array_equal(getattr(other, name), getattr(roomy, name), name)
     np.testing.assert_array_equal(default.path, roomy.path)
     np.testing.assert_array_equal(default.slots, roomy.slots)
-    assert default.log.nodes.shape[0] < roomy.log.nodes.shape[0]
+    assert default.log.nodes.shape[0] == roomy.log.nodes.shape[0]  # a small walk: every move
     with pytest.raises(ValueError, match="no room for all its moves"):
         tight.path  # noqa: B018 (a property that checks)
 
@@ -94,19 +95,24 @@ def test_all_same_sees_one_different_move_anywhere():
     assert not same(path, cut, shorter)
 
 
-def test_the_log_does_not_grow_with_a_longer_possible_path():
+def test_a_large_walks_log_does_not_grow_with_a_longer_possible_path():
     graph = grid_graph(np.zeros((32, 32), bool))
     table = jnp.where(graph.nbr >= 0, 0.0, -jnp.inf)
-    assert default_log_moves(600, step_budget(graph, None)) < 300  # room set by the map
+    budget = step_budget(graph, None)
+    assert default_log_moves(600, budget) == 256  # room set by the map
+    # 4,096 agents need more than WHOLE_ROOM_BYTES for every move; 8 do not.
+    assert room_blocks(4096, 300, None, budget) == log_blocks(4096, 300, 256)
+    assert room_blocks(4096, 600, None, budget) == log_blocks(4096, 600, 256)
+    assert room_blocks(8, 600, None, budget) == log_blocks(8, 600, 600)
+    assert room_blocks(8, 600, BLOCK, budget) == 8  # a room asked for is the room given
 
     def own_bytes(max_steps):
-        compiled = jax.jit(lambda key: walk(key, graph, table, 0, 1023, num_agents=64,
+        compiled = jax.jit(lambda key: walk(key, graph, table, 0, 1023, num_agents=4096,
                                             max_steps=max_steps)).lower(jax.random.key(0)).compile()
         analysis = compiled.memory_analysis()
         return analysis.output_size_in_bytes + analysis.temp_size_in_bytes
 
     assert own_bytes(300) == own_bytes(600)
-    assert log_blocks(64, 300, 256) == log_blocks(64, 600, 256) == 64 * 256 // BLOCK
 
 
 @pytest.fixture(scope="module")

@@ -331,7 +331,7 @@ class SwarmConfig:
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
       log_moves: moves per agent, on average, a walk's log has room for; None:
-        :func:`~jaxswarm.swarm.walking.log.default_log_moves`. Changes no result, only the
+        :func:`~jaxswarm.swarm.walking.log.room_blocks`. Changes no result, only the
         memory of a walk and how often a run is made again because a walk overflowed
         (:mod:`~jaxswarm.swarm.walking.log`).
     """

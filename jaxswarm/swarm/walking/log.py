@@ -16,7 +16,8 @@ run again with room for every agent's whole budget (:func:`jaxswarm.swarm.core.r
 the sweep runner and :func:`~jaxswarm.swarm.testing.run_batch` do it; a caller who maps
 :func:`~jaxswarm.swarm.core.run` itself reads ``Trace.overflowed``): the log's size changes no
 move, so the result is the one a larger log would have given. :func:`default_log_moves` is the
-room a walk gets when its swarm does not say.
+room a large walk gets when its swarm does not say (:func:`room_blocks`; a small one gets room
+for every move).
 
 Reading the log: :func:`paths` gives agents' paths and slots padded to a width (the columns a
 rule needs, cut as :func:`~jaxswarm.swarm.walking.moves.on_walk` cuts them), :func:`columns`
@@ -41,6 +42,15 @@ ROOM_FOR_EVERY_MOVE = 2 ** 31 - 1
 SMALLEST_DEFAULT_ROOM = 8 * BLOCK
 """The fewest moves per agent :func:`default_log_moves` gives a walk's log (small maps, whose
 budgets are short, get room for every move)."""
+
+WHOLE_ROOM_BYTES = 2 ** 20
+"""A run whose log with room for every agent's whole budget takes at most this many bytes gets
+that room (:func:`room_blocks`): small walks never overflow, so never run twice; larger ones
+get :func:`default_log_moves`, which does not grow with the budget. Per run, not per batch: a
+run's shapes may not depend on the batch it is in."""
+
+BLOCK_BYTES = BLOCK * 5
+"""Bytes of one block of a log: 16 i32 nodes and 16 i8 slots."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,6 +95,20 @@ def default_log_moves(max_steps: int, default_budget: int) -> int:
     ACO*'s first pheromone and 475 per drop from rfd_graded's converged altitudes
     (``benchmarks/walk.py``)."""
     return max(1, min(max_steps, max(SMALLEST_DEFAULT_ROOM, default_budget // 2)))
+
+
+def room_blocks(num_agents: int, max_steps: int, log_moves: int | None,
+                default_budget: int) -> int:
+    """The blocks of the log of a walk of ``num_agents`` agents (all static): room for
+    ``log_moves`` moves an agent on average; when None, room for every move if the log then
+    fits ``WHOLE_ROOM_BYTES``, else :func:`default_log_moves` (of the map's
+    ``default_budget``)."""
+    if log_moves is not None:
+        return log_blocks(num_agents, max_steps, log_moves)
+    whole = log_blocks(num_agents, max_steps, max_steps)
+    if whole * BLOCK_BYTES <= WHOLE_ROOM_BYTES:
+        return whole
+    return log_blocks(num_agents, max_steps, default_log_moves(max_steps, default_budget))
 
 
 def log_blocks(num_agents: int, max_steps: int, log_moves: int) -> int:

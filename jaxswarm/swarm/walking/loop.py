@@ -60,8 +60,8 @@ from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
-from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for,
-                                        default_log_moves, log_blocks, paths)
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for, paths,
+                                        room_blocks)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
@@ -196,20 +196,18 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       memory: the hook's memory before the walk (a pytree).
       hook_params: the hook's numbers (a pytree of traced scalars).
       log_moves: the moves per agent, on average, the walk's log has room for (static; None:
-        :func:`~.log.default_log_moves`); more, and the log says it overflowed (:mod:`.log`).
+        :func:`~.log.room_blocks`); more, and the log says it overflowed (:mod:`.log`).
 
     Returns:
       A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
     """
-    if log_moves is None:
-        log_moves = default_log_moves(max_steps, step_budget(graph, None))
-    if log_moves < 1:
+    if log_moves is not None and log_moves < 1:
         raise ValueError(f"log_moves must be at least 1, got {log_moves}")
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
-    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook,
-                          log_blocks(num_agents, max_steps, log_moves))(
+    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, log_moves,
+                          step_budget(graph, None))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)
@@ -217,13 +215,13 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
 
 @functools.lru_cache(maxsize=None)
 def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None,
-                  blocks: int):
+                  log_moves: int | None, default_budget: int):
     """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R], memory,
     hook_params) -> Walk`` with a leading run axis R on everything but the graph (the table's
-    may be 1), whose ``vmap`` folds the mapped axis into R; each run's log has ``blocks``
-    blocks."""
+    may be 1), whose ``vmap`` folds the mapped axis into R; the room of each run's log as
+    :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
-                 hook=hook, blocks=blocks)
+                 hook=hook, log_moves=log_moves, default_budget=default_budget)
 
     @custom_vmap
     def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
@@ -326,11 +324,12 @@ class Loop(NamedTuple):
 
 def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
                num_agents: int, max_steps: int, greedy_agents: int,
-               hook: StepHook | None, blocks: int) -> Walk:
+               hook: StepHook | None, log_moves: int | None, default_budget: int) -> Walk:
     """The walks of R runs on one map through one queue (leading axis R on every input; the
-    table's and the hook params' may be 1, shared by every run), each run's log of ``blocks``
-    blocks."""
+    table's and the hook params' may be 1, shared by every run), each run's log with the room
+    :func:`~.log.room_blocks` gives it."""
     runs = start.shape[0]
+    blocks = room_blocks(num_agents, max_steps, log_moves, default_budget)
     inputs = WalkInputs(
         graph=graph, log_weights=log_weights, seed=seed, start=start, goal=goal, hook=hook,
         hook_params=hook_params, num_agents=num_agents, max_steps=max_steps,
