@@ -27,7 +27,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, run, with_room
+from jaxswarm.swarm.core import Swarm, Task, again_with_room, run
 from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, is_valid_path
@@ -200,9 +200,7 @@ def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterati
         after, (frames, overflowed) = jax.lax.scan(one, state, None, length=iterations)
         return after, jnp.concatenate([swarm.memory(state)[None], frames]), jnp.any(overflowed)
 
-    after, frames, overflowed = frames_of(swarm)
-    if not isinstance(overflowed, jax.core.Tracer) and bool(overflowed):
-        after, frames, _ = frames_of(with_room(swarm))
+    after, frames, _ = again_with_room(frames_of, swarm, lambda result: result[2])
     return after, frames
 
 

@@ -235,12 +235,20 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)
-    result = _run_program(swarm, iterations, patience)(key, world, task, params, state, budget)
-    if not any(isinstance(leaf, jax.core.Tracer)
-               for leaf in jax.tree_util.tree_leaves((key, world, task, params, state, budget))):
-        if bool(np.any(np.asarray(result[1].overflowed))):
-            result = _run_program(with_room(swarm), iterations, patience)(
-                key, world, task, params, state, budget)
+    return again_with_room(
+        lambda swarm: _run_program(swarm, iterations, patience)(key, world, task, params, state,
+                                                               budget),
+        swarm, lambda result: result[1].overflowed)
+
+
+def again_with_room(call: Callable, swarm: Swarm, overflowed: Callable):
+    """``call(swarm)``, made again as ``call(with_room(swarm))`` when ``overflowed(result)``
+    (bool[...], concrete) says a walk had no room in its log; a traced flag is left to the
+    caller. How every entry that runs a swarm keeps no overflowed result."""
+    result = call(swarm)
+    flag = overflowed(result)
+    if not isinstance(flag, jax.core.Tracer) and bool(np.any(np.asarray(flag))):
+        return call(with_room(swarm))
     return result
 
 

@@ -37,7 +37,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, World, run, with_room
+from jaxswarm.swarm.core import Swarm, Task, World, again_with_room, run
 from jaxswarm.world.paths import is_valid_path, path_length
 from jaxswarm.world.plane import Plane, in_plane, trajectory_length, violations
 
@@ -88,10 +88,9 @@ def run_batch(swarm: Swarm, keys: jax.Array, world: World, task: Task, params, *
     trace)`` with a leading axis N on every leaf. The batch the checks share (one program per
     swarm, N and iterations); made again with room for every move when a walk overflowed its
     log (:func:`~jaxswarm.swarm.core.with_room`)."""
-    result = _run_batch(swarm, keys, world, task, params, iterations=iterations)
-    if bool(np.any(np.asarray(result[1].overflowed))):
-        return _run_batch(with_room(swarm), keys, world, task, params, iterations=iterations)
-    return result
+    return again_with_room(
+        lambda swarm: _run_batch(swarm, keys, world, task, params, iterations=iterations),
+        swarm, lambda result: result[1].overflowed)
 
 
 @functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
