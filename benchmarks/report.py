@@ -26,15 +26,17 @@ BENCHMARKS = [
     ("Walks: moves per second against a scalar C loop", "walk.py", [],
      ["--repeats", "2", "--layouts", "64x4", "--maps", "maze20"],
      "Moves per second of one jitted call of the walker on maze100 and on the 256 x 256 Moving AI "
-     "map Berlin_1_256 (all seeds' walks share one queue over the lanes), from the swarm's first "
-     "memory and from its memory after 30 iterations, beside `benchmarks/scalar/walk.c` on one "
-     "core and on all cores, which writes the walker's outputs in its layout (the log of moves, "
+     "map Berlin_1_256 (a device's seeds' walks share one queue over its lanes), from the swarm's "
+     "first memory and from its memory after 30 iterations, on one JAX CPU device and with the "
+     "seeds shared out over one device per core (`jax.shard_map`, as sweeps run), beside "
+     "`benchmarks/scalar/walk.c` on one core and on all cores (`share`: all against all; "
+     "`1 / 1`: one device against one core), which writes the walker's outputs in its layout (the log of moves, "
      "journaled and then laid out agent by agent, as the walker does). `busy` is the "
      "share of lane-steps that moved an agent; `same` counts the agents whose outputs all equal "
      "the C loop's (it draws the walker's own uniforms); `MiB` is the compiled walk's own memory "
      "(outputs and temporary buffers) at the default step budget and `x2` at twice that budget. "
      "Water drops: IWD's walk as the swarm walks by default and with `while_walking` updates, "
-     "beside ACO*'s."),
+     "beside ACO*'s, on all devices."),
     ("rfd_graded on the paper maps", "rfd.py", [], ["--maps", "maze20,maze100", "--seeds", "3"],
      "Median wall time of one `rfd_graded` run (100 iterations at most, patience 30, 256 drops, "
      "one XLA thread) per paper map over 20 seeds, beside the RFD paper's C# time of RFD*, and "

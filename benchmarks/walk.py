@@ -8,20 +8,24 @@ For each swarm (``--swarms``), each memory (``initial``: the swarm's first altit
 pheromone; ``converged``: its memory after ``--converge`` iterations of a run, when most agents
 follow a river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 and
 16,384 = 256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents
-share one queue over the walker's lanes), jitted, after one warm-up call (compile excluded).
-Printed, the median over ``--repeats`` runs:
+share one queue over the walker's lanes), jitted, after one warm-up call (compile excluded):
+once on one JAX CPU device, and once with the seeds shared out over ``--devices`` devices (one
+per core by default, each with one XLA thread; ``jax.shard_map``, as the sweep runner shares a
+sweep's runs out; the most devices that divide the seeds), each device walking its seeds'
+agents in its own queue on its own core. Printed, the median over ``--repeats`` runs:
 
 (ACO* finds no path on maze100 in 30 iterations, so its pheromone stays uniform up to a
 factor and both memories give the same walks.)
 
-* ``moves``: moves agents made (one agent changing node is one move), and ``busy``: the share
-  of the loop's lane-steps that were moves (the rest idled: an agent that stopped waits for its
-  lane's next refill, and the last agents' lanes wait for the slowest),
-* ``M moves/s``: moves / wall time,
+* ``ms``: the walks' wall time on all devices, ``moves``: moves agents made (one agent changing
+  node is one move), and ``busy``: the share of the loops' lane-steps that were moves on all
+  devices (the rest idled: an agent that stopped waits for its lane's next refill, and the last
+  agents' lanes wait for the slowest),
+* ``M moves/s 1 / all``: moves / wall time on one device and on all devices,
 * ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
   (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -ffp-contract=off
-  -fopenmp``, agents shared out over threads), and ``share``: ours as a share of the reference
-  on all cores. The reference writes what the walker returns, in its layout (the log of moves,
+  -fopenmp``, agents shared out over threads), and ``share``: ours on all devices as a share of
+  the reference on all cores (``1 / 1``: one device against one core). The reference writes what the walker returns, in its layout (the log of moves,
   each agent's first block, visited set, moves, length, position, arrival and stop, the blocks
   journaled as agents finish and laid out agent by agent at the end, as the walker does), and
   draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents whose
@@ -35,7 +39,7 @@ factor and both memories give the same walks.)
 Water drops (``iwd``) read their soil at every step through the walker's hook, so the table
 alone does not give their walk and the scalar reference does not apply: a second table times
 IWD's walks (soil at its start) beside ACO*'s (pheromone at its start) on the same maps and
-layouts: ``iwd`` as the swarm walks by default (the soil read during the walk, the arrived
+layouts, on all devices: ``iwd`` as the swarm walks by default (the soil read during the walk, the arrived
 drops' updates after it, :func:`jaxswarm.swarm.iwd.iwd.drop_walk`) and ``iwd ww`` with
 ``local_updates="while_walking"`` (every drop writes the soil as it moves), each as a share of
 ACO*'s moves per second (``/ aco``: what the hook costs).
@@ -44,6 +48,7 @@ Run from the repository root::
 
     python benchmarks/walk.py
     python benchmarks/walk.py --maps maze100 --layouts 256x1,256x16 --repeats 3 --swarms rfd_graded
+    python benchmarks/walk.py --devices 1   # every walk on one device
 """
 from __future__ import annotations
 
@@ -63,7 +68,10 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jax.sharding import Mesh, PartitionSpec as P
+
 from jaxswarm.maps.named import PAPER, map_kind
+from jaxswarm.runtime.cpu import configure
 from jaxswarm.studies.problems import movingai_folder, named_problem, scenario_problem
 from jaxswarm.swarm import aco, make, rfd, run
 from jaxswarm.swarm.core import Task
@@ -219,11 +227,37 @@ def memories(swarm_name: str, graph, task, drops: int, converge: int) -> dict:
     return {"initial": memory(state), "converged": memory(later)}
 
 
-def batched_walks(drops: int, steps: int):
-    """``(keys key[S], table f32[N, K], graph, task) -> Walk``: S seeds' walks under ``vmap``,
-    jitted (the map an argument, not constants for XLA to fold)."""
-    return jax.jit(lambda keys, table, graph, task: jax.vmap(lambda key: walk(
-        key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps))(keys))
+def device_count(seeds: int) -> int:
+    """The most JAX devices, at most ``len(jax.devices())``, that share ``seeds`` out evenly."""
+    return max(d for d in range(1, len(jax.devices()) + 1) if seeds % d == 0)
+
+
+def over_devices(walks, devices: int):
+    """``walks(keys key[S], *shared)`` (a ``vmap`` over the keys), jitted, its keys shared out
+    over the first ``devices`` JAX devices (``jax.shard_map``), ``shared`` on every device."""
+    mesh = Mesh(np.array(jax.devices()[:devices]), ("seeds",))
+
+    def sharded(keys, *shared):
+        return jax.shard_map(walks, mesh=mesh, in_specs=(P("seeds"),) + (P(),) * len(shared),
+                             out_specs=P("seeds"), check_vma=False)(keys, *shared)
+
+    return jax.jit(sharded)
+
+
+def batched_walks(drops: int, steps: int, devices: int = 1):
+    """``(keys key[S], table f32[N, K], graph, task) -> Walk``: S seeds' walks under ``vmap``
+    on ``devices`` devices (:func:`over_devices`), jitted (the map an argument, not constants
+    for XLA to fold)."""
+    return over_devices(lambda keys, table, graph, task: jax.vmap(lambda key: walk(
+        key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps))(keys),
+        devices)
+
+
+def busy_share(result: Walk, devices: int) -> float:
+    """The share of the lane-steps of ``result``'s loops (one per device, each of its runs
+    reporting its loop's count) that moved an agent."""
+    lane_steps = np.asarray(result.lane_steps).reshape(devices, -1)[:, 0]
+    return int(result.moves.sum()) / int(lane_steps.sum())
 
 
 def own_bytes(compiled) -> int:
@@ -242,8 +276,11 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
     keys = jax.random.split(jax.random.key(1), seeds)
     args = (keys, table, graph, task)
     walks = batched_walks(drops, steps).lower(*args).compile()  # timed and measured
-    seconds, result = timed(lambda: walks(*args), repeats)
+    one_seconds, _ = timed(lambda: walks(*args), repeats)
     longer = batched_walks(drops, 2 * steps).lower(*args).compile()
+    devices = device_count(seeds)
+    shared_out = batched_walks(drops, steps, devices).lower(*args).compile()
+    seconds, result = timed(lambda: shared_out(*args), repeats)
 
     words = seed_words(keys)
     flat_table = np.ascontiguousarray(np.asarray(table, np.float32))
@@ -259,8 +296,8 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
         reference[threads] = scalar_moves / statistics.median(walls)
     moves = int(result.moves.sum())
     return dict(agents=drops * seeds, seconds=seconds, moves=moves,
-                busy=moves / int(result.lane_steps[0]), rate=moves / seconds,
-                one_core=reference[1], all_cores=reference[os.cpu_count()],
+                busy=busy_share(result, devices), one_device=moves / one_seconds,
+                rate=moves / seconds, one_core=reference[1], all_cores=reference[os.cpu_count()],
                 same=same_agents(result, out), memory=own_bytes(walks), longer=own_bytes(longer))
 
 
@@ -285,13 +322,15 @@ def measure_drops(graph, task, drops: int, seeds: int, repeats: int) -> dict:
     pheromone = aco_swarm.init(jax.random.key(0), graph, task, aco_params).pheromone
     ant_table = aco.transition_rule(graph, task, pheromone, aco_params, goal_distance=True)
 
+    devices = device_count(seeds)
+
     def drop_walks(local_updates):
-        walks = jax.jit(lambda keys, graph, task, soil: jax.vmap(lambda key: drop_walk(
+        walks = over_devices(lambda keys, graph, task, soil: jax.vmap(lambda key: drop_walk(
             key, graph, task, soil, iwd_params, num_agents=drops, max_steps=None,
-            local_updates=local_updates))(keys))
+            local_updates=local_updates))(keys), devices)
         return lambda keys: walks(keys, graph, task, soil)
 
-    ant_walks = batched_walks(drops, step_budget(graph, None))
+    ant_walks = batched_walks(drops, step_budget(graph, None), devices)
     walks = {"iwd": drop_walks("arrived"), "iwd ww": drop_walks("while_walking"),
              "aco_star": lambda keys: ant_walks(keys, ant_table, graph, task)}
     rates = {}
@@ -311,16 +350,20 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--converge", type=int, default=30,
                         help="iterations run for the converged memory")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--devices", type=int, default=os.cpu_count(),
+                        help="JAX CPU devices, one XLA thread each (default: one per core)")
     args = parser.parse_args(argv)
+    configure(devices=args.devices, threads=args.devices)  # before JAX's first computation
     layouts = [tuple(int(part) for part in layout.split("x"))
                for layout in args.layouts.split(",")]
     problems = {name: load_problem(name) for name in args.maps.split(",")}
     print(f"machine: {machine()}")
-    print(f"median of {args.repeats} runs after a warm-up compile; reference: "
-          f"{SCALAR_SOURCE.name} on 1 and {os.cpu_count()} cores")
+    print(f"median of {args.repeats} runs after a warm-up compile; ours on 1 and up to "
+          f"{len(jax.devices())} devices, reference: {SCALAR_SOURCE.name} on 1 and "
+          f"{os.cpu_count()} cores")
     print(f"{'map':13} {'swarm':10} {'memory':9} {'agents':>7} {'ms':>8} {'moves':>9} "
-          f"{'busy':>5} {'M moves/s':>9} {'ref 1 / all':>12} {'share':>6} {'same':>12} "
-          f"{'MiB':>7} {'x2':>7}")
+          f"{'busy':>5} {'M moves/s 1 / all':>17} {'ref 1 / all':>12} {'share':>6} "
+          f"{'1 / 1':>6} {'same':>12} {'MiB':>7} {'x2':>7}")
     with tempfile.TemporaryDirectory() as directory:
         scalar = build_scalar(directory)
         for map_name, (graph, task) in problems.items():
@@ -332,9 +375,10 @@ def main(argv: list[str] | None = None) -> int:
                                     args.repeats)
                         print(f"{map_name:13} {swarm_name:10} {memory_name:9} {r['agents']:>7} "
                               f"{1e3 * r['seconds']:>8.1f} {r['moves']:>9} {r['busy']:>5.2f} "
-                              f"{r['rate'] / 1e6:>9.1f} "
+                              f"{r['one_device'] / 1e6:>9.1f} / {r['rate'] / 1e6:<5.1f} "
                               f"{r['one_core'] / 1e6:>5.1f} / {r['all_cores'] / 1e6:<5.1f} "
                               f"{r['rate'] / r['all_cores']:>6.2f} "
+                              f"{r['one_device'] / r['one_core']:>6.2f} "
                               f"{r['same']:>6}/{r['agents']:<5} {r['memory'] / MIB:>7.1f} "
                               f"{r['longer'] / MIB:>7.1f}", flush=True)
     print("\nwater drops (iwd, soil hook) beside ACO*, from their initial memory: M moves/s")

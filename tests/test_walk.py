@@ -3,8 +3,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.swarm.walking import (FORCED, STEPS_PER_REFILL, edge_table, sample_masked,
-                                    visited_nodes, walk)
+from jaxswarm.swarm.walking import (FEWEST_LANES, FORCED, LANES, STEPS_PER_REFILL, edge_table,
+                                    lanes_for, sample_masked, visited_nodes, walk)
 from jaxswarm.world.graph import dense_graph, grid_graph
 from jaxswarm.world.lattice import straight_line
 from jaxswarm.world.paths import is_valid_path, path_length
@@ -198,6 +198,35 @@ def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact,
     assert int(shared.lane_steps) != int(default.lane_steps)  # another schedule ...
     for (name, value), other in zip(_fields(default).items(), _fields(shared).values()):
         np.testing.assert_array_equal(value, other, err_msg=name)  # ... the same walks
+
+
+def test_a_loop_steps_about_one_lane_per_eight_agents_within_bounds():
+    assert [lanes_for(n) for n in (1, 100, 128, 1024, 2048, 4096, 8192, 16384, 10 ** 6)] == [
+        1, 100, 128, 128, 256, 512, 1024, 1024, 1024]
+    assert FEWEST_LANES <= LANES
+
+
+def test_a_small_walk_keeps_most_lanes_busy(monkeypatch):
+    """1,024 agents (4 runs of 256, a few of which wander long after the others arrived) on
+    ``lanes_for``'s 128 lanes: more of the lane-steps move an agent than with a lane per agent,
+    for the same walks."""
+    import jaxswarm.swarm.walking.loop as walk_module
+
+    graph = grid_graph(np.random.default_rng(5).random((24, 24)) < 0.2)
+    logw = towards(graph, graph.num_nodes - 1, 0.5)
+    keys = jax.random.split(jax.random.key(2), 4)
+
+    def walks():
+        return jax.jit(jax.vmap(lambda key: walk(key, graph, logw, 0, graph.num_nodes - 1,
+                                                 num_agents=256, max_steps=300)))(keys)
+
+    queued = walks()
+    monkeypatch.setattr(walk_module, "FEWEST_LANES", 1024)  # a lane for every agent
+    one_each = walks()
+    busy = [int(w.moves.sum()) / int(w.lane_steps[0]) for w in (queued, one_each)]
+    assert busy[0] > 0.7 and busy[0] > busy[1] + 0.05, busy
+    np.testing.assert_array_equal(queued.moves, one_each.moves)
+    np.testing.assert_array_equal(queued.log.nodes, one_each.log.nodes)
 
 
 def test_a_batch_of_walks_shares_one_queue_and_walks_as_each_alone():

@@ -258,8 +258,9 @@ def _program_key(world) -> tuple:
 
 
 def group_size(num_agents: int) -> int:
-    """Runs of ``num_agents`` agents vmapped together by default: enough to fill the walker's
-    ``LANES`` lanes (64 runs of 16 agents, 4 of 256), at least one."""
+    """Runs of ``num_agents`` agents vmapped together by default: enough for a walk loop of
+    ``LANES`` agents (64 runs of 16 agents, 4 of 256), at least one, whose lanes the queue keeps
+    busy (:func:`jaxswarm.swarm.walking.lanes_for`)."""
     return max(1, LANES // num_agents)
 
 

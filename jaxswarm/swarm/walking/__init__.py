@@ -6,8 +6,9 @@ budget), the per-step hook for memory that changes while the agents walk (:mod:`
 walk's moves as they were made (:mod:`.log`), and work on them cut to the moves the batch made
 (:mod:`.moves`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
-from jaxswarm.swarm.walking.loop import (COMPACT_SHARE, LANES, SMALLEST_COMPACTION,
-                                         STEPS_PER_REFILL, Walk, visited_nodes, walk)
+from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_LANES, LANES,
+                                         SMALLEST_COMPACTION, STEPS_PER_REFILL, Walk,
+                                         lanes_for, visited_nodes, walk)
 from jaxswarm.swarm.walking.log import MoveLog
 from jaxswarm.swarm.walking.moves import move_widths, on_moves, on_walk
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
@@ -15,8 +16,8 @@ from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
                                            neighbour_slots, step_budget)
 
-__all__ = ["COMPACT_SHARE", "EdgeGroups", "FORCED", "LANES", "Move", "MoveLog",
-           "SMALLEST_COMPACTION", "STEPS_PER_REFILL", "StepHook", "Walk", "edge_groups",
-           "edge_table", "goal_log_distance", "heads", "move_widths", "neighbour_slots",
-           "on_moves", "on_walk", "sample_masked", "step_budget", "uniforms", "visited_nodes",
-           "walk"]
+__all__ = ["AGENTS_PER_LANE", "COMPACT_SHARE", "EdgeGroups", "FEWEST_LANES", "FORCED", "LANES",
+           "Move", "MoveLog", "SMALLEST_COMPACTION", "STEPS_PER_REFILL", "StepHook", "Walk",
+           "edge_groups", "edge_table", "goal_log_distance", "heads", "lanes_for",
+           "move_widths", "neighbour_slots", "on_moves", "on_walk", "sample_masked",
+           "step_budget", "uniforms", "visited_nodes", "walk"]

@@ -12,8 +12,9 @@ That step of every lane is :func:`.lanes.step`; this module holds the queue that
 lanes, the loop over blocks of steps, the results it writes and the batching rule.
 
 Agents do not each keep a lane until the slowest one finishes. The loop steps a fixed number of
-lanes (at most ``LANES``) ``STEPS_PER_REFILL`` moves at a time; then up to a quarter of the lanes
-whose agent stopped hand its results to the output buffers and take the next agent of the queue.
+lanes (:func:`lanes_for`: one per ``AGENTS_PER_LANE`` agents, ``FEWEST_LANES`` to ``LANES``)
+``STEPS_PER_REFILL`` moves at a time; then the lanes whose agent stopped (at most half of the
+lanes, ``REFILL_SHARE``) hand its results to the output buffers and take the queue's next agents.
 Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, those go on in a
 batch of that many lanes, and so on each time a ``COMPACT_SHARE``-th of those lanes is left, down
 to ``SMALLEST_COMPACTION`` lanes: a walk's last agents (the few that wander for hundreds of
@@ -67,19 +68,37 @@ from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
 LANES = 1024
-"""Lanes of one walk loop (fewer when the walk has fewer agents). Measured on maze100 on a 2-core
-machine (``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited
-sets leave the caches), fewer leave the loop's fixed cost per step unshared."""
+"""The most lanes one walk loop steps. Measured on maze100 on a 2-core machine
+(``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited sets
+leave the caches)."""
+
+AGENTS_PER_LANE = 8
+"""A loop of ``count`` agents steps about ``count // AGENTS_PER_LANE`` lanes (at least
+``FEWEST_LANES``, at most ``LANES``): each lane walks several agents one after another, so the
+lanes stay busy while the queue lasts and only the last agents' lanes wait for the slowest. A
+lane-step costs about the same at 128 lanes as at 1,024 (its kernels' fixed cost is a few
+microseconds a step, against about 0.1 microsecond a lane), so fewer, busier lanes make more
+moves a second. Measured on maze100 and Berlin_1_256 (2 cores, one JAX device per core, the
+walks of 1,024 agents from the first memory): 128 lanes against one lane per agent moved agents
+on 0.72-0.86 of the lane-steps instead of 0.58-0.65 and made 5-30 % more moves a second; at
+16,384 agents the queue keeps 1,024 lanes busy (0.86-0.95) and 128 or 256 were no faster."""
+
+FEWEST_LANES = 128
+"""The fewest lanes a loop of more agents steps (see ``AGENTS_PER_LANE``): below it a step's
+fixed cost is no longer shared out (on maze100, 64 lanes made no more moves a second than 128)."""
 
 STEPS_PER_REFILL = BLOCK
 """Moves a lane makes between two refills (an agent that stops within them idles until then).
 Measured on maze100 (2 cores): 16 against 8 made rfd_graded's runs about 7 % faster (fewer
 loop iterations) and left the walk of 16,384 agents as fast."""
 
-REFILL_SHARE = 4
+REFILL_SHARE = 2
 """At most ``lanes // REFILL_SHARE`` lanes take a new agent per refill: copying a stopped agent's
 visited set out costs a row of words, so the copy is sized for the usual number of stops, and
-any more stopped lanes wait for the next refill."""
+any more stopped lanes wait for the next refill. Measured on maze100 (2 cores): a share of 2,
+4 or 1 made as many moves a second; on a small grid where agents stop after 14-30 moves on
+average (1,024 agents on 128 lanes), a share of 4 left 0.22-0.51 of the lane-steps moving, 2
+0.41-0.72, 1 0.54-0.72."""
 
 COMPACT_SHARE = 4
 """When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
@@ -409,7 +428,7 @@ def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
     initial = _initial_results(inputs, queue)
     writes = inputs.hook is not None and inputs.hook.writes
     # Agents that write a memory they all read walk together (module docstring).
-    num_lanes = count if writes else min(LANES, count)
+    num_lanes = count if writes else lanes_for(count)
     claims = None if not writes else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
     room = inputs.start.shape[0] * blocks
@@ -432,6 +451,12 @@ def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
             functools.partial(_block, inputs), _compact(queue, loop, few)))
         few = fewer
     return loop.results, loop.journal, loop.lane_steps, loop.memory
+
+
+def lanes_for(count: int) -> int:
+    """The lanes a loop of ``count`` agents steps (static): ``count // AGENTS_PER_LANE``, at
+    least ``FEWEST_LANES`` and at most ``LANES``, never more than ``count``."""
+    return min(count, LANES, max(FEWEST_LANES, count // AGENTS_PER_LANE))
 
 
 def _queue(inputs: WalkInputs, count: int) -> Queue:
