@@ -25,12 +25,13 @@ factor and both memories give the same walks.)
 * ``ref 1 / all``: the scalar reference's moves/s on one core and on all cores
   (``benchmarks/scalar/walk.c``, built here with ``cc -O3 -march=native -ffp-contract=off
   -fopenmp``, agents shared out over threads), and ``share``: ours on all devices as a share of
-  the reference on all cores (``1 / 1``: one device against one core). The reference writes what the walker returns, in its layout (the log of moves,
-  each agent's first block, visited set, moves, length, position, arrival and stop, the blocks
-  journaled as agents finish and laid out agent by agent at the end, as the walker does), and
-  draws the walker's uniforms, so it walks the same paths: ``same`` counts the agents whose
-  outputs (their blocks of the log included) are all identical (a last-bit difference between
-  C's ``expf`` and XLA's ``exp`` may send an agent elsewhere at a tie of cumulative weights),
+  the reference on all cores (``1 / 1``: one device against one core). The reference writes
+  what the walker returns, in its layout (the log of moves, each agent's first block, visited
+  set, moves, length, position, arrival and stop, the blocks journaled as agents finish and
+  laid out agent by agent at the end, as the walker does), and draws the walker's uniforms, so
+  it walks the same paths: ``same`` counts the agents whose outputs (their blocks of the log
+  included) are all identical (a last-bit difference between C's ``expf`` and XLA's ``exp``
+  may send an agent elsewhere at a tie of cumulative weights),
 * ``MiB`` and ``x2``: the compiled walk's own memory (its outputs and temporary buffers, from
   XLA's memory analysis; the map, the table and the keys excluded) at the default step budget
   and at twice that budget: what a longer possible path costs (the log's room is set by the
@@ -39,8 +40,8 @@ factor and both memories give the same walks.)
 Water drops (``iwd``) read their soil at every step through the walker's hook, so the table
 alone does not give their walk and the scalar reference does not apply: a second table times
 IWD's walks (soil at its start) beside ACO*'s (pheromone at its start) on the same maps and
-layouts, on all devices: ``iwd`` as the swarm walks by default (the soil read during the walk, the arrived
-drops' updates after it, :func:`jaxswarm.swarm.iwd.iwd.drop_walk`) and ``iwd ww`` with
+layouts, on all devices: ``iwd`` as the swarm walks by default (the soil read during the walk,
+the arrived drops' updates after it, :func:`jaxswarm.swarm.iwd.iwd.drop_walk`) and ``iwd ww`` with
 ``local_updates="while_walking"`` (every drop writes the soil as it moves), each as a share of
 ACO*'s moves per second (``/ aco``: what the hook costs).
 
@@ -67,7 +68,6 @@ from pathlib import Path
 import jax
 import jax.numpy as jnp
 import numpy as np
-
 from jax.sharding import Mesh, PartitionSpec as P
 
 from jaxswarm.maps.named import PAPER, map_kind
