@@ -78,10 +78,12 @@ AGENTS_PER_LANE = 8
 lanes stay busy while the queue lasts and only the last agents' lanes wait for the slowest. A
 lane-step costs about the same at 128 lanes as at 1,024 (its kernels' fixed cost is a few
 microseconds a step, against about 0.1 microsecond a lane), so fewer, busier lanes make more
-moves a second. Measured on maze100 and Berlin_1_256 (2 cores, one JAX device per core, the
-walks of 1,024 agents from the first memory): 128 lanes against one lane per agent moved agents
-on 0.72-0.86 of the lane-steps instead of 0.58-0.65 and made 5-30 % more moves a second; at
-16,384 agents the queue keeps 1,024 lanes busy (0.86-0.95) and 128 or 256 were no faster."""
+moves a second. Measured on maze100 and Berlin_1_256 (2 cores, one JAX device per core, walks
+of 1,024 agents): from the first memory, 128 lanes against one lane per agent moved agents on
+0.72-0.86 of the lane-steps instead of 0.58-0.65; over eight walks (two maps, two swarms, first
+and converged memory) they made up to 30 % more moves a second (one 3 % fewer, in the noise); at
+16,384 agents the queue keeps 1,024 lanes busy (0.86-0.95): 128 or 256 lanes were no faster on
+maze100, and up to 19 % faster on Berlin_1_256 (a rule by map size is not measured yet)."""
 
 FEWEST_LANES = 128
 """The fewest lanes a loop of more agents steps (see ``AGENTS_PER_LANE``): below it a step's
