@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.runtime.batching import one_at_a_time
-from jaxswarm.swarm.walking.log import ROOM_FOR_EVERY_MOVE, all_same
+from jaxswarm.swarm.walking.log import ROOM_FOR_EVERY_MOVE, all_same, known_overflowed
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 from jaxswarm.world.plane import Plane, check_point
@@ -246,8 +246,7 @@ def again_with_room(call: Callable, swarm: Swarm, overflowed: Callable):
     (bool[...], concrete) says a walk had no room in its log; a traced flag is left to the
     caller. How every entry that runs a swarm keeps no overflowed result."""
     result = call(swarm)
-    flag = overflowed(result)
-    if not isinstance(flag, jax.core.Tracer) and bool(np.any(np.asarray(flag))):
+    if known_overflowed(overflowed(result)):
         return call(with_room(swarm))
     return result
 

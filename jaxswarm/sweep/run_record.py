@@ -18,8 +18,8 @@ import jax
 import numpy as np
 
 from jaxswarm.swarm import Swarm, make
-from jaxswarm.swarm.registry import config_record
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
+from jaxswarm.swarm.registry import config_record
 from jaxswarm.sweep.maps import check_map_entry
 
 COLUMNS = ("run_record", "fingerprint")

@@ -30,6 +30,7 @@ import dataclasses
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from jaxswarm.world.graph import NO_NODE
 
@@ -191,6 +192,12 @@ def agent_path(log: MoveLog, agent: jax.Array, length: int) -> jax.Array:
     """i32[length] agent ``agent``'s (i32[]) path, -1 padded (cut after ``length`` nodes)."""
     one = dataclasses.replace(log, offset=log.offset[agent][None], moves=log.moves[agent][None])
     return columns(one, jnp.arange(length))[0][0]
+
+
+def known_overflowed(flag: jax.Array) -> bool:
+    """Whether ``flag`` (bool[...], a log's or a trace's ``overflowed``), when concrete, is set
+    anywhere; False for a traced flag, which only its caller can act on."""
+    return not isinstance(flag, jax.core.Tracer) and bool(np.any(np.asarray(flag)))
 
 
 def all_same(log: MoveLog) -> jax.Array:

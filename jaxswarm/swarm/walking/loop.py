@@ -53,7 +53,6 @@ from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
@@ -61,8 +60,8 @@ from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
-from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for, paths,
-                                        room_blocks)
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for,
+                                        known_overflowed, paths, room_blocks)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
@@ -178,8 +177,7 @@ def _padded(log: MoveLog):
     Raises:
       ValueError: the log (concrete, not traced) overflowed: its rows would be wrong.
     """
-    flag = log.overflowed
-    if not isinstance(flag, jax.core.Tracer) and bool(np.any(np.asarray(flag))):
+    if known_overflowed(log.overflowed):
         raise ValueError("the walk's log had no room for all its moves: walk again with a "
                          "larger log_moves (jaxswarm.swarm.walking.log.ROOM_FOR_EVERY_MOVE "
                          "has room for every move)")
