@@ -2,9 +2,9 @@
 one lockstep step of the lanes (:mod:`.lanes`), its random streams (:mod:`.streams`), the masked
 sampler (:mod:`.sampler`), packed visited sets (:mod:`.bits`), what algorithms hand it
 (:mod:`.tables`: edge tables, safe neighbour gathers and values, the goal heuristic, the step
-budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), a
-walk's moves as they were made (:mod:`.log`), and work on them cut to the moves the batch made
-(:mod:`.moves`)."""
+budget), the per-step hook for memory that changes while the agents walk (:mod:`.hooks`), the
+journal the lanes write their moves to (:mod:`.journal`), a walk's moves as they were made
+(:mod:`.log`), and work on them cut to the moves the batch made (:mod:`.moves`)."""
 from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_LANES, LANES,
                                          SMALLEST_COMPACTION, STEPS_PER_REFILL, Walk,

@@ -41,10 +41,10 @@ a gather; with a hook that writes, the loop carries one i32 per node of every ru
 step's moves (:func:`.hooks.edge_groups`). A hook that only reads (no ``update``) groups nothing.
 
 Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; each agent's visited
-set (same layout) is written when it stops. Its moves go to a journal as it makes them, one
-block of ``STEPS_PER_REFILL`` moves per lane and refill, and after the loop to each run's
-:class:`~.log.MoveLog`, agent by agent: a walk writes the moves its agents made, not rows
-padded to the step budget, in room that does not grow with the budget (:mod:`.log`).
+set (same layout) is written when it stops. Its moves go to a journal (:mod:`.journal`) as it
+makes them, one block of ``STEPS_PER_REFILL`` moves per lane and refill, and after the loop to
+each run's :class:`~.log.MoveLog`, agent by agent: a walk writes the moves its agents made,
+not rows padded to the step budget, in room that does not grow with the budget (:mod:`.log`).
 """
 from __future__ import annotations
 
@@ -60,8 +60,9 @@ from jaxswarm.swarm.walking import bits
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
-from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, blocks_for,
-                                        known_overflowed, paths, room_blocks)
+from jaxswarm.swarm.walking.journal import Journal, append, empty_journal, ordered_logs
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, known_overflowed, paths,
+                                        room_blocks)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
@@ -308,25 +309,6 @@ class Queue(NamedTuple):
     live: jax.Array
 
 
-class Journal(NamedTuple):
-    """The blocks of moves of a loop's agents in the order the lanes wrote them (leading axis:
-    the blocks, room for every run's log), before they are laid out agent by agent.
-
-    Attributes:
-      nodes: i32[C, BLOCK] and slots: ``slot_dtype[C, BLOCK]`` a block's moves (as
-        :class:`~.log.MoveLog`'s).
-      row: i32[C] the block's agent (its row in the results; the number of rows: no block).
-      index: i32[C] the block's place among its agent's blocks.
-      written: i32[] blocks written (more than C: the journal overflowed, the last were lost).
-    """
-
-    nodes: jax.Array
-    slots: jax.Array
-    row: jax.Array
-    index: jax.Array
-    written: jax.Array
-
-
 class Loop(NamedTuple):
     """The loop's carry: the lanes, the results, the journal of moves, the queue's next entry,
     the lane-steps, and with a hook its memory and, when the hook writes, the claims buffer
@@ -357,7 +339,7 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
         offsets=jnp.asarray(slot_offsets(graph)) if graph.is_grid else None)
     results, journal, lane_steps, memory = _walk_agents(inputs, runs * num_agents, blocks,
                                                         memory)
-    logs = _ordered_logs(inputs, journal, results.moves, blocks)
+    logs = ordered_logs(journal, results.moves, inputs.start, num_agents, blocks, max_steps)
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
     else:  # general graphs (small): the edge costs summed along the rows
@@ -375,36 +357,6 @@ def _moves_out_of(rows):
     """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
     path, slots = rows
     return path[:, :-1], slots
-
-
-def _ordered_logs(inputs: WalkInputs, journal: Journal, moves: jax.Array,
-                  blocks: int) -> MoveLog:
-    """Each run's :class:`~.log.MoveLog` (leading axis R) of ``blocks`` blocks: the journal's
-    blocks laid out agent by agent (``moves`` i32[R * A], each row's moves, gives each agent's
-    blocks and so their offsets). A run whose agents own more blocks than that, or any run of a
-    journal that overflowed, is marked ``overflowed``."""
-    runs, agents = inputs.start.shape[0], inputs.num_agents
-    owned = blocks_for(moves).reshape(runs, agents)
-    offset = jnp.cumsum(owned, axis=1) - owned
-    overflowed = (jnp.sum(owned, axis=1) > blocks) | (journal.written > journal.row.shape[0])
-    count = runs * agents
-    row = jnp.minimum(journal.row, count - 1)
-    place = offset.reshape(-1)[row] + journal.index
-    target = jnp.where((journal.row < count) & (place < blocks), row // agents * blocks + place,
-                       runs * blocks)
-    # Which journal block each log block is: a scatter of indices, then one gather of the
-    # moves (the log written once, not filled and then overwritten).
-    source = jnp.full((runs * blocks,), journal.row.shape[0], jnp.int32).at[target].set(
-        jnp.arange(journal.row.shape[0], dtype=jnp.int32), mode="drop")
-
-    def laid_out(table, fill):
-        out = jnp.take(table, source, axis=0, mode="fill", fill_value=fill)
-        return out.reshape((runs, blocks, BLOCK))
-
-    return MoveLog(nodes=laid_out(journal.nodes, NO_NODE),
-                   slots=laid_out(journal.slots, -1), offset=offset,
-                   moves=moves.reshape(runs, agents), start=inputs.start,
-                   overflowed=overflowed, max_steps=inputs.max_steps)
 
 
 def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
@@ -431,11 +383,7 @@ def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
     num_lanes = count if writes else lanes_for(count)
     claims = None if not writes else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
-    room = inputs.start.shape[0] * blocks
-    journal = Journal(nodes=jnp.zeros((room, BLOCK), jnp.int32),
-                      slots=jnp.zeros((room, BLOCK), inputs.slot_dtype),
-                      row=jnp.full((room,), count, jnp.int32),
-                      index=jnp.zeros((room,), jnp.int32), written=jnp.int32(0))
+    journal = empty_journal(inputs.start.shape[0] * blocks, count, inputs.slot_dtype)
     loop = Loop(lanes=_fresh_lanes(inputs, queue, jnp.arange(num_lanes)), results=initial,
                 journal=journal, next_queued=jnp.minimum(jnp.int32(num_lanes), queue.live),
                 lane_steps=jnp.int32(0), memory=memory, claims=claims)
@@ -517,15 +465,8 @@ def _block(inputs: WalkInputs, loop: Loop) -> Loop:
     nodes = jnp.full((STEPS_PER_REFILL, width), NO_NODE, jnp.int32)
     lanes, memory, claims, slots, nodes = jax.lax.fori_loop(
         0, STEPS_PER_REFILL, step_into_blocks, (lanes, loop.memory, loop.claims, slots, nodes))
-    journal = loop.journal
-    moved = lanes.moves > first_move
-    place = journal.written + jnp.cumsum(moved) - 1
-    place = jnp.where(moved, place, journal.row.shape[0])  # past the room: dropped
-    journal = Journal(nodes=journal.nodes.at[place].set(nodes.T, mode="drop"),
-                      slots=journal.slots.at[place].set(slots.T, mode="drop"),
-                      row=journal.row.at[place].set(lanes.agent, mode="drop"),
-                      index=journal.index.at[place].set(first_move // BLOCK, mode="drop"),
-                      written=journal.written + jnp.sum(moved, dtype=jnp.int32))
+    journal = append(loop.journal, nodes, slots, lanes.agent, first_move,
+                     moved=lanes.moves > first_move)
     return loop._replace(lanes=lanes, journal=journal, memory=memory, claims=claims,
                          lane_steps=loop.lane_steps + width * STEPS_PER_REFILL)
 
