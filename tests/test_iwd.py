@@ -11,7 +11,7 @@ from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
 from jaxswarm.swarm.iwd.iwd import drop_walk
-from jaxswarm.swarm.iwd.soil import (SOIL, arrived_updates, choice_log_weights,
+from jaxswarm.swarm.iwd.soil import (SOIL, arrived_update, choice_log_weights,
                                      goal_log_desirability, walked_soil)
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, Move, edge_groups
@@ -81,52 +81,61 @@ def test_walked_soil_is_the_velocity_update_and_eq_4_along_a_path():
     np.testing.assert_allclose(np.asarray(velocity), [v2, v1], rtol=1e-6)
 
 
-def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
+def test_an_arrived_drop_updates_the_soil_of_its_moves_by_eq_5():
     graph = grid_graph(np.zeros((1, 3), bool))  # 0 - 1 - 2
     soil = jnp.full(graph.nbr.shape, 1000.0)
-    path = jnp.array([[0, 1, 2], [0, 1, -1], [0, 1, 2]])
-    slots = jnp.array([[EAST, EAST], [EAST, -1], [EAST, EAST]], jnp.int8)
-    taken = jnp.array([[10.0, 20.0], [40.0, 0.0], [30.0, 50.0]])
-    arrived = jnp.array([True, False, True])
-    after = np.asarray(arrived_updates(graph, soil, path[:, :-1], slots, taken, arrived, P))
-    # Drop 1 did not arrive: nothing of it is kept. Drop 0, then drop 2 (eq. 5 twice):
-    first = 0.1 * 1000 - 0.9 * 10
-    assert after[0, EAST] == pytest.approx(0.1 * first - 0.9 * 30, rel=1e-6)
-    second = 0.1 * 1000 - 0.9 * 20
-    assert after[1, EAST] == pytest.approx(0.1 * second - 0.9 * 50, rel=1e-6)
+    here = jnp.array([0, 1, -1])
+    slots = jnp.array([EAST, EAST, -1], jnp.int8)
+    taken = jnp.array([10.0, 20.0, 0.0])
+    after = np.asarray(arrived_update(graph, soil, here, slots, taken, P))
+    assert after[0, EAST] == pytest.approx(0.1 * 1000 - 0.9 * 10, rel=1e-6)
+    assert after[1, EAST] == pytest.approx(0.1 * 1000 - 0.9 * 20, rel=1e-6)
     untouched = np.ones(after.shape, bool)
     untouched[[0, 1], EAST] = False
     assert np.all(after[untouched] == 1000.0)
-    # The other order gives another soil: the order is part of the rule.
-    swapped = np.asarray(arrived_updates(graph, soil, path[::-1, :-1], slots[::-1], taken[::-1],
-                                         arrived[::-1], P))
-    assert swapped[0, EAST] != pytest.approx(after[0, EAST])
 
 
-def test_arrived_updates_of_a_batch_equal_each_run_alone_and_a_sequential_loop():
-    # Runs with 3, 0 and 5 arrived drops: a batch loops over arrivals, each run's in its order.
-    graph = grid_graph(np.zeros((6, 6), bool))
-    rng = np.random.default_rng(5)
-    soil = jnp.asarray(rng.uniform(100, 1000, (3,) + graph.nbr.shape).astype(np.float32))
-    # A drop crosses an edge at most once: distinct nodes along each drop's moves.
-    here = jnp.asarray(np.array([[rng.permutation(graph.num_nodes)[:9] for _ in range(6)]
-                                 for _ in range(3)], np.int32))
-    moved = rng.random((3, 6, 9)) < 0.8
-    slots = jnp.asarray(np.where(moved, rng.integers(0, 8, (3, 6, 9)), -1).astype(np.int8))
-    taken = jnp.asarray(rng.uniform(0, 50, (3, 6, 9)).astype(np.float32))
-    arrived = jnp.asarray([[1, 0, 1, 0, 1, 0], [0] * 6, [1, 1, 1, 0, 1, 1]], bool)
-    batch = np.asarray(jax.jit(jax.vmap(lambda *a: arrived_updates(graph, *a, P)))(
-        soil, here, slots, taken, arrived))
+def assert_sequential_soil(graph, soil, drops):
+    """The drops' soil and states equal a loop over the arrived drops in agent order and their
+    moves in move order (NumPy float32, the soil taken over each whole row), bit for bit; the
+    other drops' states NaN. Returns the expected soil."""
+    here = drops.path[:, :-1]
+    taken, velocity = walked_soil(graph, soil, here, drops.slots, P)
+    carried = np.asarray(ordered_sum(taken, axis=1))
+    expected = np.asarray(soil).copy()
     keep, rho = np.float32(1) - np.float32(P.rho_n), np.float32(P.rho_n)
-    for r in range(3):
-        alone = np.asarray(arrived_updates(graph, soil[r], here[r], slots[r], taken[r],
-                                           arrived[r], P))
-        expected = np.asarray(soil[r]).copy()
-        for a, m in np.argwhere(np.asarray(arrived[r])[:, None] & moved[r]):
-            node, slot = int(here[r, a, m]), int(slots[r, a, m])
-            expected[node, slot] = keep * expected[node, slot] - rho * np.float32(taken[r, a, m])
-        np.testing.assert_array_equal(alone, expected)
-        np.testing.assert_array_equal(batch[r], alone)
+    arrived = np.asarray(drops.arrived)
+    slots, here, taken = np.asarray(drops.slots), np.asarray(here), np.asarray(taken)
+    for a, m in np.argwhere(arrived[:, None] & (slots >= 0)):
+        node, slot = here[a, m], slots[a, m]
+        expected[node, slot] = keep * expected[node, slot] - rho * taken[a, m]
+    np.testing.assert_array_equal(np.asarray(drops.memory), expected)
+    state = np.asarray(drops.state)
+    np.testing.assert_array_equal(state[arrived, 0], np.asarray(velocity)[arrived])
+    np.testing.assert_array_equal(state[arrived, 1], carried[arrived])
+    assert np.isnan(state[~arrived]).all()
+    return expected
+
+
+def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
+    # Drops share the corridor's edges: the order of their updates is part of the rule. A wall
+    # shuts the right end off, where the second task's goal lies.
+    blocked = np.zeros((3, 9), bool)
+    blocked[:, 6] = True
+    graph = grid_graph(blocked)
+    tasks = [make_task(graph, (0, 1), goal) for goal in ((5, 1), (8, 1))]
+    soil = jax.random.uniform(jax.random.key(3), graph.nbr.shape, minval=900.0, maxval=1100.0)
+    drops = drop_walk(jax.random.key(2), graph, tasks[0], soil, P, num_agents=16,
+                      max_steps=None)
+    assert np.asarray(drops.arrived).sum() >= 2
+    expected = assert_sequential_soil(graph, soil, drops)
+    # A batch of that run and one whose drops cannot arrive: each run's soil as alone.
+    batch = jax.jit(jax.vmap(lambda task: drop_walk(
+        jax.random.key(2), graph, task, soil, P, num_agents=16, max_steps=None)))(
+        jax.tree_util.tree_map(lambda *x: jnp.stack(x), *tasks))
+    assert not batch.arrived[1].any()
+    np.testing.assert_array_equal(np.asarray(batch.memory[0]), expected)
+    np.testing.assert_array_equal(np.asarray(batch.memory[1]), np.asarray(soil))
 
 
 def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
@@ -159,15 +168,7 @@ def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_afte
     moves, arrived = np.asarray(drops.moves), np.asarray(drops.arrived)
     assert moves[arrived].max() <= NARROWEST < moves[~arrived].max()
     # Every drop's whole row, as before the cut: the same bits for the arrived drops.
-    here = drops.path[:, :-1]
-    taken, velocity = walked_soil(graph, soil, here, drops.slots, P)
-    want = arrived_updates(graph, soil, here, drops.slots, taken, drops.arrived, P)
-    np.testing.assert_array_equal(np.asarray(drops.memory), np.asarray(want))
-    state = np.asarray(drops.state)
-    np.testing.assert_array_equal(state[arrived, 0], np.asarray(velocity)[arrived])
-    carried = np.asarray(ordered_sum(taken, axis=1))
-    np.testing.assert_array_equal(state[arrived, 1], carried[arrived])
-    assert np.isnan(state[~arrived]).all()
+    assert_sequential_soil(graph, soil, drops)
 
 
 def test_backtracking_drops_back_out_of_dead_ends():

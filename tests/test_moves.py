@@ -1,11 +1,13 @@
-"""Work on a walk's moves cut to the moves the whole batch made (jaxswarm.swarm.walking.moves)."""
+"""Work on a walk's moves cut to the moves the whole batch made, and folds over the used agents'
+walks (jaxswarm.swarm.walking.moves)."""
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
 from jaxswarm.runtime.arithmetic import ordered_cumsum, ordered_sum
-from jaxswarm.swarm.walking.moves import move_widths, on_moves
+from jaxswarm.swarm.walking.log import from_rows
+from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves
 
 
 def width_and_sum(moves, run, shared):
@@ -108,3 +110,96 @@ def test_it_runs_inside_a_vmapped_cond_with_constants():
         values, jnp.array([True, False, True]))
     np.testing.assert_array_equal(got[1], [0.0, 0.0])
     np.testing.assert_array_equal(got[2], branch(values[2]))
+
+
+def random_log(moves, max_steps=1023, nodes=50, seed=0):
+    """A MoveLog of agents that made ``moves`` moves each (random nodes and slots), and its rows
+    ``(path, slots)`` padded to the budget, as NumPy arrays."""
+    rng = np.random.default_rng(seed)
+    agents, width = len(moves), max_steps
+    made = np.arange(width)[None, :] < np.asarray(moves)[:, None]
+    slots = np.where(made, rng.integers(0, 8, (agents, width)), -1).astype(np.int8)
+    path = np.concatenate([np.full((agents, 1), 7), np.where(
+        made, rng.integers(0, nodes, (agents, width)), -1)], axis=1).astype(np.int32)
+    log = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves, jnp.int32), 7,
+                    max_steps)
+    return log, path, slots
+
+
+def record(carry, agent, row, run, shared):
+    """Each used agent's turn, its row's weighted sums and the widest row seen; nothing for an
+    agent past the last."""
+    turns, turn, sums, widest = carry
+    path, slots = row
+    column = jnp.arange(1, path.shape[0] + 1)
+    total = (jnp.sum(jnp.where(path >= 0, path * column, 0))
+             + jnp.sum(jnp.where(slots >= 0, slots * column[:-1], 0))) * run + shared
+    real = agent < turn.shape[0]
+    return (turns + real, turn.at[agent].set(turns, mode="drop"),
+            sums.at[agent].set(total, mode="drop"),
+            jnp.where(real, jnp.maximum(widest, slots.shape[0]), widest))
+
+
+def expected_record(path, slots, used, run=1, shared=0):
+    """:func:`record`'s turns and sums by a loop over the used agents in agent order."""
+    turn, sums = np.full(len(used), -1), np.zeros(len(used), np.int64)
+    for order, agent in enumerate(np.flatnonzero(used)):
+        column = np.arange(1, path.shape[1] + 1)
+        turn[agent] = order
+        sums[agent] = ((np.where(path[agent] >= 0, path[agent] * column, 0).sum()
+                        + np.where(slots[agent] >= 0, slots[agent] * column[:-1], 0).sum())
+                       * run + shared)
+    return turn, sums
+
+
+def empty_record(agents):
+    return (jnp.int32(0), jnp.full(agents, -1, jnp.int32), jnp.zeros(agents, jnp.int32),
+            jnp.int32(0))
+
+
+def test_fold_agents_takes_the_used_agents_in_agent_order_on_their_own_rows():
+    moves = [3, 700, 0, 12, 40]
+    used = np.array([True, False, True, True, True])
+    log, path, slots = random_log(moves)
+    turns, turn, sums, widest = jax.jit(lambda log, used: fold_agents(
+        record, log, empty_record(5), jnp.int32(1), jnp.int32(0), used=used))(log, used)
+    want_turn, want_sums = expected_record(path, slots, used)
+    assert int(turns) == 4
+    np.testing.assert_array_equal(turn, want_turn)
+    np.testing.assert_array_equal(sums, want_sums)
+    assert int(widest) == 128  # the unused agent's 700 moves do not widen the rows
+    everyone = fold_agents(record, log, empty_record(5), jnp.int32(1), jnp.int32(0),
+                           used=jnp.ones(5, bool))
+    assert int(everyone[3]) == 1023
+    np.testing.assert_array_equal(everyone[2], expected_record(path, slots, np.ones(5, bool))[1])
+
+
+def test_a_batch_of_folds_equals_each_run_alone_at_any_nesting():
+    # Runs with 3, 0 and 5 used agents: the batch steps to the most, the others unchanged.
+    moves = [[3, 5, 0, 1, 9], [3, 300, 2, 1, 4], [1, 1, 600, 1, 2]]
+    logs = [random_log(m, seed=i) for i, m in enumerate(moves)]
+    log = jax.tree_util.tree_map(lambda *x: jnp.stack(x), *[entry[0] for entry in logs])
+    used = jnp.array([[1, 0, 1, 0, 1], [0] * 5, [1, 1, 0, 1, 1]], bool)
+    runs = jnp.array([1, 2, 3], jnp.int32)
+
+    def one(log, used, run):
+        return fold_agents(record, log, empty_record(5), run, jnp.int32(4), used=used)
+
+    batch = jax.jit(jax.vmap(one))(log, used, runs)
+    for r, (_, path, slots) in enumerate(logs):
+        alone = one(jax.tree_util.tree_map(lambda x: x[r], log), used[r], runs[r])
+        for got, want in zip(batch, alone):
+            np.testing.assert_array_equal(got[r], want)
+        want_turn, want_sums = expected_record(path, slots, np.asarray(used[r]), r + 1, 4)
+        np.testing.assert_array_equal(batch[1][r], want_turn)
+        np.testing.assert_array_equal(batch[2][r], want_sums)
+    np.testing.assert_array_equal(batch[3], [128, 0, 128])  # no run's used agent made 600 moves
+    nested = jax.jit(jax.vmap(jax.vmap(one, in_axes=(0, 0, None))))(
+        jax.tree_util.tree_map(lambda x: x[:, None], log), used[:, None], runs)
+    for got, want in zip(nested, batch):
+        np.testing.assert_array_equal(got[:, 0], want)
+    # A batched shared input: each run folds on its own, to the same result.
+    shared = jax.vmap(lambda log, used, run, s: fold_agents(
+        record, log, empty_record(5), run, s, used=used))(log, used, runs, jnp.full(3, 4))
+    for got, want in zip(shared, batch):
+        np.testing.assert_array_equal(got, want)

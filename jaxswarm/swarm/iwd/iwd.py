@@ -28,10 +28,10 @@ import numpy as np
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
                                  default_params, keep_best)
-from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_updates,
+from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update,
                                      choice_log_weights, global_update, goal_log_desirability,
                                      walked_soil)
-from jaxswarm.swarm.walking import Walk, edge_table, on_walk, step_budget, walk
+from jaxswarm.swarm.walking import Walk, edge_table, fold_agents, step_budget, walk
 from jaxswarm.swarm.walking.backtrack import backtracking_walk
 from jaxswarm.world.graph import Graph
 
@@ -190,26 +190,26 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params,
                      log_moves=log_moves)
-    memory, velocity, carried = on_walk(_after_walk, drops.log,
-                                         (soil, drops.arrived, params), graph,
-                                         used=drops.arrived)
+    lost = jnp.full(drops.arrived.shape, jnp.nan, jnp.float32)
+    memory, velocity, carried = fold_agents(_arrived_drop, drops.log, (soil, lost, lost),
+                                            (soil, params), graph, used=drops.arrived)
     return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
 
 
-def _after_walk(rows, run, graph: Graph):
-    """The velocity update and eq. 4 along the arrived drops' walks, and their local updates
-    (:func:`~.soil.walked_soil`, :func:`~.soil.arrived_updates`) for the moves of ``rows``
-    (``(path i32[A, W + 1], slots [A, W])``) over ``run``'s ``(soil f32[N, K], arrived bool[A],
-    params)``: ``(soil f32[N, K], velocity f32[A], carried f32[A])``, NaN velocity and carried
-    soil for the drops that did not arrive; the same on any width that holds the arrived drops'
-    moves (:func:`~jaxswarm.swarm.walking.moves.on_walk`: the others' rows may be cut short)."""
-    path, slots = rows
-    here = path[:, :-1]
-    soil, arrived, params = run
-    taken, velocity = walked_soil(graph, soil, here, slots, params)
-    carried = ordered_sum(taken, axis=1)
-    return (arrived_updates(graph, soil, here, slots, taken, arrived, params),
-            jnp.where(arrived, velocity, jnp.nan), jnp.where(arrived, carried, jnp.nan))
+def _arrived_drop(after, drop, row, run, graph: Graph):
+    """The velocity update and eqs. 4-5 along the walk of drop ``drop`` (i32[], ``row`` its
+    ``(path i32[W + 1], slots [W])``) that arrived, its soil taken from ``run``'s soil at the
+    start of the walk (``(soil f32[N, K], params)``): ``after`` (``(soil f32[N, K], velocity
+    f32[A], carried f32[A])``, the drops before it applied) with its local updates applied and
+    its velocity and carried soil written (:func:`~.soil.walked_soil`,
+    :func:`~.soil.arrived_update`); ``after`` as it was for a ``drop`` past the last."""
+    path, slots = row
+    soil, params = run
+    after_soil, velocity, carried = after
+    taken, velocity_at_end = walked_soil(graph, soil, path[None, :-1], slots[None], params)
+    return (arrived_update(graph, after_soil, path[:-1], slots, taken[0], params),
+            velocity.at[drop].set(velocity_at_end[0], mode="drop"),
+            carried.at[drop].set(ordered_sum(taken, axis=1)[0], mode="drop"))
 
 
 def soil_choice(graph: Graph, table, soil, params: IWDParams):

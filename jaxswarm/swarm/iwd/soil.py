@@ -17,7 +17,7 @@ taken. Moving ``i -> j``, numbered as the IWD_PG paper numbers them:
   soil_IB / (N_IB - 1)``.
 
 When the local updates apply is :mod:`.iwd`'s choice (``local_updates``): after the walk, for
-the drops that arrived only (:func:`arrived_updates`; the drops read the soil as it was at the
+the drops that arrived only (:func:`arrived_update`; the drops read the soil as it was at the
 start of the iteration), or while the drops walk (:data:`SOIL`, the walker's per-step hook: all
 drops of a lockstep step read the soil as it was at its start, and drops crossing one edge in
 one step apply their updates one after another in the order of the walker's lanes, ``soil =
@@ -46,7 +46,6 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.runtime.arithmetic import ordered_cumsum
-from jaxswarm.runtime.batching import runs_folded
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
 from jaxswarm.swarm.walking.hooks import Move, StepHook
 from jaxswarm.world.graph import Graph
@@ -60,7 +59,11 @@ VELOCITY, CARRIED = 0, 1
 def choice_log_weights(params, soil_rows, admissible) -> jax.Array:
     """f32[l, K] ``alpha * log f(soil(i, j))`` (eqs. 2-3) over each lane's admissible slots
     (0 elsewhere); ``params`` per lane (f32[l] fields)."""
-    smallest = jnp.min(jnp.where(admissible, soil_rows, jnp.inf), axis=-1)
+    # The smallest soil as a chain of elementwise minima over the (few, static) slots rather
+    # than a reduction: XLA fuses it into the log-weights' kernel instead of running a kernel of
+    # its own at every step of the walk (a minimum is exact in any order).
+    choices = jnp.where(admissible, soil_rows, jnp.inf)
+    smallest = functools.reduce(jnp.minimum, [choices[:, k] for k in range(choices.shape[1])])
     g = soil_rows - jnp.minimum(smallest, 0.0)[:, None]  # shifted only when negative
     log_f = -jnp.log(params.eps_s[:, None] + g)
     return jnp.where(admissible, params.alpha[:, None] * log_f, 0.0)
@@ -119,7 +122,7 @@ run, eqs. 1-6."""
 SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,), jnp.float32),
                        log_weights=choice_log_weights)
 """The walker hook of drops that read the soil and leave it as it is during the walk (eqs. 1-3;
-their updates come after it, :func:`arrived_updates`)."""
+their updates come after it, :func:`arrived_update`)."""
 
 
 def walked_soil(graph: Graph, soil, here, slots, params):
@@ -136,51 +139,24 @@ def walked_soil(graph: Graph, soil, here, slots, params):
     return taken, velocity[:, -1]
 
 
-def arrived_updates(graph: Graph, soil, here, slots, taken, arrived, params):
-    """Eq. 5 for the moves of the drops that arrived, applied after the walk: f32[N, K] soil
-    after drop 0's moves, then drop 1's, ... (agent order, then move order; a drop crosses a
-    directed edge at most once), whatever lanes the drops walked in.
+def arrived_update(graph: Graph, soil, here, slots, taken, params):
+    """Eq. 5 for the moves of one drop that arrived, applied after the walk: f32[N, K] ``soil``
+    after each move's edge lost ``rho_n`` of the soil there and ``rho_n`` times the soil the
+    move took. A drop crosses a directed edge at most once, so its moves write distinct edges.
 
     Args:
       graph: the map.
-      soil: f32[N, K] the soil before.
-      here: i32[A, S] the node each move leaves (a path's nodes but its last); slots:
-        i8/i16/i32[A, S] the moves' slots.
-      taken: f32[A, S] the soil each move took (:func:`walked_soil`).
-      arrived: bool[A] which drops' updates are kept.
+      soil: f32[N, K] the soil before (after the drops before it in agent order).
+      here: i32[S] the node each move leaves (a path's nodes but its last); slots: i8/i16/i32[S]
+        the moves' slots, -1 where no move was made (no update).
+      taken: f32[S] the soil each move took (:func:`walked_soil`).
       params: the IWD params (scalars).
     """
-    one_run = [jnp.asarray(x)[None] for x in (soil, here, slots, taken, arrived, params.rho_n)]
-    return _arrived_runs(graph.num_nodes)(*one_run)[0]
-
-
-@functools.lru_cache(maxsize=None)
-def _arrived_runs(num_nodes: int):
-    """:func:`_apply_arrived` of R runs (leading axis R on every argument), a vmap folded into
-    R (:func:`~jaxswarm.runtime.batching.runs_folded`)."""
-    return runs_folded(functools.partial(_apply_arrived, num_nodes))
-
-
-def _apply_arrived(num_nodes: int, soil, here, slots, taken, arrived, rho_n):
-    """Eq. 5 for R runs' arrived drops (:func:`arrived_updates` with a leading run axis R on
-    every argument, ``rho_n`` f32[R]): the k-th arrived drop of every run at once, for k up to
-    the most drops that arrived in one run, so a batch loops over arrivals, not over drops."""
-    runs, agents = arrived.shape
-    order = jax.vmap(lambda a: jnp.nonzero(a, size=agents, fill_value=0)[0])(arrived)
-    count = jnp.sum(arrived, axis=1)
-    keep = (1.0 - rho_n)[:, None]
-    run = jnp.arange(runs)
-
-    def one_drop(k, soil):
-        drop = order[:, k]  # every run's k-th arrived drop, i32[R]
-        slot = slots[run, drop]
-        row = jnp.where((k < count)[:, None] & (slot >= 0), here[run, drop], num_nodes)
-        column = jnp.maximum(slot, 0).astype(jnp.int32)
-        before = soil[run[:, None], jnp.minimum(row, num_nodes - 1), column]
-        updated = keep * before - rho_n[:, None] * taken[run, drop]
-        return soil.at[run[:, None], row, column].set(updated, mode="drop")
-
-    return jax.lax.fori_loop(0, jnp.max(count), one_drop, soil)
+    row = jnp.where(slots >= 0, here, graph.num_nodes)  # out of range: dropped
+    column = jnp.maximum(slots, 0).astype(jnp.int32)
+    before = soil[jnp.minimum(row, graph.num_nodes - 1), column]
+    updated = (1.0 - params.rho_n) * before - params.rho_n * taken
+    return soil.at[row, column].set(updated, mode="drop")
 
 
 def goal_log_desirability(graph: Graph, goal) -> jax.Array:

@@ -10,7 +10,7 @@ from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_
                                          SMALLEST_COMPACTION, STEPS_PER_REFILL, Walk,
                                          lanes_for, visited_nodes, walk)
 from jaxswarm.swarm.walking.log import MoveLog
-from jaxswarm.swarm.walking.moves import move_widths, on_moves, on_walk
+from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves, on_walk
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
@@ -18,6 +18,6 @@ from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
 
 __all__ = ["AGENTS_PER_LANE", "COMPACT_SHARE", "EdgeGroups", "FEWEST_LANES", "FORCED", "LANES",
            "Move", "MoveLog", "SMALLEST_COMPACTION", "STEPS_PER_REFILL", "StepHook", "Walk",
-           "edge_groups", "edge_table", "goal_log_distance", "heads", "lanes_for",
+           "edge_groups", "edge_table", "fold_agents", "goal_log_distance", "heads", "lanes_for",
            "move_widths", "neighbour_slots", "on_moves", "on_walk", "sample_masked",
            "step_budget", "uniforms", "visited_nodes", "walk"]

@@ -109,8 +109,9 @@ def backtracking_walk(key: jax.Array, graph: Graph, choice: ChoiceRule, start, g
 
     Agent ``a`` draws from ``fold_in(key, a)``; all read the same ``choice`` (a memory that
     does not change during the walk). Its log holds the way without its dead ends, so at most
-    ``max_steps`` moves (an agent that found no way: none); ``moves`` counts every move the agent made,
-    back-outs included (the work done), ``stuck`` marks an agent that tried every way in vain.
+    ``max_steps`` moves (an agent that found no way: none); ``moves`` counts every move the agent
+    made, back-outs included (the work done), ``stuck`` marks an agent that tried every way in
+    vain.
 
     Args:
       key: PRNG key.

@@ -21,7 +21,8 @@ for every move).
 
 Reading the log: :func:`paths` gives agents' paths and slots padded to a width (the columns a
 rule needs, cut as :func:`~jaxswarm.swarm.walking.moves.on_walk` cuts them), :func:`columns`
-some columns of every agent's path, :func:`agent_path` one agent's whole path, and
+some columns of every agent's path, :func:`agent_rows` one agent's row of them,
+:func:`agent_path` one agent's whole path, and
 :func:`all_same` whether every agent walked the same moves.
 """
 from __future__ import annotations
@@ -186,6 +187,19 @@ def paths(log: MoveLog, width: int | None = None):
     path, _ = columns(log, jnp.arange(width + 1))
     _, slots = columns(log, jnp.arange(width))
     return path, slots
+
+
+def agent_rows(log: MoveLog, agent: jax.Array, width: int):
+    """One agent's row of :func:`paths`: ``(path i32[width + 1], slots [width])`` of agent
+    ``agent`` (i32[]), its first ``width`` moves; an ``agent`` past the last (``>= A``) made
+    no moves (the start, then -1; slots -1)."""
+    count = log.moves.shape[0]
+    known = jnp.minimum(agent, count - 1)
+    one = dataclasses.replace(log, offset=log.offset[known][None],
+                              moves=jnp.where(agent < count, log.moves[known], 0)[None])
+    path, _ = columns(one, jnp.arange(width + 1))
+    _, slots = columns(one, jnp.arange(width))
+    return path[0], slots[0]
 
 
 def agent_path(log: MoveLog, agent: jax.Array, length: int) -> jax.Array:
