@@ -18,6 +18,11 @@ or its solution breaks a rule.
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
 map.
 
+``jaxswarm tune FILE`` searches a swarm's open constants as a TOML file describes (see
+:mod:`jaxswarm.tune.spec`: iterated racing, random search, the grid or evolution strategies on
+training instances), rescores the best settings beside the swarm's defaults on held-out
+instances and prints them; a killed tune resumes from its store.
+
 ``jaxswarm replay STORE ROW`` runs one row of a sweep store (or of a table's ``runs.csv``) again,
 alone (:mod:`jaxswarm.sweep.replay`), prints the stored and the replayed figures, draws the run and
 exits with status 1 when the replay does not reproduce the row bit for bit.
@@ -62,13 +67,15 @@ def main(argv: list[str] | None = None) -> int:
             parser.error(f"--threads: {error}")
     try:
         command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
-                   "sweep": run_sweep_command, "replay": run_replay}
+                   "sweep": run_sweep_command, "tune": run_tune_command,
+                   "replay": run_replay}
         return command[args.command](args)
     except ValueError as error:
         parser.exit(2, f"jaxswarm {args.command}: error: {error}\n")
     except KeyboardInterrupt:
-        resume = ("; the finished chunks are kept: run the same command again to resume"
-                  if args.command == "sweep" else "")
+        kept = {"sweep": "chunks", "tune": "batches"}.get(args.command)
+        resume = (f"; the finished {kept} are kept: run the same command again to resume"
+                  if kept else "")
         parser.exit(130, f"jaxswarm {args.command}: interrupted{resume}\n")
 
 
@@ -83,6 +90,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_robot_parser(commands)
     _add_mapf_parser(commands)
     _add_sweep_parser(commands)
+    _add_tune_parser(commands)
     _add_replay_parser(commands)
     return parser
 
@@ -165,6 +173,20 @@ def _add_sweep_parser(subparsers) -> None:
     sweep.add_argument("--no-plots", action="store_true", help="write no figures")
 
 
+def _add_tune_parser(subparsers) -> None:
+    """The ``tune`` sub-command: search a swarm's constants from a TOML file."""
+    tune = subparsers.add_parser(
+        "tune", help="search a swarm's open constants (iterated racing, random search, grid or "
+                     "evolution strategies) and rescore the best on held-out instances",
+        description="Search the params a TOML tune spec names (see jaxswarm.tune.spec and "
+                    "docs/tuning.md) on its training instances within its budget of runs, then "
+                    "rescore the best settings and the swarm's defaults on its held-out "
+                    "instances. Writes the runs (resumable), the race's log and figure, "
+                    "held_out.csv and best.json.")
+    tune.add_argument("file", type=Path, help="the tune spec (TOML)")
+    tune.add_argument("--out", type=Path, help="tune directory (default out/tune/NAME)")
+
+
 def _add_replay_parser(subparsers) -> None:
     """The ``replay`` sub-command: run one row of a sweep store again, alone."""
     replay = subparsers.add_parser(
@@ -220,6 +242,25 @@ def run_sweep_command(args: argparse.Namespace) -> int:
         "map", sort=False).head(1)
     print("best params per map (highest success rate, then lowest mean gap):")
     print(best.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    return 0
+
+
+def run_tune_command(args: argparse.Namespace) -> int:
+    """Check the spec (before any compute), run or resume the tune, print the held-out table."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from jaxswarm.tune import default_tune_out, load_tune_spec, tune
+
+    spec = load_tune_spec(args.file)
+    out = args.out if args.out is not None else default_tune_out(spec)
+    print(f"tune {spec.name}: {spec.algorithm} by {spec.method}, {len(spec.space.free)} "
+          f"param(s), {spec.budget} training runs on {len(spec.training.pairs)} instance(s), "
+          f"objective {spec.objective} -> {out}")
+    result = tune(spec, out)
+    print(f"{result.runs_spent} training runs; on {len(spec.held_out.pairs)} held-out "
+          "instance(s), 95 % intervals over the instances:")
+    print(result.held_out.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     return 0
 
 

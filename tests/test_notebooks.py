@@ -11,6 +11,9 @@ The notebooks also check their own results with ``assert``. After a run, the tes
   shown inline.
 * dynamic: the JSON line of its ``checks`` cell (three swarms continued after the goal moved, none
   beating the new optimum) and the GIF it wrote under ``tmp_path``.
+* tuning: the JSON line of its ``checks`` cell (a race and a random search within their budget,
+  each rescored on the held-out map), the race's figure shown inline and its files under
+  ``tmp_path``.
 * many_agents: the JSON line of its ``checks`` cell (the three multi-agent planners solve, their
   solutions validate, none beats the lower bound or CBS), the GIF it wrote under ``tmp_path`` and
   the logs of the A* report's two examples.
@@ -235,3 +238,18 @@ def test_many_agents(notebook_env):
     for example in examples.values():
         assert example["cbs"] <= example["report"]
     assert count_images(nb) >= 2
+
+
+@pytest.mark.slow  # two tunes of IWD on 20 x 20 maps: one compile, about 30 s
+def test_tuning(notebook_env):
+    nb = execute("tuning.ipynb")
+    checks = [cell for cell in nb.cells if "checks" in cell.metadata.get("tags", [])]
+    assert len(checks) == 1
+    result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
+    assert 0 < result["race_runs"] <= 60 and 0 < result["random_runs"] <= 60
+    assert result["races"] >= 1 and len(result["held_out"]) >= 2
+    out = Path(result["out"])
+    assert out.parent.parent == notebook_env
+    for name in ("race.csv", "race.png", "held_out.csv", "best.json"):
+        assert (out / name).is_file()
+    assert count_images(nb) >= 1

@@ -29,7 +29,7 @@ from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_resul
                             spec_from_dict)
 from jaxswarm.sweep.maps import resolve_map
 from jaxswarm.sweep.replay import replay_row
-from jaxswarm.sweep.runner import group_size
+from jaxswarm.sweep.batches import group_size
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 
 REPO = Path(__file__).resolve().parents[1]

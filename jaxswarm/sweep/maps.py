@@ -203,6 +203,24 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
                     scenario.goal)
 
 
+def resolve_maps(entries, key: str, source: str, base_dir: Path | None = None) -> list[SweepMap]:
+    """Every map entry of ``entries`` (a spec's list at ``key``), resolved and its start and goal
+    checked (:func:`resolve_map`, :func:`check_query`).
+
+    Raises:
+      ValueError: naming the spec file ``source``, the entry (``key[i]``) and the problem.
+    """
+    maps = []
+    for i, entry in enumerate(entries):
+        try:
+            sweep_map = resolve_map(entry, base_dir)
+            check_query(sweep_map)
+        except ValueError as error:
+            raise ValueError(f"{source}: {key}[{i}] = {entry!r}: {error}") from None
+        maps.append(sweep_map)
+    return maps
+
+
 def check_query(sweep_map: SweepMap) -> None:
     """Check that a resolved map's start and goal are on the map and free.
 

@@ -70,7 +70,7 @@ class SweepSpec:
         resumed sweep skips).
       vmap_size: runs vmapped together on one device; a device goes through its share of a
         chunk that many at a time, the walks of a group sharing one queue of agents. None:
-        enough runs to fill the walker's lanes (:func:`jaxswarm.sweep.runner.group_size`). It
+        enough runs to fill the walker's lanes (:func:`jaxswarm.sweep.batches.group_size`). It
         changes speed, never results.
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).
@@ -144,13 +144,13 @@ def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
         raise SpecError(f"{source}: {key}: {problem}")
 
     sweep = _sweep_table(document, fail)
-    algorithm, name = _algorithm_and_name(sweep, fail)
-    maps = _maps(sweep["maps"], fail)
-    seeds = _seeds(sweep["seeds"], fail)
+    algorithm, name = algorithm_and_name(sweep, fail)
+    maps = check_maps(sweep["maps"], fail)
+    seeds = check_seeds(sweep["seeds"], fail)
     options = _run_options(sweep, fail)
     config = document.get("config", {})
-    swarm = _configured_swarm(algorithm, config, fail)
-    _check_map_worlds(maps, swarm, algorithm, fail)
+    swarm = configured_swarm(algorithm, config, fail)
+    check_map_worlds(maps, swarm, algorithm, fail)
     params = document.get("params", {})
     checked = _params(params, swarm, algorithm, fail)
     spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds, **options,
@@ -190,27 +190,29 @@ def _sweep_table(document: dict, fail) -> dict:
     return sweep
 
 
-def _algorithm_and_name(sweep: dict, fail) -> tuple[str, str]:
-    """``(algorithm, name)``: a registered swarm and the sweep's name (default: the
-    algorithm's), a non-empty string without '/' since it names a directory."""
-    algorithm = sweep["algorithm"]
+def algorithm_and_name(table: dict, fail, section: str = "sweep") -> tuple[str, str]:
+    """``(algorithm, name)`` of a spec's ``[section]`` table: a registered swarm and the spec's
+    name (default: the algorithm's), a non-empty string without '/' since it names a
+    directory; ``fail(key, problem)`` raises."""
+    algorithm = table["algorithm"]
     if algorithm not in swarm_registry.registered():
-        fail("sweep.algorithm", f"unknown algorithm {algorithm!r}; registered: "
+        fail(f"{section}.algorithm", f"unknown algorithm {algorithm!r}; registered: "
              f"{', '.join(swarm_registry.registered())}")
-    name = sweep.get("name", algorithm)
+    name = table.get("name", algorithm)
     if not isinstance(name, str) or not name or "/" in name:
-        fail("sweep.name", f"must be a non-empty string without '/', got {name!r}")
+        fail(f"{section}.name", f"must be a non-empty string without '/', got {name!r}")
     return algorithm, name
 
 
-def _maps(maps: Any, fail) -> list:
-    """The map entries, a non-empty list of entries that :func:`check_map_entry` accepts."""
+def check_maps(maps: Any, fail, key: str = "sweep.maps") -> list:
+    """The map entries at ``key``, a non-empty list of entries that
+    :func:`jaxswarm.sweep.maps.check_map_entry` accepts; ``fail(key, problem)`` raises."""
     if not isinstance(maps, list) or not maps:
-        fail("sweep.maps", "must be a non-empty list")
+        fail(key, "must be a non-empty list")
     for i, entry in enumerate(maps):
         problem = check_map_entry(entry)
         if problem:
-            fail(f"sweep.maps[{i}]", problem)
+            fail(f"{key}[{i}]", problem)
     return maps
 
 
@@ -218,22 +220,22 @@ def _run_options(sweep: dict, fail) -> dict:
     """The [sweep] numbers that shape every run, as :class:`SweepSpec` fields: ``iterations``
     (default 100), ``patience`` (default None), ``chunk_size`` (default
     ``DEFAULT_CHUNK_SIZE``) and ``vmap_size`` (default None), each a positive integer."""
-    iterations = _positive_int(sweep.get("iterations", 100), "sweep.iterations", fail)
+    iterations = positive_int(sweep.get("iterations", 100), "sweep.iterations", fail)
     patience = sweep.get("patience")
     if patience is not None:
-        patience = _positive_int(patience, "sweep.patience", fail)
-    chunk_size = _positive_int(sweep.get("chunk_size", DEFAULT_CHUNK_SIZE), "sweep.chunk_size",
+        patience = positive_int(patience, "sweep.patience", fail)
+    chunk_size = positive_int(sweep.get("chunk_size", DEFAULT_CHUNK_SIZE), "sweep.chunk_size",
                                fail)
     vmap_size = sweep.get("vmap_size")
     if vmap_size is not None:
-        vmap_size = _positive_int(vmap_size, "sweep.vmap_size", fail)
+        vmap_size = positive_int(vmap_size, "sweep.vmap_size", fail)
     return dict(iterations=iterations, patience=patience, chunk_size=chunk_size,
                 vmap_size=vmap_size)
 
 
-def _configured_swarm(algorithm: str, config: Any, fail):
+def configured_swarm(algorithm: str, config: Any, fail):
     """The swarm the [config] table builds: a table of the factory's options that it
-    accepts."""
+    accepts; ``fail(key, problem)`` raises."""
     if not isinstance(config, dict):
         fail("[config]", "must be a table")
     accepted = swarm_registry.config_options(algorithm)
@@ -247,11 +249,11 @@ def _configured_swarm(algorithm: str, config: Any, fail):
         fail("[config]", str(error))
 
 
-def _check_map_worlds(maps: list, swarm, algorithm: str, fail) -> None:
-    """Every map is of the world the swarm plans on (a graph or a plane)."""
+def check_map_worlds(maps: list, swarm, algorithm: str, fail, key: str = "sweep.maps") -> None:
+    """Every map at ``key`` is of the world the swarm plans on (a graph or a plane)."""
     for i, entry in enumerate(maps):
         if entry_world(entry) is not swarm.world:
-            fail(f"sweep.maps[{i}]", f"{algorithm} plans on a {swarm.world.__name__}, this map "
+            fail(f"{key}[{i}]", f"{algorithm} plans on a {swarm.world.__name__}, this map "
                  f"is a {entry_world(entry).__name__}")
 
 
@@ -280,22 +282,23 @@ def _check_grid(spec: SweepSpec, swarm, fail) -> None:
             fail(f"params.{key}" if key in combination else key, str(error))
 
 
-def _seeds(value: Any, fail) -> tuple[int, ...]:
-    """A seed count (``range(count)``) or an explicit list of distinct non-negative integers."""
+def check_seeds(value: Any, fail, key: str = "sweep.seeds") -> tuple[int, ...]:
+    """The seeds at ``key``: a count (``range(count)``) or an explicit list of distinct
+    non-negative integers."""
     if isinstance(value, int) and not isinstance(value, bool):
         if value < 1:
-            fail("sweep.seeds", f"must be at least 1, got {value}")
+            fail(key, f"must be at least 1, got {value}")
         return tuple(range(value))
     if isinstance(value, list) and value and all(
             isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value):
         if len(set(value)) != len(value):
-            fail("sweep.seeds", "repeats a seed")
+            fail(key, "repeats a seed")
         return tuple(value)
-    fail("sweep.seeds", f"must be a count or a non-empty list of non-negative integers, "
-         f"got {value!r}")
+    fail(key, f"must be a count or a non-empty list of non-negative integers, got {value!r}")
 
 
-def _positive_int(value: Any, key: str, fail) -> int:
+def positive_int(value: Any, key: str, fail) -> int:
+    """``value`` when it is a positive integer; else ``fail(key, problem)``."""
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         fail(key, f"must be a positive integer, got {value!r}")
     return value
@@ -303,12 +306,12 @@ def _positive_int(value: Any, key: str, fail) -> int:
 
 def _values(value: Any, key: str, fail) -> tuple[float, ...]:
     """A param's values: a number, a list of numbers, or a range table."""
-    if _is_number(value):
+    if is_number(value):
         return (float(value),)
     if isinstance(value, list):
         if not value:
             fail(key, "empty list: a sweep needs at least one value")
-        if not all(_is_number(v) for v in value):
+        if not all(is_number(v) for v in value):
             fail(key, f"values must be numbers, got {value!r}")
         return tuple(float(v) for v in value)
     if isinstance(value, dict):
@@ -325,7 +328,7 @@ def _range(table: dict, key: str, fail) -> tuple[float, ...]:
     if "start" not in table or "stop" not in table:
         fail(key, "a range needs start and stop")
     start, stop = table["start"], table["stop"]
-    if not (_is_number(start) and _is_number(stop)):
+    if not (is_number(start) and is_number(stop)):
         fail(key, "start and stop must be numbers")
     if ("num" in table) == ("step" in table):
         fail(key, "give exactly one of num (inclusive linspace) and step (arange)")
@@ -341,7 +344,7 @@ def _range(table: dict, key: str, fail) -> tuple[float, ...]:
             values = np.linspace(start, stop, num)
     else:
         step = table["step"]
-        if not _is_number(step) or step == 0 or (stop - start) / step < 0:
+        if not is_number(step) or step == 0 or (stop - start) / step < 0:
             fail(key, f"step {step!r} does not lead from {start} to {stop}")
         values = np.arange(start, stop, step)
     if len(values) == 0:
@@ -349,5 +352,6 @@ def _range(table: dict, key: str, fail) -> tuple[float, ...]:
     return tuple(float(v) for v in values)
 
 
-def _is_number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
+    """Whether ``value`` is an int or a float (not a bool)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)

@@ -28,6 +28,7 @@ import numpy as np
 import optax
 
 from jaxswarm.runtime.arithmetic import ordered_sum
+from jaxswarm.runtime.evolution import antithetic_gradient
 from jaxswarm.swarm.core import Swarm, Task, run
 from jaxswarm.world.plane import Plane
 
@@ -147,9 +148,8 @@ def es_search(key: jax.Array, score: Callable[[jax.Array], Score], start, seeds:
         eps = jax.random.normal(noise_key, (pairs, 3))
         tried = jnp.maximum(jnp.concatenate([mean + sigma * eps, mean - sigma * eps]), 0.0)
         result = jax.device_get(score(tried))
-        ranks = _centred_ranks(np.asarray(result.objective))
-        gradient = jnp.asarray((ranks[:pairs] - ranks[pairs:]) @ np.asarray(eps)) / (
-            2 * pairs * sigma)
+        gradient = jnp.asarray(antithetic_gradient(np.asarray(eps), np.asarray(result.objective),
+                                                   sigma))
         updates, state = optimizer.update(gradient, state, mean)
         mean = jnp.maximum(optax.apply_updates(mean, updates), 0.0)
         path.append(np.asarray(mean))
@@ -160,11 +160,3 @@ def es_search(key: jax.Array, score: Callable[[jax.Array], Score], start, seeds:
                   score=jax.tree_util.tree_map(lambda *leaves: np.concatenate(leaves), *scores),
                   step=np.concatenate(at), runs=steps * 2 * pairs * seeds, path=np.stack(path))
 
-
-def _centred_ranks(values: np.ndarray) -> np.ndarray:
-    """Ranks scaled to [-0.5, 0.5] (ties share the mean of their ranks)."""
-    order = np.argsort(np.argsort(values, kind="stable"), kind="stable").astype(np.float64)
-    for value in np.unique(values):
-        same = values == value
-        order[same] = order[same].mean()
-    return order / max(len(values) - 1, 1) - 0.5

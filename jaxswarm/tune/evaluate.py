@@ -1,0 +1,213 @@
+"""Scoring settings on instances: the runs a tuner asks for, made once and stored.
+
+Every request of a tune (settings x instances) is one numbered batch of runs: the runs go through
+the swarm's compiled batches (:class:`~jaxswarm.sweep.batches.RunBatches`, one per value of the
+static params), and the batch's rows go to the tune's results store
+(:class:`~jaxswarm.sweep.store.ResultsStore`, one Parquet file per batch, written atomically).
+A tuner is deterministic given its spec and its results, so a tune killed and started again
+asks for the same batches in the same order: a batch the store holds is read back instead of
+run (the store checks that it holds the same settings on the same instances), so nothing is
+lost or run twice.
+
+Per run, the objective is a loss (lower is better):
+
+* ``success``: 0 when the run's path is within ``SUCCESS_GAP`` (1e-4) of the optimum, else 1;
+  reported as the success rate ``1 - mean``;
+* ``gap``: the relative gap to the optimum, ``unsolved_gap`` (10, a gap of 1,000 %: worse than
+  the paths these swarms find) for a run without a path;
+* ``time_to_target``: the iterations until the best path was within the gap of the optimum,
+  twice the iteration budget when it never was (PAR2, as algorithm configurators count a
+  timeout);
+* ``evaluations``: the fitness evaluations until then, twice the budget's
+  (``iterations x num_agents``) when never.
+"""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from jaxswarm.swarm import definition
+from jaxswarm.swarm.fingerprint import hex_fingerprint
+from jaxswarm.sweep.batches import RunBatches
+from jaxswarm.sweep.maps import resolve_maps
+from jaxswarm.sweep.runner import SUCCESS_GAP, provenance
+from jaxswarm.sweep.store import ResultsStore
+from jaxswarm.tune.spec import TuneSpec
+
+TRAINING, HELD_OUT = "training", "held_out"
+"""The two phases of a tune: the search, on training instances, and the rescoring of its best
+settings on held-out ones."""
+
+
+class StoreConflictError(ValueError):
+    """A tune's store holds another batch where this tune asks for one."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Setting:
+    """A setting a tuner made: its number (in the order the tuner made them) and its values
+    (name -> value of every param of the space)."""
+
+    number: int
+    values: dict
+
+
+def run_losses(spec: TuneSpec, rows: pd.DataFrame, num_agents: int) -> np.ndarray:
+    """f64[C] each row's loss under ``spec.objective`` (see the module docstring)."""
+    if spec.objective == "success":
+        return 1.0 - rows["success"].to_numpy(np.float64)
+    if spec.objective == "gap":
+        return np.where(rows["found"], rows["gap"], spec.unsolved_gap).astype(np.float64)
+    if spec.objective == "time_to_target":
+        reached = rows["target_iterations"].to_numpy()
+        return np.where(reached >= 0, reached, 2 * spec.iterations).astype(np.float64)
+    reached = rows["target_evaluations"].to_numpy()
+    return np.where(reached >= 0, reached,
+                    2 * spec.iterations * num_agents).astype(np.float64)
+
+
+def reported(spec: TuneSpec, losses: np.ndarray) -> float:
+    """The objective as reported from losses: the success rate for ``success``, else the mean
+    loss."""
+    mean = float(np.mean(losses))
+    return 1.0 - mean if spec.objective == "success" else mean
+
+
+class Evaluator:
+    """A tune's runs: settings scored on instances, batch by batch, through its store.
+
+    Attributes:
+      spec: the tune.
+      maps: the training and held-out maps, resolved (phase -> list of SweepMap).
+      runs_spent: training runs made or read back so far (the budget counts these).
+    """
+
+    def __init__(self, spec: TuneSpec, out, log: Callable[[str], None] = print):
+        """Resolve every map of ``spec`` (naming the entry that fails, before anything is
+        written) and open (or resume) the store at ``out``.
+
+        Raises:
+          ValueError: a map cannot be resolved.
+          StoreMismatchError: ``out`` holds another tune or another definition of the swarm.
+        """
+        self.spec = spec
+        self.log = log
+        base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
+        self.maps = {phase: resolve_maps(instances.maps, f"tune.{phase}.maps", spec.source,
+                                         base_dir)
+                     for phase, instances in ((TRAINING, spec.training),
+                                              (HELD_OUT, spec.held_out))}
+        self._optimum = {phase: [m.optimum() for m in maps] for phase, maps in self.maps.items()}
+        self._batches: dict = {}
+        swarm = self._batches_for({}).swarm
+        self.store = ResultsStore(Path(out), spec.as_dict(),
+                                  dict(provenance(), swarm=definition(swarm)))
+        self.runs_spent = 0
+        self._next = 0
+
+    def score(self, settings: list[Setting], instances: list[tuple[int, int]], *,
+              phase: str = TRAINING, iteration: int = 0) -> np.ndarray:
+        """f64[len(settings), len(instances)] the losses of every setting on every instance
+        (``(map index, seed)`` of ``phase``'s maps): :meth:`rows`' ``loss``."""
+        rows = self.rows(settings, instances, phase=phase, iteration=iteration)
+        return rows["loss"].to_numpy(np.float64).reshape(len(settings), len(instances))
+
+    def rows(self, settings: list[Setting], instances: list[tuple[int, int]], *,
+             phase: str = TRAINING, iteration: int = 0) -> pd.DataFrame:
+        """The runs of every setting on every instance (setting-major), as one numbered batch
+        of the store: read back when the store holds it, else run and written. ``iteration``
+        (the race's) is recorded with the rows."""
+        number = self._next
+        self._next += 1
+        if self.store.finished(0, number):
+            rows = pd.read_parquet(self.store.chunk_path(0, number))
+            _check_same(rows, settings, instances, phase, self.store.chunk_path(0, number))
+        else:
+            rows = self._run(settings, instances, phase, iteration, number)
+            self.store.write_chunk(0, number, {k: v.to_numpy() if k not in _TEXT else
+                                               v.tolist() for k, v in rows.items()})
+        if phase == TRAINING:
+            self.runs_spent += len(rows)
+        return rows
+
+    def _run(self, settings, instances, phase, iteration, number) -> pd.DataFrame:
+        """The rows of every setting on every instance, setting-major."""
+        spec = self.spec
+        frames = []
+        static_names = spec.space.static
+        groups: dict = {}
+        for s, setting in enumerate(settings):
+            key = tuple(setting.values[name] for name in static_names)
+            groups.setdefault(key, []).append(s)
+        parts = {}
+        for key, members in groups.items():
+            batches = self._batches_for(dict(zip(static_names, key)))
+            for i, (map_index, seed) in enumerate(instances):
+                sweep_map = self.maps[phase][map_index]
+                optimum = self._optimum[phase][map_index]
+                params = {name: np.array([float(settings[s].values[name]) for s in members])
+                          for name in spec.space.domains if name not in static_names}
+                params |= {name: np.full(len(members), value)
+                           for name, value in spec.fixed.items()}
+                outputs = batches.run(sweep_map, np.full(len(members), seed), params,
+                                      target=optimum * (1 + SUCCESS_GAP))
+                for j, s in enumerate(members):
+                    parts[s, i] = {name: value[j] for name, value in outputs.items()} | dict(
+                        map_index=map_index, map=sweep_map.label, seed=seed, optimum=optimum,
+                        num_agents=batches.swarm.config.num_agents)
+        for s, setting in enumerate(settings):
+            for i in range(len(instances)):
+                part = parts[s, i]
+                frames.append(dict(batch=number, phase=phase, iteration=iteration,
+                                   setting=setting.number, instance=i, map=part["map"],
+                                   map_index=part["map_index"], seed=part["seed"],
+                                   **{f"param.{k}": float(v) for k, v in setting.values.items()},
+                                   **_outcome(part)))
+        rows = pd.DataFrame(frames)
+        num_agents = rows.pop("num_agents").to_numpy()
+        rows["loss"] = run_losses(spec, rows, num_agents)
+        return rows
+
+    def _batches_for(self, static: dict) -> RunBatches:
+        """The compiled batches of the swarm with the static params ``static``."""
+        key = tuple(sorted(static.items()))
+        if key not in self._batches:
+            spec = self.spec
+            self._batches[key] = RunBatches(spec.algorithm, {**spec.config, **static},
+                                            spec.iterations, spec.patience, spec.chunk_size,
+                                            log=self.log, fit_calls=True)
+        return self._batches[key]
+
+
+_TEXT = ("phase", "map")
+
+
+def _outcome(part: dict) -> dict:
+    """A run's outcome columns from its outputs."""
+    cost, optimum = float(part["cost"]), float(part["optimum"])
+    found = np.isfinite(cost)
+    gap = (cost - optimum) / optimum if found and optimum > 0 else np.nan
+    return dict(cost=cost, optimum=optimum, gap=gap, found=bool(found),
+                success=bool(found and gap < SUCCESS_GAP),
+                iterations=int(part["iterations"]), moves=int(part["moves"]),
+                evaluations=int(part["evaluations"]),
+                target_iterations=int(part["target_iterations"]),
+                target_evaluations=int(part["target_evaluations"]),
+                fingerprint=hex_fingerprint(part["fingerprint"]),
+                seconds=float(part["seconds"]), num_agents=int(part["num_agents"]))
+
+
+def _check_same(rows: pd.DataFrame, settings, instances, phase, path) -> None:
+    """The stored batch ``rows`` holds ``settings`` on ``instances`` of ``phase``."""
+    want = [(setting.number, i) for setting in settings for i in range(len(instances))]
+    got = list(zip(rows["setting"], rows["instance"]))
+    seeds = [seed for _ in settings for _, seed in instances]
+    if got != want or list(rows["phase"]) != [phase] * len(want) or list(rows["seed"]) != seeds:
+        raise StoreConflictError(
+            f"{path} holds another batch than this tune asks for (a tune's batches follow from "
+            "its spec: was the store written by another version?); choose another --out or "
+            "delete it")

@@ -1,0 +1,337 @@
+"""Tune specifications: a TOML file that names a swarm, its search space, the instances, a
+budget, an objective and a method, checked before any compute::
+
+    # What it asks, in a sentence or two.
+    [tune]
+    name = "iwd_open_constants"      # results go to out/tune/<name> unless --out is given
+    algorithm = "iwd"
+    method = "race"                  # race | random | grid | es
+    budget = 1200                    # runs of the swarm, training instances only
+    objective = "gap"                # success | gap | time_to_target | evaluations
+    iterations = 100
+    patience = 30                    # optional, as in a sweep
+    seed = 0                         # the tuner's own key: draws and instance order
+    chunk_size = 64                  # optional: runs per compiled call
+
+    [tune.training]                  # instances = every (map, seed) pair
+    maps = ["maze20", "mosaic20", "alley20"]
+    seeds = 10
+
+    [tune.held_out]                  # rescored after the search, never searched on
+    maps = ["maze100"]
+    seeds = [1000, 1001, 1002]
+
+    [tune.race]                      # optional: irace's settings
+    first_test = 5                   # instances before the first test
+    alpha = 0.05                     # the tests' level
+
+    [config]                         # static: the swarm factory's options
+    num_agents = 50                  # fixed
+    # num_agents = { choices = [16, 64] } would tune it: each value compiles on its own
+
+    [params]                         # traced
+    alpha = { low = 0.5, high = 4.0 }
+    beta = { tied = "alpha" }        # IWD's alpha = beta: one param of the space
+    rho_n = { low = 0.01, high = 0.99, log = true }
+    initial_soil = 10000             # fixed at a value (not searched)
+
+Also ``{ low = 1, high = 8, integer = true }`` and ``{ choices = [0.1, 0.5, 0.9] }``; under
+``[tune]`` ``grid_points`` (method grid: values per numeric param, default the most that fit
+the budget), ``es_pairs``, ``es_sigma`` and ``es_learning_rate`` (method es), and
+``unsolved_gap`` (objective gap: the gap a run without a path counts, default 10.0, worse than
+the paths these swarms find). Every
+mistake raises :class:`TuneSpecError` naming the file and the key.
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from jaxswarm.sweep.spec import (DEFAULT_CHUNK_SIZE, algorithm_and_name, check_map_worlds,
+                                 check_maps, check_seeds, configured_swarm, is_number,
+                                 positive_int)
+from jaxswarm.swarm import registry as swarm_registry
+from jaxswarm.tune.space import Choice, Integer, Real, Space, Tied
+
+METHODS = ("race", "random", "grid", "es")
+"""The search methods (:mod:`jaxswarm.tune.race`, :mod:`jaxswarm.tune.search`)."""
+
+OBJECTIVES = ("success", "gap", "time_to_target", "evaluations")
+"""What a tune scores each run by (:mod:`jaxswarm.tune.evaluate`)."""
+
+TUNE_KEYS = {"name", "algorithm", "method", "budget", "objective", "iterations", "patience",
+             "seed", "chunk_size", "training", "held_out", "race", "grid_points", "es_pairs",
+             "es_sigma", "es_learning_rate", "unsolved_gap"}
+RACE_KEYS = {"first_test", "alpha"}
+INSTANCE_KEYS = {"maps", "seeds"}
+DOMAIN_KEYS = {"low", "high", "log", "integer", "choices", "tied"}
+
+
+class TuneSpecError(ValueError):
+    """A tune spec that cannot run; the message names the file and the key."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Instances:
+    """Instances of a tune: every (map, seed) pair.
+
+    Attributes:
+      maps: map entries as written (resolved by :mod:`jaxswarm.sweep.maps`).
+      seeds: the seeds; run ``s`` uses ``jax.random.key(s)``.
+    """
+
+    maps: tuple
+    seeds: tuple[int, ...]
+
+    @property
+    def pairs(self) -> list[tuple[int, int]]:
+        """``(map index, seed)`` of every instance, map-major."""
+        return list(itertools.product(range(len(self.maps)), self.seeds))
+
+
+@dataclasses.dataclass(frozen=True)
+class TuneSpec:
+    """A checked tune (see the module docstring for each field's meaning)."""
+
+    name: str
+    algorithm: str
+    method: str
+    budget: int
+    objective: str
+    iterations: int
+    patience: int | None
+    seed: int
+    chunk_size: int
+    training: Instances
+    held_out: Instances
+    config: dict
+    fixed: dict
+    space: Space
+    first_test: int = 5
+    alpha: float = 0.05
+    grid_points: int | None = None
+    es_pairs: int = 4
+    es_sigma: float = 0.1
+    es_learning_rate: float = 0.05
+    unsolved_gap: float = 10.0
+    source: str = "<dict>"
+
+    def as_dict(self) -> dict:
+        """JSON-ready form of everything that decides the tune's runs (its store's resume
+        check)."""
+        record = dataclasses.asdict(self)
+        record["space"] = {name: dict(kind=type(domain).__name__, **dataclasses.asdict(domain))
+                           for name, domain in self.space.domains.items()}
+        record.pop("source")
+        return record
+
+
+def load_tune_spec(path) -> TuneSpec:
+    """Read and check a tune file (see the module docstring).
+
+    Raises:
+      TuneSpecError: unreadable TOML, an unknown section or key, a bad value; the message names
+        the file and the key.
+    """
+    path = Path(path)
+    try:
+        document = tomllib.loads(path.read_text())
+    except OSError as error:
+        raise TuneSpecError(f"{path}: cannot read the tune file ({error.strerror})") from None
+    except tomllib.TOMLDecodeError as error:
+        raise TuneSpecError(f"{path}: not valid TOML: {error}") from None
+    return tune_spec_from_dict(document, source=str(path))
+
+
+def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
+    """Check a parsed tune spec (the TOML document as a dict); see :func:`load_tune_spec`."""
+    def fail(key: str, problem: str):
+        raise TuneSpecError(f"{source}: {key}: {problem}")
+
+    for section in document:
+        if section not in ("tune", "config", "params"):
+            fail(section, "unknown section; expected tune, config, params")
+    tune = _table(document.get("tune"), "[tune]", TUNE_KEYS, fail)
+    for key in ("algorithm", "budget", "training", "held_out"):
+        if key not in tune:
+            fail(f"tune.{key}", "missing")
+    algorithm, name = algorithm_and_name(tune, fail, "tune")
+    method = _one_of(tune.get("method", "race"), METHODS, "tune.method", fail)
+    objective = _one_of(tune.get("objective", "success"), OBJECTIVES, "tune.objective", fail)
+    config, static = _config(document.get("config", {}), algorithm, fail)
+    swarm = configured_swarm(algorithm, config, fail)
+    training = _instances(tune["training"], "tune.training", swarm, algorithm, fail)
+    held_out = _instances(tune["held_out"], "tune.held_out", swarm, algorithm, fail)
+    fixed, domains = _params(document.get("params", {}), swarm, algorithm, fail)
+    space = Space({**domains, **static})
+    if not space.free:
+        fail("[params]", "nothing to tune: give at least one range or choice")
+    race = _table(tune.get("race", {}), "tune.race", RACE_KEYS, fail)
+    alpha = race.get("alpha", 0.05)
+    if not is_number(alpha) or not 0 < alpha < 1:
+        fail("tune.race.alpha", f"must be a number in (0, 1), got {alpha!r}")
+    patience = tune.get("patience")
+    spec = TuneSpec(
+        name=name, algorithm=algorithm, method=method,
+        budget=positive_int(tune["budget"], "tune.budget", fail), objective=objective,
+        iterations=positive_int(tune.get("iterations", 100), "tune.iterations", fail),
+        patience=None if patience is None else positive_int(patience, "tune.patience", fail),
+        seed=_natural(tune.get("seed", 0), "tune.seed", fail),
+        chunk_size=positive_int(tune.get("chunk_size", DEFAULT_CHUNK_SIZE), "tune.chunk_size",
+                                fail),
+        training=training, held_out=held_out, config=config, fixed=fixed, space=space,
+        first_test=positive_int(race.get("first_test", 5), "tune.race.first_test", fail),
+        alpha=float(alpha),
+        grid_points=(None if "grid_points" not in tune
+                     else positive_int(tune["grid_points"], "tune.grid_points", fail)),
+        es_pairs=positive_int(tune.get("es_pairs", 4), "tune.es_pairs", fail),
+        es_sigma=_positive(tune.get("es_sigma", 0.1), "tune.es_sigma", fail),
+        es_learning_rate=_positive(tune.get("es_learning_rate", 0.05), "tune.es_learning_rate",
+                                   fail),
+        unsolved_gap=_positive(tune.get("unsolved_gap", 10.0), "tune.unsolved_gap", fail),
+        source=source)
+    _check_corners(spec, fail)
+    return spec
+
+
+def _table(value: Any, key: str, allowed: set, fail) -> dict:
+    """``value``, a table of only ``allowed`` keys."""
+    if not isinstance(value, dict):
+        fail(key, "missing section" if value is None else "must be a table")
+    for name in value:
+        if name not in allowed:
+            fail(f"{key.strip('[]')}.{name}",
+                 f"unknown key; expected one of {', '.join(sorted(allowed))}")
+    return value
+
+
+def _one_of(value: Any, allowed: tuple, key: str, fail) -> str:
+    if value not in allowed:
+        fail(key, f"must be one of {', '.join(allowed)}, got {value!r}")
+    return value
+
+
+def _natural(value: Any, key: str, fail) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        fail(key, f"must be a non-negative integer, got {value!r}")
+    return value
+
+
+def _positive(value: Any, key: str, fail) -> float:
+    if not is_number(value) or value <= 0:
+        fail(key, f"must be a positive number, got {value!r}")
+    return float(value)
+
+
+def _instances(table: Any, key: str, swarm, algorithm: str, fail) -> Instances:
+    """The instances at ``key``: maps of the swarm's world and seeds."""
+    table = _table(table, key, INSTANCE_KEYS, fail)
+    for name in INSTANCE_KEYS:
+        if name not in table:
+            fail(f"{key}.{name}", "missing")
+    maps = check_maps(table["maps"], fail, f"{key}.maps")
+    check_map_worlds(maps, swarm, algorithm, fail, f"{key}.maps")
+    return Instances(maps=tuple(maps), seeds=check_seeds(table["seeds"], fail, f"{key}.seeds"))
+
+
+def _config(config: Any, algorithm: str, fail) -> tuple[dict, dict]:
+    """``(fixed, static)``: the [config] values the swarm's factory accepts, and the tuned ones
+    as static choices, each value of which builds a swarm."""
+    if not isinstance(config, dict):
+        fail("[config]", "must be a table")
+    fixed = {name: value for name, value in config.items() if not isinstance(value, dict)}
+    static = {}
+    for name, value in config.items():
+        if isinstance(value, dict):
+            if set(value) != {"choices"}:
+                fail(f"config.{name}", "a tuned config value is { choices = [...] }")
+            static[name] = Choice(tuple(_choices(value["choices"], f"config.{name}", fail)),
+                                  static=True)
+            for choice in static[name].values:
+                configured_swarm(algorithm, {**fixed, name: choice}, fail)
+    return fixed, static
+
+
+def _choices(values: Any, key: str, fail) -> list:
+    if not isinstance(values, list) or len(values) < 2:
+        fail(key, f"choices must be a list of at least two values, got {values!r}")
+    if len(set(map(repr, values))) != len(values):
+        fail(key, "repeats a choice")
+    return values
+
+
+def _params(params: Any, swarm, algorithm: str, fail) -> tuple[dict, dict]:
+    """``(fixed, domains)``: the [params] table's fixed values and searched domains, for
+    params the swarm knows; a tied param names a searched one."""
+    if not isinstance(params, dict):
+        fail("[params]", "must be a table")
+    known = swarm.default_params._fields
+    fixed, domains = {}, {}
+    for name, value in params.items():
+        key = f"params.{name}"
+        if name not in known:
+            fail(key, f"unknown param of {algorithm}; known: {', '.join(known)}")
+        if is_number(value):
+            fixed[name] = float(value)
+        elif isinstance(value, dict):
+            domains[name] = _domain(value, key, fail)
+        else:
+            fail(key, f"must be a number or a table, got {value!r}")
+    for name, domain in domains.items():
+        if isinstance(domain, Tied) and not isinstance(domains.get(domain.to),
+                                                       (Real, Integer, Choice)):
+            fail(f"params.{name}.tied", f"{domain.to!r} is not a searched param of this spec")
+    return fixed, domains
+
+
+def _domain(table: dict, key: str, fail):
+    """A param's domain from its table."""
+    unknown = set(table) - DOMAIN_KEYS
+    if unknown:
+        fail(key, f"unknown keys {sorted(unknown)}; a range is low, high (log, integer), a "
+             "choice is choices, a tie is tied")
+    if "tied" in table:
+        if len(table) != 1 or not isinstance(table["tied"], str):
+            fail(key, "a tie is { tied = \"OTHER\" } alone")
+        return Tied(table["tied"])
+    if "choices" in table:
+        if len(table) != 1:
+            fail(key, "a choice is { choices = [...] } alone")
+        values = _choices(table["choices"], key, fail)
+        if not all(is_number(v) for v in values):
+            fail(key, f"choices of a param must be numbers, got {values!r}")
+        return Choice(tuple(float(v) for v in values))
+    if "low" not in table or "high" not in table:
+        fail(key, "a range needs low and high")
+    low, high = table["low"], table["high"]
+    if not (is_number(low) and is_number(high)) or not low < high:
+        fail(key, f"low and high must be numbers with low < high, got {low!r} and {high!r}")
+    log = table.get("log", False)
+    if not isinstance(log, bool) or (log and low <= 0):
+        fail(key, "log must be true or false, and a log range needs low > 0")
+    if table.get("integer", False):
+        if not (float(low).is_integer() and float(high).is_integer()):
+            fail(key, "an integer range needs integer low and high")
+        return Integer(int(low), int(high), log)
+    return Real(float(low), float(high), log)
+
+
+def _check_corners(spec: TuneSpec, fail) -> None:
+    """The lowest and highest value of every searched param (the others at the swarm's
+    defaults or fixed values) is a valid setting of the swarm, so an out-of-range bound fails
+    here, before any compute."""
+    swarm = swarm_registry.make(spec.algorithm, **spec.config)
+    for name in spec.space.numeric:
+        domain = spec.space.domains[name]
+        for bound in (domain.low, domain.high):
+            setting = {**spec.fixed, name: float(bound)}
+            for other, tie in spec.space.domains.items():
+                if isinstance(tie, Tied) and tie.to == name:
+                    setting[other] = float(bound)
+            try:
+                swarm.check_params(swarm.params_with(**setting))
+            except ValueError as error:
+                fail(f"params.{name}", f"{bound} is not a valid value: {error}")

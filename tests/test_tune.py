@@ -1,0 +1,300 @@
+"""The tuner: specs and their errors, the search space, iterated racing and the other methods on
+a planted objective, and a real tune on small maps that resumes after a kill to the same race."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from repo_scripts import load_script
+
+from jaxswarm.cli import main
+from jaxswarm.runtime.evolution import antithetic_gradient, centred_ranks
+from jaxswarm.sweep.batches import RunBatches
+from jaxswarm.sweep.maps import resolve_map
+from jaxswarm.sweep.store import ResultsStore
+from jaxswarm.tune import TuneSpecError, tune, tune_spec_from_dict
+from jaxswarm.tune.evaluate import Setting
+from jaxswarm.tune.race import iterated_race
+from jaxswarm.tune.search import es_search, grid_search, random_search
+from jaxswarm.tune.space import Choice, Integer, Real, Space, Tied, from_unit, to_unit
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def document(**changes):
+    """A small tune spec document: IWD's alpha (beta tied to it) and rho_n on two 20 x 20 paper
+    maps, held out on a third."""
+    tune_table = {"name": "tiny", "algorithm": "iwd", "method": "race", "budget": 60,
+                  "objective": "gap", "iterations": 4, "seed": 3, "chunk_size": 16,
+                  "training": {"maps": ["maze20", "mosaic20"], "seeds": 6},
+                  "held_out": {"maps": ["alley20"], "seeds": [100, 101]},
+                  "race": {"first_test": 3}}
+    doc = {"tune": tune_table, "config": {"num_agents": 8},
+           "params": {"alpha": {"low": 0.5, "high": 4.0}, "beta": {"tied": "alpha"},
+                      "rho_n": {"low": 0.01, "high": 0.9, "log": True}}}
+    for section, values in changes.items():
+        doc[section] = dict(doc.get(section, {}), **values)
+    return doc
+
+
+def test_a_spec_becomes_a_space_with_ties_and_fixed_values():
+    spec = tune_spec_from_dict(document(params={"initial_soil": 500}))
+    assert spec.space.free == ["alpha", "rho_n"]
+    assert spec.space.domains["beta"] == Tied("alpha")
+    assert spec.space.domains["rho_n"] == Real(0.01, 0.9, True)
+    assert spec.fixed == {"initial_soil": 500.0}
+    assert spec.training.pairs[:2] == [(0, 0), (0, 1)] and len(spec.training.pairs) == 12
+    assert spec.held_out.seeds == (100, 101)
+    assert json.loads(json.dumps(spec.as_dict()))["space"]["beta"] == {"kind": "Tied",
+                                                                        "to": "alpha"}
+
+
+@pytest.mark.parametrize("changes, message", [
+    (dict(tune={"budgett": 3}), "tune.budgett: unknown key"),
+    (dict(tune={"method": "bayes"}), "tune.method: must be one of race, random, grid, es"),
+    (dict(tune={"objective": "speed"}), "tune.objective: must be one of"),
+    (dict(tune={"algorithm": "bees"}), "tune.algorithm: unknown algorithm 'bees'"),
+    (dict(tune={"held_out": {"maps": ["maze20"]}}), "tune.held_out.seeds: missing"),
+    (dict(tune={"training": {"maps": ["maze21"], "seeds": 2}}), "tune.training.maps[0]"),
+    (dict(tune={"race": {"alpha": 2}}), "tune.race.alpha: must be a number in (0, 1)"),
+    (dict(params={"alpha": {"low": 4, "high": 1}}), "params.alpha: low and high must be"),
+    (dict(params={"beta": {"tied": "gamma"}}), "params.beta.tied: 'gamma' is not a searched"),
+    (dict(params={"rho_n": {"low": 0, "high": 1, "log": True}}), "params.rho_n: log must be"),
+    (dict(params={"rho": {"low": 0.1, "high": 0.5}}), "params.rho: unknown param of iwd"),
+    (dict(params={"rho_n": {"low": 0.5, "high": 3.0}}), "params.rho_n: 3.0 is not a valid"),
+    (dict(config={"num_agents": {"choices": [8, -1]}}), "[config]"),
+    (dict(config={"agents": 8}), "config.agents: unknown config of iwd"),
+    (dict(unknown={}), "unknown: unknown section"),
+])
+def test_a_bad_spec_names_its_key(changes, message):
+    with pytest.raises(TuneSpecError) as error:
+        tune_spec_from_dict(document(**changes), source="spec.toml")
+    assert str(error.value).startswith("spec.toml: ")
+    assert message in str(error.value)
+
+
+def test_nothing_to_tune_is_an_error():
+    fixed = document()
+    fixed["params"] = {"alpha": 1.0}
+    with pytest.raises(TuneSpecError, match=r"\[params\]: nothing to tune"):
+        tune_spec_from_dict(fixed)
+
+
+def test_the_space_draws_within_its_domains_on_their_scales():
+    space = Space({"a": Real(1e-3, 1e3, log=True), "n": Integer(1, 9), "c": Choice((0.5, 2.0)),
+                   "b": Tied("a")})
+    settings = space.uniform(np.random.default_rng(0), 400)
+    a = np.array([s["a"] for s in settings])
+    assert np.all((1e-3 <= a) & (a <= 1e3)) and all(s["b"] == s["a"] for s in settings)
+    assert 0.3 < np.mean(a < 1.0) < 0.7  # log-uniform: half the draws below the geometric mean
+    assert {s["n"] for s in settings} == set(range(1, 10))
+    assert {s["c"] for s in settings} == {0.5, 2.0}
+    assert len(space.grid(3)) == 3 * 3 * 2
+    assert sorted({s["a"] for s in space.grid(3)}) == pytest.approx([1e-3, 1.0, 1e3])
+    for domain, value in ((Real(2.0, 6.0), 5.0), (Real(0.01, 100.0, True), 1.0)):
+        assert from_unit(domain, to_unit(domain, value)) == pytest.approx(value)
+    assert to_unit(Real(0.01, 100.0, True), 1.0) == pytest.approx(0.5)
+
+
+class PlantedEvaluator:
+    """Scores settings of one param ``x`` by ``(x - 0.3)^2`` plus instance noise, counting
+    runs as the real evaluator does."""
+
+    def __init__(self, spec):
+        self.spec = spec
+        self.runs_spent = 0
+        self.batches = []
+
+    def score(self, settings, instances, *, phase="training", iteration=0):
+        self.runs_spent += len(settings) * len(instances)
+        self.batches.append((len(settings), len(instances)))
+        noise = np.array([np.random.default_rng(1000 + 7 * m + s).normal(0, 0.01)
+                          for m, s in instances])
+        return np.array([[(setting.values["alpha"] - 1.3) ** 2 + n for n in noise]
+                         for setting in settings])
+
+
+def planted(method, budget=600):
+    spec = tune_spec_from_dict(document(
+        tune={"method": method, "budget": budget, "training": {"maps": ["maze20"],
+                                                                "seeds": 40}},
+        params={"alpha": {"low": 0.5, "high": 4.0}, "beta": 1.0, "rho_n": 0.9}))
+    return spec, PlantedEvaluator(spec)
+
+
+def test_a_race_drops_settings_worse_than_the_best_and_closes_in_on_the_optimum():
+    spec, evaluator = planted("race")
+    result = iterated_race(evaluator, spec.space, {"alpha": 1.0}, np.random.default_rng(0))
+    assert evaluator.runs_spent <= spec.budget
+    assert result.settings[0].values == {"alpha": 1.0}  # the defaults race first
+    dropped = result.log[result.log["dropped"] != ""]
+    assert len(dropped) > 0 and set(dropped["dropped"]) <= {"conover"}
+    first = result.log[result.log["iteration"] == 1]
+    assert first["step"].min() == 1
+    assert (first.groupby("setting")["step"].max() >= spec.first_test).all()  # no early drop
+    worst = max(result.settings.values(), key=lambda s: abs(s.values["alpha"] - 1.3))
+    assert worst.number in set(dropped["setting"])  # the setting planted furthest is dropped
+    assert abs(result.elites[0].values["alpha"] - 1.3) < 0.15
+    assert result.log["iteration"].max() >= 2  # new settings drawn around the elites
+
+
+def test_a_race_is_the_same_race_from_the_same_key():
+    runs = []
+    for _ in range(2):
+        spec, evaluator = planted("race")
+        runs.append(iterated_race(evaluator, spec.space, {"alpha": 1.0},
+                                  np.random.default_rng(5)))
+    pd.testing.assert_frame_equal(runs[0].log, runs[1].log)
+
+
+@pytest.mark.parametrize("method", ["random", "grid", "es"])
+def test_the_other_methods_keep_to_the_budget_and_find_better_than_the_default(method):
+    spec, evaluator = planted(method)
+    rng = np.random.default_rng(0)
+    if method == "random":
+        result = random_search(evaluator, spec.space, {"alpha": 1.0}, rng)
+    elif method == "grid":
+        result = grid_search(evaluator, spec.space, rng)
+    else:
+        result = es_search(evaluator, spec.space, {"alpha": 1.0}, rng)
+    assert 0 < evaluator.runs_spent <= spec.budget
+    assert abs(result.best[0].values["alpha"] - 1.3) < abs(1.0 - 1.3)
+
+
+def test_the_es_gradient_points_downhill_from_centred_ranks():
+    np.testing.assert_allclose(centred_ranks(np.array([3.0, 1.0, 2.0, 2.0])),
+                               [0.5, -0.5, 0.0, 0.0])
+    eps = np.array([[1.0, 0.0], [0.0, 1.0]])
+    # Loss falls along +x, rises along +y: the gradient is -x, +y.
+    gradient = antithetic_gradient(eps, np.array([0.0, 3.0, 2.0, 1.0]), sigma=0.5)
+    assert gradient[0] < 0 < gradient[1]
+
+
+@pytest.fixture(scope="module")
+def finished_tune(tmp_path_factory):
+    out = tmp_path_factory.mktemp("tune") / "tiny"
+    spec = tune_spec_from_dict(document())
+    return spec, out, tune(spec, out, log=lambda _: None)
+
+
+def test_a_tune_rescores_the_best_beside_the_defaults_on_held_out_instances(finished_tune):
+    spec, out, result = finished_tune
+    assert 0 < result.runs_spent <= spec.budget
+    table = result.held_out
+    assert list(table["label"][:2]) == ["default", "best"]
+    assert (table["runs"] == 2).all()
+    assert (table["low"] <= table["objective"]).all() and (
+        table["objective"] <= table["high"]).all()
+    assert table["alpha"].iloc[1] == result.best["alpha"] == result.best["beta"]
+    for name in ("held_out.csv", "race.csv", "race.png", "best.json", "metadata.json"):
+        assert (out / name).is_file()
+    runs = pd.read_parquet(out / "runs")
+    assert (runs["phase"] == "training").sum() == result.runs_spent
+    held = runs[runs["phase"] == "held_out"]
+    assert set(held["seed"]) == {100, 101} and set(held["map"]) == {"alley20"}
+    # The held-out rows are what the table reports: a gap's mean per setting.
+    default = held[held["setting"] == -1]
+    assert table["objective"].iloc[0] == pytest.approx(default["loss"].mean())
+    assert (runs["loss"] == np.where(runs["found"], runs["gap"], spec.unsolved_gap)).all()
+
+
+def test_a_killed_tune_resumes_to_the_same_race_running_only_what_was_lost(
+        finished_tune, tmp_path, monkeypatch):
+    spec, out, result = finished_tune
+    killed = tmp_path / "killed"
+    real_write = ResultsStore.write_chunk
+    written = []
+
+    def write_then_die(self, map_index, chunk_index, rows):
+        if len(written) == 3:
+            raise KeyboardInterrupt
+        written.append(chunk_index)
+        return real_write(self, map_index, chunk_index, rows)
+
+    monkeypatch.setattr(ResultsStore, "write_chunk", write_then_die)
+    with pytest.raises(KeyboardInterrupt):
+        tune(spec, killed, log=lambda _: None)
+    monkeypatch.setattr(ResultsStore, "write_chunk", real_write)
+    real_run = RunBatches.run
+    made = []
+
+    def counted(self, sweep_map, seeds, params, target=np.inf):
+        made.append(len(seeds))
+        return real_run(self, sweep_map, seeds, params, target)
+
+    monkeypatch.setattr(RunBatches, "run", counted)
+    resumed = tune(spec, killed, log=lambda _: None)
+    pd.testing.assert_frame_equal(resumed.race, result.race)
+    pd.testing.assert_frame_equal(resumed.held_out, result.held_out)
+    before = pd.read_parquet(out / "runs").drop(columns="seconds")
+    after = pd.read_parquet(killed / "runs").drop(columns="seconds")
+    pd.testing.assert_frame_equal(after, before)
+    stored_before_kill = sum(len(pd.read_parquet(path)) for path in
+                             sorted((killed / "runs").glob("part-*.parquet"))[:3])
+    assert sum(made) == len(before) - stored_before_kill
+
+
+def test_a_store_of_another_tune_is_refused(finished_tune):
+    spec, out, _ = finished_tune
+    other = tune_spec_from_dict(document(tune={"seed": 4}))
+    with pytest.raises(ValueError, match="different sweep"):
+        tune(other, out, log=lambda _: None)
+
+
+def test_the_tune_command_prints_its_help_and_names_a_bad_key(tmp_path, capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["tune", "--help"])
+    assert done.value.code == 0 and "held-out" in capsys.readouterr().out
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[tune]\nalgorithm = "iwd"\nbudget = 0\n')
+    with pytest.raises(SystemExit) as done:
+        main(["tune", str(bad)])
+    assert done.value.code == 2
+    assert f"{bad}: tune.training: missing" in capsys.readouterr().err
+
+
+def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
+    sweep_map = resolve_map("maze20")
+    seeds, params = np.array([3, 4, 5]), {"alpha": np.array([1.0, 2.0, 3.0])}
+    outputs = [RunBatches("iwd", {"num_agents": 8}, 3, None, 16, log=lambda _: None,
+                          fit_calls=fit).run(sweep_map, seeds, params)
+               for fit in (False, True)]
+    assert RunBatches("iwd", {"num_agents": 8}, 3, None, 16, fit_calls=True).call_size(3) == 4
+    for name in ("cost", "iterations", "moves", "fingerprint", "target_iterations"):
+        np.testing.assert_array_equal(outputs[0][name], outputs[1][name])
+
+
+def test_every_paper_swarm_has_a_committed_spec_and_a_quick_twin_of_the_same_space():
+    from jaxswarm.swarm import registry
+    from jaxswarm.tune import load_tune_spec
+    paper = {name for name in registry.registered() if registry.entry(name).faithful}
+    specs = {path.stem: load_tune_spec(path) for path in sorted((REPO / "tunes").glob("*.toml"))}
+    assert set(specs) == paper and all(spec.algorithm == name for name, spec in specs.items())
+    for name, spec in specs.items():
+        quick = load_tune_spec(REPO / "tunes" / "quick" / f"{name}.toml")
+        assert quick.algorithm == spec.algorithm and quick.objective == spec.objective
+        assert {k: type(d) for k, d in quick.space.domains.items()} == {
+            k: type(d) for k, d in spec.space.domains.items()}  # cabc's limit scales with N
+        assert quick.budget < spec.budget
+        assert not set(spec.space.domains) & set(spec.fixed)
+
+
+@pytest.mark.slow  # two quick calibrations and their comparison: about three minutes
+def test_the_calibration_script_writes_its_tables(tmp_path, monkeypatch):
+    monkeypatch.chdir(REPO)
+    calibration = load_script("sweeps/calibration.py")
+    out = tmp_path / "calibration"
+    calibration.main(["--specs", "tunes/quick/iwd.toml", "tunes/quick/aco_star.toml",
+                      "--compare", "--methods", "race,random", "--tuner-seeds", "2",
+                      "--out", str(out), "--stores", str(tmp_path / "stores")])
+    held_out = pd.read_csv(out / "held_out.csv")
+    assert set(held_out["algorithm"]) == {"iwd", "aco_star"}
+    assert set(held_out["label"]) >= {"default", "best"}
+    comparison = pd.read_csv(out / "comparison.csv")
+    assert len(comparison) == 2 * 2 * 2
+    assert (comparison["runs"] <= comparison["budget"]).all()
+    for name in ("table.md", "comparison.md", "provenance.json", "iwd/race.png",
+                 "aco_star/best.json"):
+        assert (out / name).is_file()
