@@ -1,16 +1,16 @@
 """Runs of one swarm as compiled batches over the devices: what sweeps and tuners share.
 
-A :class:`RunBatches` holds a swarm (its registry name and static config), the iteration
-budget and the patience, and runs any list of ``(seed, params)`` runs on a map: the runs are
-cut into calls of ``chunk_size`` (padded to a multiple of the device count, or with
-``fit_calls`` a small call to a quarter or a half of that; padding rows are dropped), shared out over ``jax.devices()`` (``shard_map``), and each device goes through its
-share a group of runs at a time, a ``vmap`` of :func:`jaxswarm.swarm.run` inside ``lax.map``
-(the walks of a group share one queue of agents over the walker's lanes). Maps of the same
-shape share one compiled program; each compile is logged. A call in which a walk had no room
-in its log for its moves is made again with room for every move
-(:func:`~jaxswarm.swarm.core.with_room`). A run with seed ``s`` uses ``jax.random.key(s)``, so
-its outputs equal ``run(swarm, jax.random.key(s), ...)`` bit for bit whatever the batch it is
-in (:mod:`jaxswarm.runtime.arithmetic`).
+A :class:`RunBatches` holds a swarm (its registry name and static config), the iteration budget and
+the patience, and runs any list of ``(seed, params)`` runs on a map: the runs are cut into calls of
+``chunk_size`` (padded to a multiple of the device count, or with ``fit_calls`` a small call to a
+quarter or a half of that; padding rows are dropped), shared out over ``jax.devices()``
+(``shard_map``), and each device goes through its share a group of runs at a time, a ``vmap`` of
+:func:`jaxswarm.swarm.run` inside ``lax.map`` (the walks of a group share one queue of agents over
+the walker's lanes). Maps of the same shape share one compiled program; each compile is logged. A
+call in which a walk had no room in its log for its moves is made again with room for every move
+(:func:`~jaxswarm.swarm.core.with_room`). A run with seed ``s`` uses ``jax.random.key(s)``, so its
+outputs equal ``run(swarm, jax.random.key(s), ...)`` bit for bit whatever the batch it is in
+(:mod:`jaxswarm.runtime.arithmetic`).
 """
 from __future__ import annotations
 

@@ -83,7 +83,8 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     """
     out = Path(out) if out is not None else default_out(spec)
     base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
-    maps = resolve_maps(spec.maps, "sweep.maps", spec.source, base_dir)  # every entry checked before anything is written
+    # Every entry checked before anything is written.
+    maps = resolve_maps(spec.maps, "sweep.maps", spec.source, base_dir)
     chunks = _set_up(spec, maps, out, log)
     todo, finished_runs = _unfinished_chunks(chunks, len(maps), out)
     bar = tqdm(total=chunks.num_runs * len(maps), unit="run", disable=not progress,
