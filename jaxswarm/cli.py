@@ -60,11 +60,13 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``jaxswarm`` command; returns the exit status."""
     parser = _parser()
     args = parser.parse_args(argv)
-    if args.threads is not None:
-        try:
-            configure(threads=args.threads)
-        except (ValueError, RuntimeError) as error:
-            parser.error(f"--threads: {error}")
+    for option in ("devices", "threads"):
+        value = getattr(args, option)
+        if value is not None:
+            try:
+                configure(**{option: value})
+            except (ValueError, RuntimeError) as error:
+                parser.error(f"--{option}: {error}")
     try:
         command = {"demo": run_demo, "robot": run_robot, "mapf": run_mapf,
                    "sweep": run_sweep_command, "tune": run_tune_command,
@@ -85,6 +87,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--threads", type=int,
                         help="XLA:CPU intra-op threads (default: one per core); 1 is fastest for "
                              "single runs on a few cores, see jaxswarm.runtime.cpu")
+    parser.add_argument("--devices", type=int,
+                        help="JAX CPU devices (default: JAX's, one): a sweep's or a tune's runs "
+                             "are shared out over them, one core each, see jaxswarm.runtime.cpu")
     commands = parser.add_subparsers(dest="command", required=True)
     _add_demo_parser(commands)
     _add_robot_parser(commands)

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import glob
+import os
 import shutil
 import statistics
 import tomllib
@@ -34,6 +35,7 @@ from pathlib import Path
 import pandas as pd
 
 from jaxswarm.runtime.atomic import write_atomically
+from jaxswarm.runtime.cpu import backends_started, configure
 from jaxswarm.studies import provenance
 from jaxswarm.tune import tune, tune_spec_from_dict
 from jaxswarm.tune.spec import METHODS
@@ -62,7 +64,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("out/calibration"))
     parser.add_argument("--stores", type=Path, default=Path("out/calibration/stores"),
                         help="where the tunes' run stores go (resumable; not committed)")
+    parser.add_argument("--devices", type=int, default=os.cpu_count(),
+                        help="JAX CPU devices the runs are shared out over (default: one per "
+                             "core; ignored when JAX has already started)")
     args = parser.parse_args(argv)
+    if not backends_started():
+        configure(devices=args.devices)
     record = provenance.begin(__file__, argv)
     paths = args.specs or sorted(glob.glob("tunes/quick/*.toml" if args.quick
                                            else "tunes/*.toml"))

@@ -253,6 +253,9 @@ def test_the_tune_command_prints_its_help_and_names_a_bad_key(tmp_path, capsys):
         main(["tune", str(bad)])
     assert done.value.code == 2
     assert f"{bad}: tune.training: missing" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as done:
+        main(["--devices", "0", "tune", str(bad)])
+    assert done.value.code == 2 and "--devices: devices must be" in capsys.readouterr().err
 
 
 def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
