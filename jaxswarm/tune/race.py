@@ -1,26 +1,26 @@
 """Iterated racing (irace; López-Ibáñez et al., Operations Research Perspectives 3, 2016).
 
-A tune of budget ``B`` runs over ``d`` free params makes ``N_iter = floor(2 + log2 d)``
-iterations. Iteration ``j`` has a budget ``B_j = (B - spent) / (N_iter - j + 1)`` and races
-``N_j = floor(B_j / (first_test + min(5, j)))`` settings: in the first, the swarm's defaults and
-settings drawn uniformly; later, the elites of the race before and new settings drawn around
-them. A race takes the training instances (``(map, seed)`` pairs, in an order the tuner's key
-shuffles once: blocking, every setting sees the same instances in the same order) one after
+A tune of budget ``B`` runs over ``d`` free params makes ``N_iter = floor(2 + log2 d)`` iterations.
+Iteration ``j`` has a budget ``B_j = (B - spent) / (N_iter - j + 1)`` and races ``N_j = floor(B_j /
+(first_test + min(5, j)))`` settings (at least one more than the elites): in the first, the swarm's
+defaults and settings drawn uniformly; later, the elites of the race before and new settings drawn
+around them. A race takes the training instances (``(map, seed)`` pairs, in an order the tuner's
+key shuffles once: blocking, every setting sees the same instances in the same order) one after
 another, the settings still alive as one batch of runs; from the ``first_test``-th instance on,
 after each, the Friedman test on the ranks at level ``alpha`` and, when it rejects, Conover's
 pairwise comparisons against the best (:func:`jaxswarm.tune.stats.race_step`) drop the settings
 worse than the best. A race ends when at most ``N_min = floor(2 + log2 d)`` settings are alive,
 when its budget cannot pay for the next instance, or when the instances run out; its survivors,
-best mean rank first, are the elites (at most ``N_min``). A setting keeps its results from race
-to race (an elite is not run again on an instance it has seen).
+best mean rank first, are the elites (at most ``N_min``). A setting keeps its results from race to
+race (an elite is not run again on an instance it has seen).
 
-New settings: a parent elite of rank ``r`` (of ``k``) is picked with probability
-``(k - r + 1) / (k (k + 1) / 2)``; each numeric param is drawn from a normal around the parent's
-value on the unit scale of its range (log-scaled where the range is), truncated to it, whose
-deviation starts at 0.5 and shrinks every iteration by ``(1 / N_j^new)^(1 / d)``; each choice from
-the parent's probabilities, which move towards the parent's value by ``(j - 1) / N_iter`` (irace's
-update) and pass to the child. irace's deviation is kept per elite; here one deviation per
-iteration serves every parent (a simplification, documented).
+New settings: a parent elite of rank ``r`` (of ``k``) is picked with probability ``(k - r + 1) / (k
+(k + 1) / 2)``; each numeric param is drawn from a normal around the parent's value on the unit
+scale of its range (log-scaled where the range is), truncated to it, whose deviation starts at 0.5
+and shrinks every iteration by ``(1 / N_j^new)^(1 / d)``; each choice from the parent's
+probabilities, which move towards the parent's value by ``(j - 1) / N_iter`` (irace's update) and
+pass to the child. irace's deviation is kept per elite; here one deviation per iteration serves
+every parent (a simplification, documented).
 """
 from __future__ import annotations
 
@@ -83,8 +83,10 @@ def iterated_race(evaluator: Evaluator, space: Space, defaults: dict,
     for j in range(1, iterations + 1):
         remaining = spec.budget - evaluator.runs_spent
         budget = remaining / (iterations - j + 1)
-        size = int(budget // (spec.first_test + min(5, j)))
-        if size <= len(elites) or remaining <= 0:
+        # At least one new setting while the iteration's budget pays for a race of them all
+        # (irace would stop at a budget this small; a tune spends what it was given).
+        size = max(int(budget // (spec.first_test + min(5, j))), len(elites) + 1)
+        if remaining <= 0 or budget < size:
             break
         fresh = size - len(elites)
         if j == 1:
