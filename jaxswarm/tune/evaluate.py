@@ -128,8 +128,8 @@ class Evaluator:
             _check_same(rows, settings, instances, phase, self.store.chunk_path(0, number))
         else:
             rows = self._run(settings, instances, phase, iteration, number)
-            self.store.write_chunk(0, number, {k: v.to_numpy() if k not in _TEXT else
-                                               v.tolist() for k, v in rows.items()})
+            self.store.write_chunk(0, number, {name: column.to_numpy()
+                                               for name, column in rows.items()})
         if phase == TRAINING:
             self.runs_spent += len(rows)
         return rows
@@ -181,9 +181,6 @@ class Evaluator:
                                             spec.iterations, spec.patience, spec.chunk_size,
                                             log=self.log, fit_calls=True)
         return self._batches[key]
-
-
-_TEXT = ("phase", "map")
 
 
 def _outcome(part: dict) -> dict:
