@@ -67,6 +67,8 @@ def test_a_spec_becomes_a_space_with_ties_and_fixed_values():
     (dict(config={"num_agents": {"choices": [8, -1]}}), "[config]"),
     (dict(config={"agents": 8}), "config.agents: unknown config of iwd"),
     (dict(unknown={}), "unknown: unknown section"),
+    (dict(tune={"held_out": {"maps": ["mosaic20"], "seeds": [5, 100]}}),
+     "tune.held_out: 1 instance(s) are also training instances (e.g. map 'mosaic20' with seed 5)"),
 ])
 def test_a_bad_spec_names_its_key(changes, message):
     with pytest.raises(TuneSpecError) as error:

@@ -165,6 +165,12 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
     swarm = configured_swarm(algorithm, config, fail)
     training = _instances(tune["training"], "tune.training", swarm, algorithm, fail)
     held_out = _instances(tune["held_out"], "tune.held_out", swarm, algorithm, fail)
+    shared = [(entry, seed) for entry in held_out.maps for seed in held_out.seeds
+              if entry in training.maps and seed in training.seeds]
+    if shared:
+        fail("tune.held_out", f"{len(shared)} instance(s) are also training instances (e.g. map "
+             f"{shared[0][0]!r} with seed {shared[0][1]}): a setting would be judged on runs "
+             "like those that chose it")
     fixed, domains = _params(document.get("params", {}), swarm, algorithm, fail)
     space = Space({**domains, **static})
     if not space.free:
