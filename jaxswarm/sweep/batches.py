@@ -116,9 +116,7 @@ class RunBatches:
             index = np.minimum(np.arange(first, first + self.call_size(size)), count - 1)
             inputs = self._sharded((np.asarray(seeds)[index].astype(np.int32),
                                     jax.tree_util.tree_map(lambda leaf: leaf[index], stacked)))
-            began = time.perf_counter()
-            outputs = self._call(sweep_map, inputs, world, task, target)
-            seconds = time.perf_counter() - began
+            outputs, seconds = self._call(sweep_map, inputs, world, task, target)
             parts.append({name: value[:size] for name, value in outputs.items()}
                          | {"seconds": np.full(size, seconds)})
         return {name: np.concatenate([part[name] for part in parts]) for name in parts[0]}
@@ -136,18 +134,21 @@ class RunBatches:
                 return size
         return self.padded
 
-    def _call(self, sweep_map: SweepMap, inputs, world, task, target) -> dict[str, np.ndarray]:
-        """One compiled call on ``inputs`` (seeds i32[padded], params with leaves f32[padded],
-        sharded over the runs axis): :data:`OUTPUTS` as host arrays, made again with room for
-        every move where a walk overflowed its log."""
-        outputs = _gather(self._compiled_for(sweep_map, inputs, world, task, target,
-                                             roomy=False)(*inputs, world, task, target))
+    def _call(self, sweep_map: SweepMap, inputs, world, task,
+              target) -> tuple[dict[str, np.ndarray], float]:
+        """One compiled call on ``inputs`` (seeds i32[C], params with leaves f32[C], sharded
+        over the runs axis): ``(outputs, seconds)``, :data:`OUTPUTS` as host arrays, made again
+        with room for every move where a walk overflowed its log, and the call's wall time (the
+        first compile for the map's shape excluded)."""
+        program = self._compiled_for(sweep_map, inputs, world, task, target, roomy=False)
+        began = time.perf_counter()
+        outputs = _gather(program(*inputs, world, task, target))
         if np.any(outputs["overflowed"]):
             self.log(f"a walk on {sweep_map.label} had no room for its moves: the call again "
                      "with room for every move")
             outputs = _gather(self._compiled_for(sweep_map, inputs, world, task, target,
                                                  roomy=True)(*inputs, world, task, target))
-        return {name: outputs[name] for name in OUTPUTS}
+        return {name: outputs[name] for name in OUTPUTS}, time.perf_counter() - began
 
     def _sharded(self, host) -> tuple:
         """``host`` arrays as global arrays sharded over the runs axis (each process builds only
