@@ -35,19 +35,20 @@ bench: $(INSTALLED)  ## benchmark scripts (print figures; not tests)
 performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md (about 35 min on 2 cores)
 	$(BIN)/python benchmarks/report.py
 
-# The generated tables of results/ (see results/README.md), one script each; every script writes
-# its Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and
+# The generated tables of results/ (see results/README.md), one script each; every script writes its
+# Markdown, CSV and provenance.json (commit, versions, machine, command) into its folder, and
 # sweeps/index_results.py then indexes them in results/README.md. The full run is the scripts'
 # paper-size defaults, spelled out: Table 1, the RFD table, the dynamic Tables 2-5 and IWD on all
 # nine paper maps with 20 seeds (100 iterations, 256 drops or ants, 50 water drops); the path maps
 # 10x10, 20x20 and 40x25 with 10 runs of populations of 50 ants; the robot study on the three
-# path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size
-# 10..100; the MAPF study on five Moving AI maps with 5 to 100 agents, 5 random orders and CBS
-# limited to 30 s an instance. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC shared with
-# other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
-# 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the bees' tables
-# 20 min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, MAPF study 9 min: about
-# 155 minutes in all.
+# path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size 10..100;
+# the MAPF study on five Moving AI maps with 5 to 100 agents, 5 random orders and CBS limited to 30
+# s an instance; every tune spec of tunes/ raced and judged on its held-out instances (the tunes'
+# run stores under out/calibration/stores, resumable). Measured (jaxswarm 0.4.0 and later, 2 cores
+# AMD EPYC shared with other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min,
+# dynamic tables 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the
+# bees' tables 20 min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, MAPF study
+# 9 min: about 155 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -63,6 +64,7 @@ IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-com
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20 --cycle-runs 30
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
+CALIBRATION_FULL := --stores out/calibration/stores
 TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
 RFD_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --max-ants 200
@@ -74,6 +76,8 @@ IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
 BEES_QUICK := --tables 6 --runs 1 --cycle-runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
 MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
+CALIBRATION_QUICK := --specs tunes/quick/iwd.toml tunes/quick/aco_star.toml \
+	--stores $(QUICK_OUT)/calibration/stores
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 155 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
@@ -87,6 +91,7 @@ reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_FULL) --out $(RESULTS)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_FULL) --out $(RESULTS)/exact_study
 	$(BIN)/python sweeps/mapf_study.py $(MAPF_FULL) --out $(RESULTS)/mapf_study
+	$(BIN)/python sweeps/calibration.py $(CALIBRATION_FULL) --out $(RESULTS)/calibration
 	$(BIN)/python sweeps/index_results.py $(RESULTS)
 
 reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-quick (minutes)
@@ -101,6 +106,7 @@ reproduce-quick: $(INSTALLED)  ## the same at a tiny size into out/reproduce-qui
 	$(BIN)/python sweeps/bees_inverse.py $(BEES_INVERSE_QUICK) --out $(QUICK_OUT)/bees_inverse
 	$(BIN)/python sweeps/exact_study.py $(EXACT_QUICK) --out $(QUICK_OUT)/exact_study
 	$(BIN)/python sweeps/mapf_study.py $(MAPF_QUICK) --out $(QUICK_OUT)/mapf_study
+	$(BIN)/python sweeps/calibration.py $(CALIBRATION_QUICK) --out $(QUICK_OUT)/calibration
 	$(BIN)/python sweeps/index_results.py $(QUICK_OUT)
 
 clean:

@@ -55,7 +55,7 @@ def out_folders(commands: list[list[str]]) -> list[str]:
 
 TABLES = ["rfd_paper_table1", "rfd_static", "aco_pathmaps", "rfd_paper_dynamic", "robot_study",
           "iwd_paper_maps", "iwd_pg_experiments", "bees_tables", "bees_inverse", "exact_study",
-          "mapf_study"]
+          "mapf_study", "calibration"]
 """The folders of results/, in the order ``make reproduce`` writes them."""
 
 
