@@ -49,7 +49,9 @@ ABOUT = ("Each row is a setting of a paper swarm on its spec's held-out instance
          "paper leaves open and the ranges searched). `objective` is the spec's objective "
          "(lower is better for a gap, higher for a success rate) with a 95 % bootstrap "
          "interval over the held-out instances; `found` and `success` are the shares of runs "
-         "that found a path and that reached the optimum (relative gap below 1e-4).")
+         "that found a path and that reached the optimum (relative gap below 1e-4). A tune "
+         "resumed from its store (`--stores`) reads its runs back, so the run time of a table "
+         "made from stores is that of the rescoring alone; `training_runs` counts the runs.")
 """What the rows are."""
 
 
