@@ -25,7 +25,6 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
-import glob
 import os
 import shutil
 import statistics
@@ -40,6 +39,8 @@ from jaxswarm.studies import provenance
 from jaxswarm.tune import tune, tune_spec_from_dict
 from jaxswarm.tune.spec import METHODS
 
+ROOT = Path(__file__).resolve().parents[1]
+"""The repository root: spec paths are relative to it."""
 TITLE = "The papers' open constants, raced and judged on held-out instances"
 """Title of table.md."""
 ABOUT = ("Each row is a setting of a paper swarm on its spec's held-out instances (maps and "
@@ -73,11 +74,11 @@ def main(argv: list[str] | None = None) -> int:
     if not backends_started():
         configure(devices=args.devices)
     record = provenance.begin(__file__, argv)
-    paths = args.specs or sorted(glob.glob("tunes/quick/*.toml" if args.quick
-                                           else "tunes/*.toml"))
+    paths = args.specs or sorted(str(path.relative_to(ROOT)) for path in (
+        ROOT / "tunes" / ("quick" if args.quick else "")).glob("*.toml"))
     held_out, comparison = [], []
     for path in paths:
-        document = tomllib.loads(Path(path).read_text())
+        document = tomllib.loads(_found(path).read_text())
         spec = tune_spec_from_dict(document, source=path)
         result = tune(spec, args.stores / spec.name)
         folder = args.out / spec.algorithm
@@ -101,6 +102,13 @@ def main(argv: list[str] | None = None) -> int:
         write_atomically(args.out / "comparison.csv", compared.to_csv(index=False))
         write_atomically(args.out / "comparison.md", record.document(_comparison(compared)))
     return 0
+
+
+def _found(path: str) -> Path:
+    """``path``, or where it lies below the repository root when it is relative and not found
+    from the working directory."""
+    given = Path(path)
+    return given if given.exists() or given.is_absolute() else ROOT / given
 
 
 def _compare(document: dict, path: str, args) -> list[dict]:
