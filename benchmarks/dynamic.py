@@ -47,7 +47,7 @@ from jaxswarm.exact import astar, dijkstra, replanner
 from jaxswarm.maps.paper import paper_map, paper_map_names
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
-from jaxswarm.sweep.runner import SUCCESS_GAP
+from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.world.graph import grid_graph
 
 ITERATIONS = 100

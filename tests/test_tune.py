@@ -222,9 +222,9 @@ def test_a_killed_tune_resumes_to_the_same_race_running_only_what_was_lost(
     real_run = RunBatches.run
     made = []
 
-    def counted(self, sweep_map, seeds, params, target=np.inf):
+    def counted(self, sweep_map, seeds, params, optimum=np.inf):
         made.append(len(seeds))
-        return real_run(self, sweep_map, seeds, params, target)
+        return real_run(self, sweep_map, seeds, params, optimum)
 
     monkeypatch.setattr(RunBatches, "run", counted)
     resumed = tune(spec, killed, log=lambda _: None)

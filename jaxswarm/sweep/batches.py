@@ -15,6 +15,7 @@ outputs equal ``run(swarm, jax.random.key(s), ...)`` bit for bit whatever the ba
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from typing import Any, Callable
 
@@ -29,6 +30,9 @@ from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.fingerprint import run_fingerprint
 from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap
+
+SUCCESS_GAP = 1e-4
+"""A run succeeds when its relative gap to the optimum is below this."""
 
 RUNS_AXIS = "runs"
 """The mesh axis a call's runs are sharded over."""
@@ -92,16 +96,18 @@ class RunBatches:
         return self.swarm.default_params
 
     def run(self, sweep_map: SweepMap, seeds: np.ndarray, params: dict[str, np.ndarray],
-            target: float = np.inf) -> dict[str, np.ndarray]:
+            optimum: float = np.inf) -> dict[str, np.ndarray]:
         """Run ``seeds`` (i64[C]) with ``params`` (name -> f64[C]; params not named keep the
-        swarm's defaults) on ``sweep_map``, ``chunk_size`` runs a call.
+        swarm's defaults) on ``sweep_map``, whose optimum is ``optimum``
+        (:meth:`~jaxswarm.sweep.maps.SweepMap.optimum`), ``chunk_size`` runs a call.
 
         Returns:
           name -> array[C]: ``cost`` (f64, inf without a path), ``iterations`` (i32, used),
           ``moves`` and ``evaluations`` (i64, all iterations), ``fingerprint`` (u32[C, 2],
           :func:`~jaxswarm.swarm.fingerprint.run_fingerprint`), ``target_iterations`` and
           ``target_evaluations`` (i32 and i64: the iterations, and the evaluations they made,
-          until the best cost was at most ``target``; -1 where it never was), and
+          until the best cost was within :data:`SUCCESS_GAP` of ``optimum``, the rule of
+          :func:`jaxswarm.dynamic.events.first_iteration_at`; -1 where it never was), and
           ``seconds`` (f64: the wall time of the call the run was part of, compile excluded).
         """
         count = len(seeds)
@@ -109,7 +115,7 @@ class RunBatches:
         world, task = jax.device_put(
             (sweep_map.world, make_task(sweep_map.world, sweep_map.start, sweep_map.goal)),
             self._replicated)
-        target = jax.device_put(jnp.float32(target), self._replicated)
+        target = jax.device_put(jnp.float32(optimum), self._replicated)
         parts = []
         for first in range(0, count, self.chunk_size):
             size = min(self.chunk_size, count - first)
@@ -176,15 +182,16 @@ class RunBatches:
 
 
 def _program(swarm, iterations: int, patience: int | None, mesh: Mesh, group: int):
-    """The jitted call: ``(seeds i32[C], params with leaves f32[C], world, task, target f32[])
+    """The jitted call: ``(seeds i32[C], params with leaves f32[C], world, task, optimum f32[])
     -> {output: [C, ...]}`` (:data:`OUTPUTS` and ``overflowed``), C a multiple of the mesh
     size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
     ``group`` at a time."""
-    def one(run_input, world, task, target):
+    def one(run_input, world, task, optimum):
         seed, params = run_input
         state, trace = run(swarm, jax.random.key(seed), world, task, params,
                            iterations=iterations, patience=patience)
-        reached = jnp.nan_to_num(trace.best_cost, nan=jnp.inf) <= target
+        # The relative gap of first_iteration_at and of the rows' success (NaN after the stop).
+        reached = (trace.best_cost - optimum) / optimum < SUCCESS_GAP
         first = jnp.argmax(reached)
         found = reached[first]
         evaluations = jnp.cumsum(trace.evaluations)
@@ -216,6 +223,17 @@ def _program_key(world) -> tuple:
     """Worlds with equal structure and array shapes share one compiled program."""
     leaves, treedef = jax.tree_util.tree_flatten(world)
     return treedef, tuple(leaf.shape for leaf in leaves)
+
+
+def run_outcomes(cost: np.ndarray, optimum: float) -> dict[str, np.ndarray]:
+    """The outcome columns of runs whose best paths cost ``cost`` (f64[C], inf without a path)
+    on a map whose optimum is ``optimum``: ``gap`` (f64, relative; NaN without a path or a
+    positive finite optimum), ``found`` and ``success`` (bool: within :data:`SUCCESS_GAP`)."""
+    cost = np.asarray(cost, np.float64)
+    found = np.isfinite(cost)
+    gap = ((cost - optimum) / optimum if math.isfinite(optimum) and optimum > 0
+           else np.full(cost.shape, np.nan))
+    return dict(gap=gap, found=found, success=found & (gap < SUCCESS_GAP))
 
 
 def _gather(outputs) -> Any:

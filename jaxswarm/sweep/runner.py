@@ -42,13 +42,11 @@ from tqdm.auto import tqdm
 
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
-from jaxswarm.sweep.batches import RunBatches
+from jaxswarm.sweep.batches import RunBatches, run_outcomes
 from jaxswarm.sweep.maps import SweepMap, resolve_maps
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
 
-SUCCESS_GAP = 1e-4
-"""A run succeeds when its relative gap to the optimum is below this."""
 
 
 def default_out(spec: SweepSpec) -> Path:
@@ -170,7 +168,8 @@ def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: li
         first = c * spec.chunk_size
         runs = np.arange(first, first + _chunk_runs(c, spec.chunk_size, chunks.num_runs))
         outputs = chunks.batches.run(sweep_map, chunks.seeds[runs % len(chunks.seeds)],
-                                     {name: values[runs] for name, values in chunks.swept.items()})
+                                     {name: values[runs] for name, values in chunks.swept.items()},
+                                     best)
         rows = _rows(spec, chunks.grid, chunks.seeds, sweep_map.label, map_index, c, runs,
                      outputs, best)
         if chunks.writer:
@@ -186,16 +185,13 @@ def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, runs, outputs, 
     """A chunk's rows (see :func:`run_sweep`) from its runs' outputs
     (:meth:`~jaxswarm.sweep.batches.RunBatches.run`)."""
     count = len(runs)
-    cost = np.asarray(outputs["cost"], np.float64)
-    found = np.isfinite(cost)
-    gap = (cost - best) / best if math.isfinite(best) and best > 0 else np.full(count, np.nan)
     rows = dict(map=[label] * count, map_index=np.full(count, map_index, np.int32),
                 run=runs.astype(np.int64), algorithm=[spec.algorithm] * count,
                 seed=seeds[runs % len(seeds)].astype(np.int64))
     for name in spec.params:
         rows[name] = np.array([grid[r // len(seeds)][name] for r in runs], np.float64)
-    rows.update(cost=cost, optimum=np.full(count, best), gap=gap, found=found,
-                success=found & (gap < SUCCESS_GAP),
+    cost = np.asarray(outputs["cost"], np.float64)
+    rows.update(cost=cost, optimum=np.full(count, best), **run_outcomes(cost, best),
                 iterations=np.asarray(outputs["iterations"], np.int32),
                 moves=np.asarray(outputs["moves"], np.int64),
                 evaluations=np.asarray(outputs["evaluations"], np.int64),

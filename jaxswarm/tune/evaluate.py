@@ -32,9 +32,9 @@ import pandas as pd
 
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
-from jaxswarm.sweep.batches import RunBatches
+from jaxswarm.sweep.batches import RunBatches, run_outcomes
 from jaxswarm.sweep.maps import resolve_maps
-from jaxswarm.sweep.runner import SUCCESS_GAP, provenance
+from jaxswarm.sweep.runner import provenance
 from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.tune.spec import TuneSpec
 
@@ -135,41 +135,38 @@ class Evaluator:
         return rows
 
     def _run(self, settings, instances, phase, iteration, number) -> pd.DataFrame:
-        """The rows of every setting on every instance, setting-major."""
+        """The rows of every setting on every instance, setting-major: one call of the swarm's
+        batches per instance and value of the static params."""
         spec = self.spec
-        frames = []
-        static_names = spec.space.static
+        static = spec.space.static
         groups: dict = {}
         for s, setting in enumerate(settings):
-            key = tuple(setting.values[name] for name in static_names)
-            groups.setdefault(key, []).append(s)
-        parts = {}
+            groups.setdefault(tuple(setting.values[name] for name in static), []).append(s)
+        parts = []
         for key, members in groups.items():
-            batches = self._batches_for(dict(zip(static_names, key)))
+            batches = self._batches_for(dict(zip(static, key)))
+            params = {name: np.array([float(settings[s].values[name]) for s in members])
+                      for name in spec.space.domains if name not in static}
+            params |= {name: np.full(len(members), value) for name, value in spec.fixed.items()}
             for i, (map_index, seed) in enumerate(instances):
-                sweep_map = self.maps[phase][map_index]
-                optimum = self._optimum[phase][map_index]
-                params = {name: np.array([float(settings[s].values[name]) for s in members])
-                          for name in spec.space.domains if name not in static_names}
-                params |= {name: np.full(len(members), value)
-                           for name, value in spec.fixed.items()}
-                outputs = batches.run(sweep_map, np.full(len(members), seed), params,
-                                      target=optimum * (1 + SUCCESS_GAP))
-                for j, s in enumerate(members):
-                    parts[s, i] = {name: value[j] for name, value in outputs.items()} | dict(
-                        map_index=map_index, map=sweep_map.label, seed=seed, optimum=optimum,
-                        num_agents=batches.swarm.config.num_agents)
-        for s, setting in enumerate(settings):
-            for i in range(len(instances)):
-                part = parts[s, i]
-                frames.append(dict(batch=number, phase=phase, iteration=iteration,
-                                   setting=setting.number, instance=i, map=part["map"],
-                                   map_index=part["map_index"], seed=part["seed"],
-                                   **{f"param.{k}": float(v) for k, v in setting.values.items()},
-                                   **_outcome(part)))
-        rows = pd.DataFrame(frames)
-        num_agents = rows.pop("num_agents").to_numpy()
-        rows["loss"] = run_losses(spec, rows, num_agents)
+                sweep_map, optimum = self.maps[phase][map_index], self._optimum[phase][map_index]
+                outputs = batches.run(sweep_map, np.full(len(members), seed), params, optimum)
+                cost = np.asarray(outputs["cost"], np.float64)
+                parts.append(pd.DataFrame(dict(
+                    position=members, instance=i, map=sweep_map.label, map_index=map_index,
+                    seed=seed, cost=cost, optimum=optimum, **run_outcomes(cost, optimum),
+                    fingerprint=[hex_fingerprint(f) for f in outputs["fingerprint"]],
+                    num_agents=batches.swarm.config.num_agents,
+                    **{name: outputs[name] for name in _COUNTS})))
+        runs = pd.concat(parts).sort_values(["position", "instance"], kind="stable")
+        values = pd.DataFrame([{f"param.{k}": float(v) for k, v in setting.values.items()}
+                               for setting in settings])
+        rows = pd.concat([
+            pd.DataFrame(dict(batch=number, phase=phase, iteration=iteration,
+                              setting=[settings[p].number for p in runs["position"]])),
+            values.iloc[runs["position"]].reset_index(drop=True),
+            runs.drop(columns=["position", "num_agents"]).reset_index(drop=True)], axis=1)
+        rows["loss"] = run_losses(spec, rows, runs["num_agents"].to_numpy())
         return rows
 
     def _batches_for(self, static: dict) -> RunBatches:
@@ -183,19 +180,9 @@ class Evaluator:
         return self._batches[key]
 
 
-def _outcome(part: dict) -> dict:
-    """A run's outcome columns from its outputs."""
-    cost, optimum = float(part["cost"]), float(part["optimum"])
-    found = np.isfinite(cost)
-    gap = (cost - optimum) / optimum if found and optimum > 0 else np.nan
-    return dict(cost=cost, optimum=optimum, gap=gap, found=bool(found),
-                success=bool(found and gap < SUCCESS_GAP),
-                iterations=int(part["iterations"]), moves=int(part["moves"]),
-                evaluations=int(part["evaluations"]),
-                target_iterations=int(part["target_iterations"]),
-                target_evaluations=int(part["target_evaluations"]),
-                fingerprint=hex_fingerprint(part["fingerprint"]),
-                seconds=float(part["seconds"]), num_agents=int(part["num_agents"]))
+_COUNTS = ("iterations", "moves", "evaluations", "target_iterations", "target_evaluations",
+           "seconds")
+"""The outputs of :meth:`~jaxswarm.sweep.batches.RunBatches.run` a row keeps as they are."""
 
 
 def _check_same(rows: pd.DataFrame, settings, instances, phase, path) -> None:

@@ -193,10 +193,7 @@ def agent_rows(log: MoveLog, agent: jax.Array, width: int):
     """One agent's row of :func:`paths`: ``(path i32[width + 1], slots [width])`` of agent
     ``agent`` (i32[]), its first ``width`` moves; an ``agent`` past the last (``>= A``) made
     no moves (the start, then -1; slots -1)."""
-    count = log.moves.shape[0]
-    known = jnp.minimum(agent, count - 1)
-    one = dataclasses.replace(log, offset=log.offset[known][None],
-                              moves=jnp.where(agent < count, log.moves[known], 0)[None])
+    one = _one_agent(log, agent)
     path, _ = columns(one, jnp.arange(width + 1))
     _, slots = columns(one, jnp.arange(width))
     return path[0], slots[0]
@@ -204,8 +201,15 @@ def agent_rows(log: MoveLog, agent: jax.Array, width: int):
 
 def agent_path(log: MoveLog, agent: jax.Array, length: int) -> jax.Array:
     """i32[length] agent ``agent``'s (i32[]) path, -1 padded (cut after ``length`` nodes)."""
-    one = dataclasses.replace(log, offset=log.offset[agent][None], moves=log.moves[agent][None])
-    return columns(one, jnp.arange(length))[0][0]
+    return columns(_one_agent(log, agent), jnp.arange(length))[0][0]
+
+
+def _one_agent(log: MoveLog, agent: jax.Array) -> MoveLog:
+    """The log of agent ``agent`` (i32[]) alone; an agent past the last made no moves."""
+    count = log.moves.shape[0]
+    known = jnp.minimum(agent, count - 1)
+    return dataclasses.replace(log, offset=log.offset[known][None],
+                               moves=jnp.where(agent < count, log.moves[known], 0)[None])
 
 
 def known_overflowed(flag: jax.Array) -> bool:
