@@ -37,7 +37,8 @@ BENCHMARKS = [
      "the C loop's (it draws the walker's own uniforms); `MiB` is the compiled walk's own memory "
      "(outputs and temporary buffers) at the default step budget and `x2` at twice that budget. "
      "Water drops: IWD's walk as the swarm walks by default and with `while_walking` updates, "
-     "beside ACO*'s, on all devices."),
+     "beside ACO*'s, on all devices, each an iteration's walk with its per-walk table (IWD's "
+     "goal term, ACO*'s transition rule), the three taking turns within each repeat."),
     ("rfd_graded on the paper maps", "rfd.py", [], ["--maps", "maze20,maze100", "--seeds", "3"],
      "Median wall time of one `rfd_graded` run (100 iterations at most, patience 30, 256 drops, "
      "one XLA thread) per paper map over 20 seeds, beside the RFD paper's C# time of RFD*, and "

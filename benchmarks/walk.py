@@ -43,7 +43,9 @@ IWD's walks (soil at its start) beside ACO*'s (pheromone at its start) on the sa
 layouts, on all devices: ``iwd`` as the swarm walks by default (the soil read during the walk,
 the arrived drops' updates after it, :func:`jaxswarm.swarm.iwd.iwd.drop_walk`) and ``iwd ww`` with
 ``local_updates="while_walking"`` (every drop writes the soil as it moves), each as a share of
-ACO*'s moves per second (``/ aco``: what the hook costs).
+ACO*'s moves per second (``/ aco``: what the hook costs). Each is timed as its swarm's iteration
+walks, its per-walk table built in the timed call (IWD's goal term, ACO*'s transition rule), and
+the three take turns within each repeat, so the machine's noise falls on them alike.
 
 Run from the repository root::
 
@@ -314,30 +316,49 @@ def timed(call, repeats: int):
 
 def measure_drops(graph, task, drops: int, seeds: int, repeats: int) -> dict:
     """``{name: (seconds, moves)}`` of IWD's walks (as it walks by default, and with
-    ``while_walking`` updates) and of ACO*'s, same keys and layout, from each swarm's start."""
+    ``while_walking`` updates) and of ACO*'s, same keys and layout, from each swarm's start.
+
+    Each call is one iteration's walk as its swarm makes it, its per-walk table included (IWD's
+    goal term, ACO*'s transition rule), and the calls take turns, one run each per round
+    (:func:`timed_in_turn`), so that the machine's noise falls on all of them alike."""
     keys = jax.random.split(jax.random.key(1), seeds)
     iwd_swarm, aco_swarm = make("iwd", num_agents=drops), make("aco_star", num_agents=drops)
     iwd_params, aco_params = iwd_swarm.default_params, aco_swarm.default_params
     soil = iwd_swarm.init(jax.random.key(0), graph, task, iwd_params).soil
     pheromone = aco_swarm.init(jax.random.key(0), graph, task, aco_params).pheromone
-    ant_table = aco.transition_rule(graph, task, pheromone, aco_params, goal_distance=True)
-
     devices = device_count(seeds)
+    steps = step_budget(graph, None)
 
     def drop_walks(local_updates):
         walks = over_devices(lambda keys, graph, task, soil: jax.vmap(lambda key: drop_walk(
             key, graph, task, soil, iwd_params, num_agents=drops, max_steps=None,
             local_updates=local_updates))(keys), devices)
-        return lambda keys: walks(keys, graph, task, soil)
+        return lambda: walks(keys, graph, task, soil)
 
-    ant_walks = batched_walks(drops, step_budget(graph, None), devices)
-    walks = {"iwd": drop_walks("arrived"), "iwd ww": drop_walks("while_walking"),
-             "aco_star": lambda keys: ant_walks(keys, ant_table, graph, task)}
-    rates = {}
-    for name, call in walks.items():
-        seconds, result = timed(lambda: call(keys), repeats)
-        rates[name] = (seconds, int(result.moves.sum()))
-    return rates
+    def ant_walk(key, graph, task, pheromone):
+        table = aco.transition_rule(graph, task, pheromone, aco_params, goal_distance=True)
+        return walk(key, graph, table, task.start, task.goal, num_agents=drops, max_steps=steps)
+
+    ant_walks = over_devices(lambda keys, graph, task, pheromone: jax.vmap(
+        lambda key: ant_walk(key, graph, task, pheromone))(keys), devices)
+    timings = timed_in_turn({"iwd": drop_walks("arrived"), "iwd ww": drop_walks("while_walking"),
+                             "aco_star": lambda: ant_walks(keys, graph, task, pheromone)},
+                            repeats)
+    return {name: (seconds, int(result.moves.sum()))
+            for name, (seconds, result) in timings.items()}
+
+
+def timed_in_turn(calls: dict, repeats: int) -> dict:
+    """``{name: (median seconds, result)}`` of each of ``calls`` (``{name: call()}``) over
+    ``repeats`` rounds after a warm-up, the calls taking turns within each round."""
+    results = {name: jax.block_until_ready(call()) for name, call in calls.items()}
+    times = {name: [] for name in calls}
+    for _ in range(repeats):
+        for name, call in calls.items():
+            began = time.perf_counter()
+            results[name] = jax.block_until_ready(call())
+            times[name].append(time.perf_counter() - began)
+    return {name: (statistics.median(times[name]), results[name]) for name in calls}
 
 
 def main(argv: list[str] | None = None) -> int:
