@@ -44,11 +44,12 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size 10..100;
 # the MAPF study on five Moving AI maps with 5 to 100 agents, 5 random orders and CBS limited to 30
 # s an instance; every tune spec of tunes/ raced and judged on its held-out instances (the tunes'
-# run stores under out/calibration/stores, resumable). Measured (jaxswarm 0.4.0 and later, 2 cores
-# AMD EPYC shared with other work, load 2-6): Table 1 9.4 min, RFD table 5.2 min, path maps 0.7 min,
-# dynamic tables 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's experiments about 25 min, the
-# bees' tables 20 min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, MAPF study
-# 9 min: about 155 minutes in all.
+# run stores under out/calibration/stores, resumable), and racing against random search, the grid
+# and evolution strategies with 5 tuner seeds on the twins of tunes/compare/. Measured (jaxswarm
+# 0.4.0 and later, 2 cores AMD EPYC shared with other work, load 2-6): Table 1 9.4 min, RFD table
+# 5.2 min, path maps 0.7 min, dynamic tables 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's
+# experiments about 25 min, the bees' tables 20 min (load 5-8) and inverse problem 10 min, A* study
+# about 5 min alone, MAPF study 9 min: about 155 minutes in all.
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -64,7 +65,8 @@ IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-com
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20 --cycle-runs 30
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
 MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
-CALIBRATION_FULL := --stores out/calibration/stores
+CALIBRATION_FULL := --stores out/calibration/stores --compare-specs tunes/compare/aco_star.toml \
+	tunes/compare/iwd.toml tunes/compare/max_min_aco.toml tunes/compare/rfd_star.toml
 TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
 RFD_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --max-ants 200
@@ -77,7 +79,8 @@ BEES_QUICK := --tables 6 --runs 1 --cycle-runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
 MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
 CALIBRATION_QUICK := --specs tunes/quick/iwd.toml tunes/quick/aco_star.toml \
-	--stores $(QUICK_OUT)/calibration/stores
+	--stores $(QUICK_OUT)/calibration/stores --compare-specs tunes/quick/aco_star.toml \
+	--methods race,grid --tuner-seeds 1
 
 reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 155 min on 2 cores)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1

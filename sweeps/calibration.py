@@ -1,26 +1,35 @@
 """The papers' open constants calibrated: every tune spec of ``tunes/`` raced, its best setting
-rescored beside the swarm's defaults on held-out instances; and, with ``--compare``, racing
-against random search, the grid and evolution strategies at the same budgets.
+rescored beside the swarm's defaults on held-out instances; and, with ``--compare`` or
+``--compare-specs``, racing against random search, the grid and evolution strategies.
 
 Per spec (``--specs``, default every ``tunes/*.toml``; ``--quick``: ``tunes/quick/*.toml``), one
-tune (:func:`jaxswarm.tune.tune`, its store under ``--stores``): the race, then the defaults and the
-best settings on the spec's held-out instances, the objective with a 95 % bootstrap interval over
-them, and the shares of runs that found a path and that reached the optimum. With ``--compare``,
-each spec is tuned by every method of ``--methods`` with ``--tuner-seeds`` tuner seeds each
-(the spec's budget each time), and each tune's best setting is rescored on the held-out instances.
+tune (:func:`jaxswarm.tune.tune`, its store under ``--stores``): the race, then the defaults and
+the best settings on the spec's held-out instances, the objective with a 95 % bootstrap interval
+over them, and the shares of runs that found a path and that reached the optimum. With
+``--compare``, each spec (or with ``--compare-specs`` each of those specs instead, e.g. the smaller
+twins of ``tunes/compare/``) is tuned by every method of ``--methods`` with ``--tuner-seeds`` tuner
+seeds each: first the grid with ``--grid-budget`` times the spec's budget (3 by default), then the
+others with the runs the grid spent divided by that factor (the race is judged against a grid that
+spent three times as many runs), and each tune's best setting is rescored on the held-out
+instances; a verdict per spec compares the race's median held-out objective with the grid's median
+(within ``1 pp`` of success, or ``1 %`` of the mean gap or the other mean objectives) and with
+random search's (never worse, at the same budget).
 
 Written to ``--out`` (default ``out/calibration``; ``results/calibration`` for the committed
 tables), each file atomically: ``held_out.csv`` (one row per spec and rescored setting),
-``table.md`` (the provenance, then the table), ``provenance.json`` and per spec its race's
-``race.png``, ``race.csv`` and ``best.json``; with ``--compare``, ``comparison.csv`` and
+``held_out_maps.csv`` (per spec and held-out map, the defaults against the best setting and,
+where the RFD paper reports runs on the map, its claim),
+``table.md`` (the provenance, then both tables), ``provenance.json`` and per spec its race's
+``race.png``, ``race.csv`` and ``best.json``; with a comparison, ``comparison.csv`` and
 ``comparison.md`` (per spec and method: the median, lowest and highest held-out objective over
-the tuner seeds and the runs spent).
+the tuner seeds and the runs spent; then the verdicts).
 
 Run from the repository root::
 
     python sweeps/calibration.py --quick
     python sweeps/calibration.py --specs tunes/iwd.toml --out results/calibration
     python sweeps/calibration.py --quick --compare --tuner-seeds 5
+    python sweeps/calibration.py --specs tunes/iwd.toml --compare-specs tunes/compare/*.toml
 """
 from __future__ import annotations
 
@@ -31,11 +40,15 @@ import statistics
 import tomllib
 from pathlib import Path
 
+import math
+
 import pandas as pd
 
+from jaxswarm.maps.paper import PAPER_OPTIMA, PAPER_TABLE1_LENGTH
 from jaxswarm.runtime.atomic import write_atomically
 from jaxswarm.runtime.cpu import backends_started, configure
 from jaxswarm.studies import provenance
+from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.tune import tune, tune_spec_from_dict
 from jaxswarm.tune.spec import METHODS
 
@@ -61,9 +74,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--specs", nargs="*", help="tune specs (default: tunes/*.toml)")
     parser.add_argument("--quick", action="store_true", help="the quick specs of tunes/quick/")
     parser.add_argument("--compare", action="store_true",
-                        help="also every method of --methods at the same budget")
+                        help="also every method of --methods on each spec")
+    parser.add_argument("--compare-specs", nargs="*", default=[],
+                        help="compare the methods on these specs instead (implies --compare)")
     parser.add_argument("--methods", default=",".join(METHODS))
     parser.add_argument("--tuner-seeds", type=int, default=5)
+    parser.add_argument("--grid-budget", type=float, default=3.0,
+                        help="the grid's budget as a multiple of the spec's (default 3)")
     parser.add_argument("--out", type=Path, default=Path("out/calibration"))
     parser.add_argument("--stores", type=Path, default=Path("out/calibration/stores"),
                         help="where the tunes' run stores go (resumable; not committed)")
@@ -76,7 +93,7 @@ def main(argv: list[str] | None = None) -> int:
     record = provenance.begin(__file__, argv)
     paths = args.specs or sorted(str(path.relative_to(ROOT)) for path in (
         ROOT / "tunes" / ("quick" if args.quick else "")).glob("*.toml"))
-    held_out, comparison = [], []
+    held_out, per_map, comparison = [], [], []
     for path in paths:
         document = tomllib.loads(_found(path).read_text())
         spec = tune_spec_from_dict(document, source=path)
@@ -89,13 +106,21 @@ def main(argv: list[str] | None = None) -> int:
         held_out.append(result.held_out.assign(spec=path, algorithm=spec.algorithm,
                                                objective_name=spec.objective,
                                                training_runs=result.runs_spent))
-        if args.compare:
+        per_map.append(result.held_out_maps.assign(algorithm=spec.algorithm,
+                                                   objective_name=spec.objective))
+        if args.compare and not args.compare_specs:
             comparison += _compare(document, path, args)
+    for path in args.compare_specs:
+        document = tomllib.loads(_found(path).read_text())
+        comparison += _compare(document, path, args)
     frame = pd.concat(held_out, ignore_index=True)
     args.out.mkdir(parents=True, exist_ok=True)
+    maps = _default_against_best(pd.concat(per_map, ignore_index=True))
     write_atomically(args.out / "held_out.csv", frame.to_csv(index=False))
-    record.finish(title=TITLE, about=ABOUT, specs=paths)
-    write_atomically(args.out / "table.md", record.document(_table(frame)))
+    write_atomically(args.out / "held_out_maps.csv", maps.to_csv(index=False))
+    record.finish(title=TITLE, about=ABOUT, specs=paths, compare_specs=args.compare_specs)
+    write_atomically(args.out / "table.md", record.document(
+        _table(frame) + "\n" + PER_MAP + "\n\n" + _markdown(maps)))
     record.write(args.out)
     if comparison:
         compared = pd.DataFrame(comparison)
@@ -113,13 +138,26 @@ def _found(path: str) -> Path:
 
 def _compare(document: dict, path: str, args) -> list[dict]:
     """Every method of ``args.methods`` with ``args.tuner_seeds`` tuner seeds on the spec
-    ``document``: one row per tune, its best setting's and the defaults' held-out objective."""
+    ``document``: one row per tune, its best setting's and the defaults' held-out objective.
+    The grid runs first, with ``args.grid_budget`` times the spec's budget; the other methods
+    then get the runs the grid spent (the least over its seeds) divided by that factor, so the
+    race is judged against a grid that spent ``args.grid_budget`` times as many runs even
+    where the grid's settings and instances do not fill its budget."""
+    methods = args.methods.split(",")
+    budget = document["tune"]["budget"]
     rows = []
-    for method in args.methods.split(","):
+    for method in sorted(methods, key=lambda m: m != "grid"):
+        if method == "grid":
+            method_budget = max(1, round(args.grid_budget * budget))
+        elif "grid" in methods:
+            grid_runs = min(row["runs"] for row in rows if row["method"] == "grid")
+            method_budget = max(1, int(grid_runs // args.grid_budget))
+        else:
+            method_budget = budget
         for seed in range(args.tuner_seeds):
-            changed = dict(document, tune=dict(document["tune"], method=method, seed=seed,
-                                               name=f"{document['tune'].get('name', 'tune')}"
-                                                    f"_{method}_{seed}"))
+            changed = dict(document, tune=dict(
+                document["tune"], method=method, seed=seed, budget=method_budget,
+                name=f"{document['tune'].get('name', 'tune')}_{method}_{seed}"))
             spec = tune_spec_from_dict(changed, source=path)
             result = tune(spec, args.stores / spec.name)
             table = result.held_out.set_index("label")
@@ -129,6 +167,52 @@ def _compare(document: dict, path: str, args) -> list[dict]:
                              best=float(table.loc["best", "objective"]),
                              default=float(table.loc["default", "objective"])))
     return rows
+
+
+PER_MAP = ("Per held-out map: the defaults' objective and the best setting's, and whether the "
+           "best does at least as well there (`at_least_as_good`; Moving AI maps are named "
+           "with their scenario row, `map#row`). `paper_gap` is what the paper claims there: "
+           "only the RFD paper reports runs on held-out maps (its Table 1 on the 100 x 100 "
+           "maps, for `ant_system` (its ACO), `aco_star`, `rfd` and `rfd_star`), as the "
+           "relative gap of its mean path to its Dijkstra path on its own maps (`nan` where it "
+           "found none or reports nothing); `reaches_paper` holds when every run of the best "
+           "setting found a path within that gap (plus 1e-4), and is empty where the paper "
+           "claims nothing. A `False` there is the finding that the calibrated constants do "
+           "not reach the paper's claim.")
+"""What the per-map table shows."""
+
+PAPER_ROWS = {"ant_system": "ACO", "aco_star": "ACO*", "rfd": "RFD", "rfd_star": "RFD*"}
+"""The RFD paper's Table 1 row of each swarm it runs."""
+
+
+def _default_against_best(per_map: pd.DataFrame) -> pd.DataFrame:
+    """One row per swarm and held-out map: the defaults' and the best setting's objective and
+    shares of runs that found a path, whether the best is at least as good (the objective's
+    direction from its name: higher is better for ``success``), and the paper's claim there
+    (:func:`_paper_gap`) with whether the best reaches it."""
+    rows = []
+    for (algorithm, map_name), group in per_map.groupby(["algorithm", "map"], sort=False):
+        by_label = group.set_index("label")
+        default, best = by_label.loc["default"], by_label.loc["best"]
+        objective = group["objective_name"].iloc[0]
+        claim = _paper_gap(algorithm, map_name)
+        reaches = None if math.isnan(claim) or objective != "gap" else bool(
+            best["found"] == 1.0 and best["objective"] <= claim + SUCCESS_GAP)
+        rows.append(dict(
+            algorithm=algorithm, map=map_name, objective_name=objective,
+            default=float(default["objective"]), best=float(best["objective"]),
+            default_found=float(default["found"]), best_found=float(best["found"]),
+            at_least_as_good=_at_least_as_good(objective, best["objective"],
+                                               default["objective"]),
+            paper_gap=claim, reaches_paper=reaches))
+    return pd.DataFrame(rows)
+
+
+def _paper_gap(algorithm: str, map_name: str) -> float:
+    """The relative gap the RFD paper's Table 1 reports for ``algorithm`` on ``map_name`` (its
+    mean path over its Dijkstra path, less 1); NaN where it reports no path or nothing."""
+    length = PAPER_TABLE1_LENGTH.get(PAPER_ROWS.get(algorithm, ""), {}).get(map_name)
+    return math.nan if length is None else length / PAPER_OPTIMA[map_name] - 1.0
 
 
 def _table(frame: pd.DataFrame) -> str:
@@ -141,9 +225,54 @@ def _comparison(frame: pd.DataFrame) -> str:
     summary = frame.groupby(["algorithm", "method"], sort=False).agg(
         budget=("budget", "first"), runs=("runs", "median"),
         median=("best", statistics.median), lowest=("best", "min"), highest=("best", "max"),
-        default=("default", "first")).reset_index()
+        default=("default", "first"), objective_name=("objective_name", "first")
+    ).reset_index()
+    verdicts = pd.DataFrame([_verdict(algorithm, rows)
+                             for algorithm, rows in summary.groupby("algorithm", sort=False)])
     return ("Held-out objective of each method's best setting over the tuner seeds (median, "
-            "lowest and highest), beside the defaults'.\n\n" + _markdown(summary))
+            "lowest and highest), beside the defaults'.\n\n" + _markdown(summary)
+            + "\n" + VERDICTS + "\n\n" + _markdown(verdicts))
+
+
+VERDICTS = ("Verdicts: `near_grid` holds when the race's median is within 1 percentage point "
+            "of success (or 1 % of a mean objective) of the grid's median while the race spent "
+            "at most a third of the grid's runs; `not_worse_than_random` when the race's "
+            "median is at least as good as random search's at the same budget. A method that "
+            "did not run leaves its columns `nan`.")
+"""What the verdict columns mean."""
+
+
+def _verdict(algorithm: str, summary: pd.DataFrame) -> dict:
+    """The race against the grid and random search for one algorithm's rows of the summary
+    (one per method: ``median``, ``runs``); the objective's direction from its name."""
+    by_method = summary.set_index("method")
+    objective = summary["objective_name"].iloc[0]
+    row = dict(algorithm=algorithm, objective_name=objective)
+    if "race" not in by_method.index:
+        return row
+    race = by_method.loc["race"]
+    row["race_median"] = float(race["median"])
+    if "grid" in by_method.index:
+        grid = by_method.loc["grid"]
+        slack = 0.01 if objective == "success" else 0.01 * abs(float(grid["median"]))
+        row |= dict(grid_median=float(grid["median"]),
+                    runs_share=float(race["runs"]) / float(grid["runs"]),
+                    near_grid=_at_least_as_good(objective, race["median"], grid["median"], slack)
+                    and bool(3 * race["runs"] <= grid["runs"]))
+    if "random" in by_method.index:
+        random = by_method.loc["random"]
+        row |= dict(random_median=float(random["median"]),
+                    not_worse_than_random=_at_least_as_good(objective, race["median"],
+                                                            random["median"]))
+    return row
+
+
+def _at_least_as_good(objective: str, value: float, other: float, slack: float = 0.0) -> bool:
+    """Whether ``value`` of ``objective`` is at least as good as ``other`` less ``slack``
+    (higher is better for a success rate, lower for every mean)."""
+    if objective == "success":
+        return bool(value >= other - slack)
+    return bool(value <= other + slack)
 
 
 def _markdown(frame: pd.DataFrame) -> str:

@@ -1,6 +1,8 @@
 """The tuner: specs and their errors, the search space, iterated racing and the other methods on
 a planted objective, and a real tune on small maps that resumes after a kill to the same race."""
+import argparse
 import json
+import types
 from pathlib import Path
 
 import numpy as np
@@ -200,6 +202,11 @@ def test_a_tune_rescores_the_best_beside_the_defaults_on_held_out_instances(fini
     default = held[held["setting"] == -1]
     assert table["objective"].iloc[0] == pytest.approx(default["loss"].mean())
     assert (runs["loss"] == np.where(runs["found"], runs["gap"], spec.unsolved_gap)).all()
+    # Per held-out map (one here): each setting's rows of that map, labelled as in the table.
+    maps = result.held_out_maps
+    assert list(maps["label"]) == list(table["label"]) and set(maps["map"]) == {"alley20"}
+    np.testing.assert_allclose(maps["objective"], table["objective"])
+    assert (maps["runs"] == 2).all() and (out / "held_out_maps.csv").is_file()
 
 
 def test_a_killed_tune_resumes_to_the_same_race_running_only_what_was_lost(
@@ -271,7 +278,7 @@ def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
         np.testing.assert_array_equal(outputs[0][name], outputs[1][name])
 
 
-def test_every_paper_swarm_has_a_committed_spec_and_a_quick_twin_of_the_same_space():
+def test_every_paper_swarm_has_a_committed_spec_and_twins_of_the_same_space():
     from jaxswarm.swarm import registry
     from jaxswarm.tune import load_tune_spec
     paper = {name for name in registry.registered() if registry.entry(name).faithful}
@@ -284,22 +291,100 @@ def test_every_paper_swarm_has_a_committed_spec_and_a_quick_twin_of_the_same_spa
             k: type(d) for k, d in spec.space.domains.items()}  # cabc's limit scales with N
         assert quick.budget < spec.budget
         assert not set(spec.space.domains) & set(spec.fixed)
+    for path in sorted((REPO / "tunes" / "compare").glob("*.toml")):  # the tuner comparison's
+        twin = load_tune_spec(path)
+        assert twin.space.domains == specs[path.stem].space.domains
+        assert twin.objective == specs[path.stem].objective and twin.method == "race"
 
 
-@pytest.mark.slow  # two quick calibrations and their comparison: about three minutes
+@pytest.mark.slow  # two quick calibrations and their comparison: about four minutes
 def test_the_calibration_script_writes_its_tables(tmp_path, monkeypatch):
     monkeypatch.chdir(REPO)
     calibration = load_script("sweeps/calibration.py")
     out = tmp_path / "calibration"
     calibration.main(["--specs", "tunes/quick/iwd.toml", "tunes/quick/aco_star.toml",
-                      "--compare", "--methods", "race,random", "--tuner-seeds", "2",
+                      "--compare", "--methods", "race,random,grid", "--tuner-seeds", "1",
                       "--out", str(out), "--stores", str(tmp_path / "stores")])
     held_out = pd.read_csv(out / "held_out.csv")
     assert set(held_out["algorithm"]) == {"iwd", "aco_star"}
     assert set(held_out["label"]) >= {"default", "best"}
     comparison = pd.read_csv(out / "comparison.csv")
-    assert len(comparison) == 2 * 2 * 2
+    assert len(comparison) == 2 * 3
     assert (comparison["runs"] <= comparison["budget"]).all()
+    for _, rows in comparison.groupby("algorithm"):  # each spec's own grid sets its budgets
+        budget = rows.set_index("method")["budget"]
+        grid_runs = rows.loc[rows["method"] == "grid", "runs"].min()
+        assert budget["grid"] == 3 * 60 and budget["random"] == budget["race"] == grid_runs // 3
+    assert "near_grid" in (out / "comparison.md").read_text()
     for name in ("table.md", "comparison.md", "provenance.json", "iwd/race.png",
                  "aco_star/best.json"):
         assert (out / name).is_file()
+
+
+@pytest.mark.parametrize("objective, race, grid, random, race_runs, near, not_worse", [
+    ("gap", 1.005, 1.0, 1.2, 60, True, True),      # within 1 % of the grid at a third
+    ("gap", 1.02, 1.0, 1.2, 60, False, True),      # 2 % worse than the grid
+    ("gap", 1.0, 1.0, 0.9, 61, False, False),      # more than a third; random better
+    ("success", 0.595, 0.6, 0.5, 60, True, True),  # success: higher is better, 1 pp of slack
+    ("success", 0.58, 0.6, 0.59, 60, False, False),
+])
+def test_the_comparison_verdicts(objective, race, grid, random, race_runs, near, not_worse):
+    calibration = load_script("sweeps/calibration.py")
+    summary = pd.DataFrame(dict(method=["race", "grid", "random"], median=[race, grid, random],
+                                runs=[race_runs, 180, 60], objective_name=objective))
+    verdict = calibration._verdict("iwd", summary)
+    assert verdict["near_grid"] is near and verdict["not_worse_than_random"] is not_worse
+    assert verdict["runs_share"] == pytest.approx(race_runs / 180)
+    alone = calibration._verdict("iwd", summary[summary["method"] == "race"])
+    assert "near_grid" not in alone and alone["race_median"] == race
+
+
+def test_the_per_map_table_sets_the_defaults_against_the_best_in_the_objectives_direction():
+    calibration = load_script("sweeps/calibration.py")
+    per_map = pd.DataFrame(dict(
+        algorithm=["iwd"] * 4 + ["bees"] * 2, map=["a", "a", "b", "b", "p", "p"],
+        label=["default", "best"] * 3, objective=[2.0, 1.0, 0.5, 0.7, 0.4, 0.6],
+        found=[0.5, 1.0, 1.0, 1.0, 0.4, 0.6],
+        objective_name=["gap"] * 4 + ["success"] * 2))
+    table = calibration._default_against_best(per_map)
+    assert list(zip(table["algorithm"], table["map"])) == [("iwd", "a"), ("iwd", "b"),
+                                                          ("bees", "p")]
+    assert list(table["at_least_as_good"]) == [True, False, True]
+    assert list(table["best"]) == [1.0, 0.7, 0.6] and list(table["default_found"]) == [0.5, 1.0,
+                                                                                     0.4]
+    assert table["paper_gap"].isna().all() and table["reaches_paper"].isna().all()
+
+
+def test_the_per_map_table_says_where_the_rfd_papers_claim_is_not_reached():
+    calibration = load_script("sweeps/calibration.py")
+    per_map = pd.DataFrame(dict(
+        algorithm=["rfd_star"] * 4 + ["ant_system"] * 2,
+        map=["maze100", "maze100", "mosaic100", "mosaic100", "alley100", "alley100"],
+        label=["default", "best"] * 3, objective=[10.0, 10.0, 0.3, 5e-5, 10.0, 25.0],
+        found=[0.0, 0.0, 1.0, 1.0, 0.0, 1.0], objective_name="gap"))
+    table = calibration._default_against_best(per_map).set_index("map")
+    # RFD* claims the optimum on every 100 x 100 map; its ACO 5435.08 on alley100 (optimum
+    # 170.42): a gap of 30.9 that a best setting at 25 with every run finding a path reaches.
+    assert table.loc["maze100", "paper_gap"] == pytest.approx(0.0)
+    assert table.loc["alley100", "paper_gap"] == pytest.approx(5435.08 / 170.42 - 1)
+    assert list(table["reaches_paper"]) == [False, True, True]
+
+
+def test_the_comparison_gives_the_other_methods_a_third_of_what_the_grid_spent(
+        tmp_path, monkeypatch):
+    calibration = load_script("sweeps/calibration.py")
+    asked = []
+
+    def fake_tune(spec, out):  # the grid fills 440 of its 450 runs on seed 0, 449 on seed 1
+        asked.append((spec.method, spec.budget))
+        spent = {0: 440, 1: 449}[spec.seed] if spec.method == "grid" else spec.budget
+        held_out = pd.DataFrame(dict(label=["default", "best"], objective=[1.0, 0.5]))
+        return types.SimpleNamespace(runs_spent=spent, held_out=held_out)
+
+    monkeypatch.setattr(calibration, "tune", fake_tune)
+    args = argparse.Namespace(methods="race,random,grid,es", tuner_seeds=2, grid_budget=3.0,
+                              stores=tmp_path)
+    rows = calibration._compare(document(tune={"budget": 150}), "spec.toml", args)
+    assert asked == [("grid", 450)] * 2 + [(m, 440 // 3) for m in ("race", "random", "es")
+                                           for _ in range(2)]
+    assert [row["best"] for row in rows] == [0.5] * 8

@@ -11,6 +11,7 @@ A tune writes to its directory (``out/tune/<name>`` by default)::
     race.png        the race drawn: each setting's life over the instances
     held_out.csv    the defaults and the best settings on the held-out instances: the objective
                     with a 95 % bootstrap interval over the instances
+    held_out_maps.csv  the same per held-out map
     best.json       the best setting's values
 
 The search never sees a held-out run: the best setting is chosen on training runs alone.
@@ -47,6 +48,8 @@ class TuneResult:
         ...; its values; ``objective``, ``low`` and ``high`` of the 95 % interval, ``found``
         and ``success``: the shares of its runs that found a path and that were within the
         success gap of the optimum, ``runs``).
+      held_out_maps: the same per held-out map (``label``, ``map``, ``objective``, ``found``,
+        ``success``, ``runs``): where a setting gains or loses.
       race: the race's log (method race; else None).
       runs_spent: training runs the search made.
       out: the tune's directory.
@@ -54,6 +57,7 @@ class TuneResult:
 
     best: dict
     held_out: pd.DataFrame
+    held_out_maps: pd.DataFrame
     race: pd.DataFrame | None
     runs_spent: int
     out: Path
@@ -97,12 +101,13 @@ def tune(spec: TuneSpec, out=None, *, log: Callable[[str], None] = print) -> Tun
     labels = ["default", "best"] + [f"elite {i}" for i in range(2, len(rescored))]
     rows = evaluator.rows(rescored, spec.held_out.pairs, phase=HELD_OUT)
     held_out = _held_out_table(spec, rescored, labels, rows)
-    _write(out, held_out, race, best[0].values)
+    held_out_maps = _per_map(spec, labels, rows)
+    _write(out, held_out, held_out_maps, race, best[0].values)
     if race is not None:
         race_figure(race, out / "race.png", title=f"{spec.name}: {spec.algorithm}, "
                     f"{spec.objective}")
-    return TuneResult(best=best[0].values, held_out=held_out, race=race, runs_spent=spent,
-                      out=out)
+    return TuneResult(best=best[0].values, held_out=held_out, held_out_maps=held_out_maps,
+                      race=race, runs_spent=spent, out=out)
 
 
 def default_values(spec: TuneSpec) -> dict:
@@ -133,8 +138,23 @@ def _held_out_table(spec: TuneSpec, settings: list[Setting], labels: list[str],
     return pd.DataFrame(table)
 
 
-def _write(out: Path, held_out: pd.DataFrame, race: pd.DataFrame | None, best: dict) -> None:
+def _per_map(spec: TuneSpec, labels: list[str], rows: pd.DataFrame) -> pd.DataFrame:
+    """One row per setting and held-out map: its objective, shares of runs that found a path
+    and that succeeded, and runs (``rows`` the held-out runs, setting-major)."""
+    count = len(rows) // len(labels)
+    labelled = rows.assign(label=np.repeat(labels, count))
+    table = [dict(label=label, map=map_name,
+                  objective=reported(spec, runs["loss"].to_numpy(np.float64)),
+                  found=float(runs["found"].mean()), success=float(runs["success"].mean()),
+                  runs=len(runs))
+             for (label, map_name), runs in labelled.groupby(["label", "map"], sort=False)]
+    return pd.DataFrame(table)
+
+
+def _write(out: Path, held_out: pd.DataFrame, held_out_maps: pd.DataFrame,
+           race: pd.DataFrame | None, best: dict) -> None:
     write_atomically(out / "held_out.csv", held_out.to_csv(index=False))
+    write_atomically(out / "held_out_maps.csv", held_out_maps.to_csv(index=False))
     if race is not None:
         write_atomically(out / "race.csv", race.to_csv(index=False))
     write_atomically(out / "best.json", json.dumps(best, indent=2, default=float))
