@@ -56,6 +56,12 @@ class Setting:
     values: dict
 
 
+def instance_order(instances: list, rng: np.random.Generator) -> list:
+    """``instances`` in the order the tuner's generator shuffles them (every method's: a race
+    and the searches of one tuner seed take the same order)."""
+    return [instances[i] for i in rng.permutation(len(instances))]
+
+
 def run_losses(spec: TuneSpec, rows: pd.DataFrame, num_agents: int) -> np.ndarray:
     """f64[C] each row's loss under ``spec.objective`` (see the module docstring)."""
     if spec.objective == "success":

@@ -30,7 +30,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from jaxswarm.tune.evaluate import Evaluator, Setting
+from jaxswarm.tune.evaluate import Evaluator, Setting, instance_order
 from jaxswarm.tune.space import Choice, Space, from_unit, to_unit
 from jaxswarm.tune.stats import race_step, ranks
 
@@ -63,8 +63,7 @@ def iterated_race(evaluator: Evaluator, space: Space, defaults: dict,
       rng: the tuner's generator (draws and the instance order).
     """
     spec = evaluator.spec
-    instances = spec.training.pairs
-    order = [instances[i] for i in rng.permutation(len(instances))]
+    order = instance_order(spec.training.pairs, rng)
     dimension = max(len(space.free), 1)
     iterations = int(2 + math.log2(dimension))
     survivors = int(2 + math.log2(dimension))

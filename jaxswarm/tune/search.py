@@ -24,7 +24,7 @@ import numpy as np
 import optax
 
 from jaxswarm.runtime.evolution import antithetic_gradient
-from jaxswarm.tune.evaluate import Evaluator, Setting
+from jaxswarm.tune.evaluate import Evaluator, Setting, instance_order
 from jaxswarm.tune.space import Space, from_unit, to_unit
 
 
@@ -41,7 +41,7 @@ def random_search(evaluator: Evaluator, space: Space, defaults: dict,
                   rng: np.random.Generator) -> SearchResult:
     """Random search (see the module docstring)."""
     spec = evaluator.spec
-    order = _instance_order(spec.training.pairs, rng)
+    order = instance_order(spec.training.pairs, rng)
     least = spec.first_test + 5
     count = min(len(order), max(1, spec.budget // least))
     settings = _numbered([{name: defaults[name] for name in space.free}]
@@ -54,7 +54,7 @@ def random_search(evaluator: Evaluator, space: Space, defaults: dict,
 def grid_search(evaluator: Evaluator, space: Space, rng: np.random.Generator) -> SearchResult:
     """The grid (see the module docstring)."""
     spec = evaluator.spec
-    order = _instance_order(spec.training.pairs, rng)
+    order = instance_order(spec.training.pairs, rng)
     points = spec.grid_points or _most_points(space, spec.budget // spec.first_test)
     grid = space.grid(points)
     count = min(len(order), max(1, spec.budget // len(grid)))
@@ -65,7 +65,7 @@ def es_search(evaluator: Evaluator, space: Space, defaults: dict,
               rng: np.random.Generator) -> SearchResult:
     """Evolution strategies with ``optax.adam`` (see the module docstring)."""
     spec = evaluator.spec
-    order = _instance_order(spec.training.pairs, rng)
+    order = instance_order(spec.training.pairs, rng)
     numeric = space.numeric
     mean = np.array([min(max(to_unit(space.domains[n], defaults[n]), 0.0), 1.0)
                      for n in numeric])
@@ -93,11 +93,6 @@ def es_search(evaluator: Evaluator, space: Space, defaults: dict,
         updates, state = optimizer.update(gradient.astype(np.float64), state, mean)
         mean = np.clip(np.asarray(optax.apply_updates(mean, updates)), 0.0, 1.0)
     return SearchResult(best=[setting(mean)], settings=made)
-
-
-def _instance_order(instances: list, rng: np.random.Generator) -> list:
-    """The training instances in the order the tuner's key shuffles them."""
-    return [instances[i] for i in rng.permutation(len(instances))]
 
 
 def _numbered(values: list[dict], space: Space) -> list[Setting]:
