@@ -305,13 +305,7 @@ def measure(scalar, swarm_name: str, graph, task, memory, drops: int, seeds: int
 
 def timed(call, repeats: int):
     """``(median seconds, result)`` of ``call()`` over ``repeats`` runs after a warm-up."""
-    jax.block_until_ready(call())
-    times = []
-    for _ in range(repeats):
-        began = time.perf_counter()
-        result = jax.block_until_ready(call())
-        times.append(time.perf_counter() - began)
-    return statistics.median(times), result
+    return timed_in_turn({"call": call}, repeats)["call"]
 
 
 def measure_drops(graph, task, drops: int, seeds: int, repeats: int) -> dict:
