@@ -1,28 +1,30 @@
 """The papers' open constants calibrated: every tune spec of ``tunes/`` raced, its best setting
-rescored beside the swarm's defaults on held-out instances; and, with ``--compare`` or
-``--compare-specs``, racing against random search, the grid and evolution strategies.
+rescored beside its baseline (the swarm's defaults before the calibration) on held-out instances;
+whether the best setting is now the swarm's default; and, with ``--compare`` or ``--compare-specs``,
+racing against random search, the grid and evolution strategies.
 
 Per spec (``--specs``, default every ``tunes/*.toml``; ``--quick``: ``tunes/quick/*.toml``), one
-tune (:func:`jaxswarm.tune.tune`, its store under ``--stores``): the race, then the defaults and
-the best settings on the spec's held-out instances, the objective with a 95 % bootstrap interval
-over them, and the shares of runs that found a path and that reached the optimum. With
-``--compare``, each spec (or with ``--compare-specs`` each of those specs instead, e.g. the smaller
-twins of ``tunes/compare/``) is tuned by every method of ``--methods`` with ``--tuner-seeds`` tuner
-seeds each: first the grid with ``--grid-budget`` times the spec's budget (3 by default), then the
-others with the runs the grid spent divided by that factor (the race is judged against a grid that
-spent three times as many runs), and each tune's best setting is rescored on the held-out
-instances; a verdict per spec compares the race's median held-out objective with the grid's median
-(within ``1 pp`` of success, or ``1 %`` of the mean gap or the other mean objectives) and with
-random search's (never worse, at the same budget).
+tune (:func:`jaxswarm.tune.tune`, its store under ``--stores``): the race, then the baseline and the
+best settings on the spec's held-out instances, the objective with a 95 % bootstrap interval over
+them, and the shares of runs that found a path and that reached the optimum. With ``--compare``,
+each spec (or with ``--compare-specs`` each of those specs instead, e.g. the smaller twins of
+``tunes/compare/``) is tuned by every method of ``--methods`` with ``--tuner-seeds`` tuner seeds
+each: first the grid with ``--grid-budget`` times the spec's budget (3 by default), then the others
+with the runs the grid spent divided by that factor (the race is judged against a grid that spent
+three times as many runs), and each tune's best setting is rescored on the held-out instances; a
+verdict per spec compares the race's median held-out objective with the grid's median (within ``1
+pp`` of success, or ``1 %`` of the mean gap or the other mean objectives) and with random search's
+(never worse, at the same budget).
 
 Written to ``--out`` (default ``out/calibration``; ``results/calibration`` for the committed
 tables), each file atomically: ``held_out.csv`` (one row per spec and rescored setting),
-``held_out_maps.csv`` (per spec and held-out map, the defaults against the best setting and,
-where the RFD paper reports runs on the map, its claim),
-``table.md`` (the provenance, then both tables), ``provenance.json`` and per spec its race's
-``race.png``, ``race.csv`` and ``best.json``; with a comparison, ``comparison.csv`` and
-``comparison.md`` (per spec and method: the median, lowest and highest held-out objective over
-the tuner seeds and the runs spent; then the verdicts).
+``held_out_maps.csv`` (per spec and held-out map, the baseline against the best setting and, where
+the RFD paper reports runs on the map, its claim), ``defaults.csv`` (per spec, whether the best
+setting is at least as good as the baseline overall and on every held-out map, and whether it is the
+swarm's registered default), ``table.md`` (the provenance, then the three tables),
+``provenance.json`` and per spec its race's ``race.png``, ``race.csv`` and ``best.json``; with a
+comparison, ``comparison.csv`` and ``comparison.md`` (per spec and method: the median, lowest and
+highest held-out objective over the tuner seeds and the runs spent; then the verdicts).
 
 Run from the repository root::
 
@@ -42,6 +44,7 @@ from pathlib import Path
 
 import math
 
+import numpy as np
 import pandas as pd
 
 from jaxswarm.maps.paper import PAPER_OPTIMA, PAPER_TABLE1_LENGTH
@@ -51,14 +54,17 @@ from jaxswarm.studies import provenance
 from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.tune import tune, tune_spec_from_dict
 from jaxswarm.tune.spec import METHODS
+from jaxswarm.tune.tuner import default_values
 
 ROOT = Path(__file__).resolve().parents[1]
 """The repository root: spec paths are relative to it."""
 TITLE = "The papers' open constants, raced and judged on held-out instances"
 """Title of table.md."""
 ABOUT = ("Each row is a setting of a paper swarm on its spec's held-out instances (maps and "
-         "seeds the search never ran on): `default` is the swarm as registered (the paper's "
-         "values where it gives them, ours where it does not), `best` and `elite k` the race's "
+         "seeds the search never ran on): `baseline` is the setting the race started from, the "
+         "swarm's defaults before this calibration (the paper's values where it gives them, "
+         "ours where it does not; a spec's `[tune.baseline]` pins them where the best setting "
+         "has since become the default), `best` and `elite k` the race's "
          "survivors on the training instances (`tunes/<swarm>.toml` names the constants each "
          "paper leaves open and the ranges searched). `objective` is the spec's objective "
          "(lower is better for a gap, higher for a success rate) with a 95 % bootstrap "
@@ -70,6 +76,41 @@ ABOUT = ("Each row is a setting of a paper swarm on its spec's held-out instance
 
 
 def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    if not backends_started():
+        configure(devices=args.devices)
+    record = provenance.begin(__file__, argv)
+    paths = args.specs or sorted(str(path.relative_to(ROOT)) for path in (
+        ROOT / "tunes" / ("quick" if args.quick else "")).glob("*.toml"))
+    held_out, per_map, registered, comparison = [], [], [], []
+    for path in paths:
+        document = tomllib.loads(_found(path).read_text())
+        spec = tune_spec_from_dict(document, source=path)
+        result = tune(spec, args.stores / spec.name)
+        folder = args.out / spec.algorithm
+        folder.mkdir(parents=True, exist_ok=True)
+        for name in ("race.png", "race.csv", "best.json"):
+            if (result.out / name).is_file():
+                shutil.copyfile(result.out / name, folder / name)
+        held_out.append(result.held_out.assign(spec=path, algorithm=spec.algorithm,
+                                               objective_name=spec.objective,
+                                               training_runs=result.runs_spent))
+        per_map.append(result.held_out_maps.assign(algorithm=spec.algorithm,
+                                                   objective_name=spec.objective))
+        registered.append(dict(algorithm=spec.algorithm,
+                               adopted=_is_default(default_values(spec), result.best)))
+        if args.compare and not args.compare_specs:
+            comparison += _compare(document, path, args)
+    for path in args.compare_specs:
+        document = tomllib.loads(_found(path).read_text())
+        comparison += _compare(document, path, args)
+    record.finish(title=TITLE, about=ABOUT, specs=paths, compare_specs=args.compare_specs)
+    _write(args.out, record, pd.concat(held_out, ignore_index=True),
+           pd.concat(per_map, ignore_index=True), pd.DataFrame(registered), comparison)
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--specs", nargs="*", help="tune specs (default: tunes/*.toml)")
     parser.add_argument("--quick", action="store_true", help="the quick specs of tunes/quick/")
@@ -87,46 +128,26 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--devices", type=int, default=os.cpu_count(),
                         help="JAX CPU devices the runs are shared out over (default: one per "
                              "core; ignored when JAX has already started)")
-    args = parser.parse_args(argv)
-    if not backends_started():
-        configure(devices=args.devices)
-    record = provenance.begin(__file__, argv)
-    paths = args.specs or sorted(str(path.relative_to(ROOT)) for path in (
-        ROOT / "tunes" / ("quick" if args.quick else "")).glob("*.toml"))
-    held_out, per_map, comparison = [], [], []
-    for path in paths:
-        document = tomllib.loads(_found(path).read_text())
-        spec = tune_spec_from_dict(document, source=path)
-        result = tune(spec, args.stores / spec.name)
-        folder = args.out / spec.algorithm
-        folder.mkdir(parents=True, exist_ok=True)
-        for name in ("race.png", "race.csv", "best.json"):
-            if (result.out / name).is_file():
-                shutil.copyfile(result.out / name, folder / name)
-        held_out.append(result.held_out.assign(spec=path, algorithm=spec.algorithm,
-                                               objective_name=spec.objective,
-                                               training_runs=result.runs_spent))
-        per_map.append(result.held_out_maps.assign(algorithm=spec.algorithm,
-                                                   objective_name=spec.objective))
-        if args.compare and not args.compare_specs:
-            comparison += _compare(document, path, args)
-    for path in args.compare_specs:
-        document = tomllib.loads(_found(path).read_text())
-        comparison += _compare(document, path, args)
-    frame = pd.concat(held_out, ignore_index=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    maps = _default_against_best(pd.concat(per_map, ignore_index=True))
-    write_atomically(args.out / "held_out.csv", frame.to_csv(index=False))
-    write_atomically(args.out / "held_out_maps.csv", maps.to_csv(index=False))
-    record.finish(title=TITLE, about=ABOUT, specs=paths, compare_specs=args.compare_specs)
-    write_atomically(args.out / "table.md", record.document(
-        _table(frame) + "\n" + PER_MAP + "\n\n" + _markdown(maps)))
-    record.write(args.out)
+    return parser
+
+
+def _write(out: Path, record: provenance.Provenance, frame: pd.DataFrame, per_map: pd.DataFrame,
+           registered: pd.DataFrame, comparison: list[dict]) -> None:
+    """Every table of ``out`` (see the module docstring), each file atomically."""
+    out.mkdir(parents=True, exist_ok=True)
+    maps = _baseline_against_best(per_map)
+    defaults = _defaults(frame, maps, registered)
+    write_atomically(out / "held_out.csv", frame.to_csv(index=False))
+    write_atomically(out / "held_out_maps.csv", maps.to_csv(index=False))
+    write_atomically(out / "defaults.csv", defaults.to_csv(index=False))
+    write_atomically(out / "table.md", record.document(
+        _table(frame) + "\n" + PER_MAP + "\n\n" + _markdown(maps) + "\n" + DEFAULTS + "\n\n"
+        + _markdown(defaults)))
+    record.write(out)
     if comparison:
         compared = pd.DataFrame(comparison)
-        write_atomically(args.out / "comparison.csv", compared.to_csv(index=False))
-        write_atomically(args.out / "comparison.md", record.document(_comparison(compared)))
-    return 0
+        write_atomically(out / "comparison.csv", compared.to_csv(index=False))
+        write_atomically(out / "comparison.md", record.document(_comparison(compared)))
 
 
 def _found(path: str) -> Path:
@@ -138,7 +159,7 @@ def _found(path: str) -> Path:
 
 def _compare(document: dict, path: str, args) -> list[dict]:
     """Every method of ``args.methods`` with ``args.tuner_seeds`` tuner seeds on the spec
-    ``document``: one row per tune, its best setting's and the defaults' held-out objective.
+    ``document``: one row per tune, its best setting's and the baseline's held-out objective.
     The grid runs first, with ``args.grid_budget`` times the spec's budget; the other methods
     then get the runs the grid spent (the least over its seeds) divided by that factor, so the
     race is judged against a grid that spent ``args.grid_budget`` times as many runs even
@@ -165,11 +186,11 @@ def _compare(document: dict, path: str, args) -> list[dict]:
                              runs=result.runs_spent, budget=spec.budget,
                              objective_name=spec.objective,
                              best=float(table.loc["best", "objective"]),
-                             default=float(table.loc["default", "objective"])))
+                             baseline=float(table.loc["baseline", "objective"])))
     return rows
 
 
-PER_MAP = ("Per held-out map: the defaults' objective and the best setting's, and whether the "
+PER_MAP = ("Per held-out map: the baseline's objective and the best setting's, and whether the "
            "best does at least as well there (`at_least_as_good`; Moving AI maps are named "
            "with their scenario row, `map#row`). `paper_gap` is what the paper claims there: "
            "only the RFD paper reports runs on held-out maps (its Table 1 on the 100 x 100 "
@@ -185,27 +206,62 @@ PAPER_ROWS = {"ant_system": "ACO", "aco_star": "ACO*", "rfd": "RFD", "rfd_star":
 """The RFD paper's Table 1 row of each swarm it runs."""
 
 
-def _default_against_best(per_map: pd.DataFrame) -> pd.DataFrame:
-    """One row per swarm and held-out map: the defaults' and the best setting's objective and
+def _baseline_against_best(per_map: pd.DataFrame) -> pd.DataFrame:
+    """One row per swarm and held-out map: the baseline's and the best setting's objective and
     shares of runs that found a path, whether the best is at least as good (the objective's
     direction from its name: higher is better for ``success``), and the paper's claim there
     (:func:`_paper_gap`) with whether the best reaches it."""
     rows = []
     for (algorithm, map_name), group in per_map.groupby(["algorithm", "map"], sort=False):
         by_label = group.set_index("label")
-        default, best = by_label.loc["default"], by_label.loc["best"]
+        baseline, best = by_label.loc["baseline"], by_label.loc["best"]
         objective = group["objective_name"].iloc[0]
         claim = _paper_gap(algorithm, map_name)
         reaches = None if math.isnan(claim) or objective != "gap" else bool(
             best["found"] == 1.0 and best["objective"] <= claim + SUCCESS_GAP)
         rows.append(dict(
             algorithm=algorithm, map=map_name, objective_name=objective,
-            default=float(default["objective"]), best=float(best["objective"]),
-            default_found=float(default["found"]), best_found=float(best["found"]),
+            baseline=float(baseline["objective"]), best=float(best["objective"]),
+            baseline_found=float(baseline["found"]), best_found=float(best["found"]),
             at_least_as_good=_at_least_as_good(objective, best["objective"],
-                                               default["objective"]),
+                                               baseline["objective"]),
             paper_gap=claim, reaches_paper=reaches))
     return pd.DataFrame(rows)
+
+
+DEFAULTS = ("The defaults: a swarm's best setting became its default (jaxswarm 0.8.0) where it is "
+            "at least as good as the baseline both overall (`overall`) and on every held-out "
+            "map (`every_map`); elsewhere the defaults stayed as they were. `adopted` says "
+            "whether the swarm's registered defaults are the best setting (equal as float32, "
+            "the precision the swarms compute in).")
+"""What the defaults table shows."""
+
+
+def _defaults(frame: pd.DataFrame, maps: pd.DataFrame,
+              registered: pd.DataFrame) -> pd.DataFrame:
+    """One row per swarm: whether its best setting is at least as good as its baseline overall
+    (``frame``, the held-out table) and on every held-out map (``maps``), and whether it is the
+    registered default (``registered``: ``algorithm``, ``adopted``)."""
+    rows = []
+    for algorithm, table in frame.groupby("algorithm", sort=False):
+        by_label = table.set_index("label")
+        objective = table["objective_name"].iloc[0]
+        rows.append(dict(
+            algorithm=algorithm, objective_name=objective,
+            baseline=float(by_label.loc["baseline", "objective"]),
+            best=float(by_label.loc["best", "objective"]),
+            overall=_at_least_as_good(objective, by_label.loc["best", "objective"],
+                                      by_label.loc["baseline", "objective"]),
+            every_map=bool(maps.loc[maps["algorithm"] == algorithm, "at_least_as_good"].all())))
+    return pd.DataFrame(rows).merge(registered, on="algorithm")
+
+
+def _is_default(defaults: dict, best: dict) -> bool:
+    """Whether the swarm's registered ``defaults`` are the ``best`` setting (every number of the
+    setting equal as float32, every other value equal)."""
+    return all(np.float32(defaults[name]) == np.float32(value)
+               if isinstance(value, (int, float)) else defaults[name] == value
+               for name, value in best.items())
 
 
 def _paper_gap(algorithm: str, map_name: str) -> float:
@@ -225,12 +281,12 @@ def _comparison(frame: pd.DataFrame) -> str:
     summary = frame.groupby(["algorithm", "method"], sort=False).agg(
         budget=("budget", "first"), runs=("runs", "median"),
         median=("best", statistics.median), lowest=("best", "min"), highest=("best", "max"),
-        default=("default", "first"), objective_name=("objective_name", "first")
+        baseline=("baseline", "first"), objective_name=("objective_name", "first")
     ).reset_index()
     verdicts = pd.DataFrame([_verdict(algorithm, rows)
                              for algorithm, rows in summary.groupby("algorithm", sort=False)])
     return ("Held-out objective of each method's best setting over the tuner seeds (median, "
-            "lowest and highest), beside the defaults'.\n\n" + _markdown(summary)
+            "lowest and highest), beside the baseline's.\n\n" + _markdown(summary)
             + "\n" + VERDICTS + "\n\n" + _markdown(verdicts))
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import make, make_task, run
-from jaxswarm.swarm.iwd import DEFAULT_IWD, global_update, soil_taken, velocity_after
+from jaxswarm.swarm.iwd import STANDARD_IWD, global_update, soil_taken, velocity_after
 from jaxswarm.swarm.iwd.iwd import drop_walk
 from jaxswarm.swarm.iwd.soil import (SOIL, arrived_update, choice_log_weights,
                                      goal_log_desirability, walked_soil)
@@ -19,7 +19,7 @@ from jaxswarm.swarm.walking.moves import NARROWEST
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import step_slots
 
-P = DEFAULT_IWD
+P = STANDARD_IWD
 EAST = 0  # slot of the move (x, y) -> (x + 1, y)
 
 
@@ -310,8 +310,8 @@ def test_iwd_finds_the_corridor_and_its_soil_falls_along_it():
     state, trace = run(swarm, jax.random.key(0), graph, make_task(graph, 0, 5),
                        swarm.default_params, iterations=3)
     assert float(swarm.best(state).cost) == pytest.approx(5.0)
-    soil = np.asarray(state.soil)
-    assert np.all(soil[:5, EAST] < 10_000) and np.all(soil[:, 2] == 10_000)  # no west moves
+    soil, initial = np.asarray(state.soil), swarm.default_params.initial_soil
+    assert np.all(soil[:5, EAST] < initial) and np.all(soil[:, 2] == initial)  # no west moves
 
 
 def test_bad_params_are_named():

@@ -29,6 +29,7 @@ from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_resul
                             spec_from_dict)
 from jaxswarm.sweep.maps import resolve_map
 from jaxswarm.sweep.replay import replay_row
+from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.sweep.batches import group_size
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 
@@ -299,9 +300,28 @@ def test_a_store_of_0_6_0_is_not_resumed(finished, tmp_path):
     old = tmp_path / "old"
     shutil.copytree(out, old)
     _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.6.0"))  # same definition, older results
-    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.6\.0, whose swarms "
-                       r"computed otherwise \(results changed in 0\.7\.0"):
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.6\.0, whose 'rfd_star' "
+                       r"computed otherwise \(its results changed in 0\.7\.0"):
         run_sweep(spec, old, progress=False)
+
+
+def test_a_store_of_0_7_resumes_for_a_swarm_whose_results_stayed(finished, tmp_path):
+    spec, out, _ = finished
+    old = tmp_path / "old"
+    shutil.copytree(out, old)
+    _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.7.1"))  # rfd_star is as it was in 0.7
+    assert run_sweep(spec, old, progress=False).equals(read_results(out))
+
+
+@pytest.mark.parametrize("name", ["ant_system", "iwd", "max_min_aco", "rfd"])
+def test_a_store_of_0_7_is_refused_for_a_swarm_calibrated_in_0_8(tmp_path, name):
+    # Same definition as recorded (a store that recorded today's defaults under 0.7.1 cannot
+    # exist, but the version alone refuses it): its results changed with 0.8.0's defaults.
+    metadata = dict(jaxswarm="0.7.1", swarm=definition(make(name)))
+    ResultsStore(tmp_path, {"sweep": 1}, metadata)
+    with pytest.raises(StoreMismatchError, match=rf"whose '{name}' computed otherwise \(its "
+                                                 r"results changed in 0\.8\.0"):
+        ResultsStore(tmp_path, {"sweep": 1}, dict(metadata, jaxswarm="0.8.0"))
 
 
 def test_a_store_of_0_1_0s_rfd_star_is_not_resumed(finished, tmp_path):

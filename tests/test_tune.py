@@ -15,12 +15,14 @@ from jaxswarm.cli import main
 from jaxswarm.runtime.evolution import antithetic_gradient, centred_ranks
 from jaxswarm.sweep.batches import RunBatches
 from jaxswarm.sweep.maps import resolve_map
-from jaxswarm.sweep.store import ResultsStore
-from jaxswarm.tune import TuneSpecError, tune, tune_spec_from_dict
+from jaxswarm.swarm import make
+from jaxswarm.sweep.store import SAME_RESULTS_SINCE_BY_SWARM, ResultsStore
+from jaxswarm.tune import TuneSpecError, load_tune_spec, tune, tune_spec_from_dict
 from jaxswarm.tune.evaluate import Setting
 from jaxswarm.tune.race import iterated_race
 from jaxswarm.tune.search import es_search, grid_search, random_search
 from jaxswarm.tune.space import Choice, Integer, Real, Space, Tied, from_unit, to_unit
+from jaxswarm.tune.tuner import baseline_values, default_values
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -69,6 +71,11 @@ def test_a_spec_becomes_a_space_with_ties_and_fixed_values():
     (dict(config={"num_agents": {"choices": [8, -1]}}), "[config]"),
     (dict(config={"agents": 8}), "config.agents: unknown config of iwd"),
     (dict(unknown={}), "unknown: unknown section"),
+    (dict(tune={"baseline": 3}), "tune.baseline: must be a table"),
+    (dict(tune={"baseline": {"beta": 1.0}}), "tune.baseline.beta: not a searched param of this "
+                                             "spec; searched: alpha, rho_n"),
+    (dict(tune={"baseline": {"alpha": 9.0}}), "tune.baseline.alpha: must be a number in [0.5, "
+                                              "4.0], got 9.0"),
     (dict(tune={"held_out": {"maps": ["mosaic20"], "seeds": [5, 100]}}),
      "tune.held_out: 1 instance(s) are also training instances (e.g. map 'mosaic20' with seed 5)"),
 ])
@@ -176,6 +183,38 @@ def test_the_es_gradient_points_downhill_from_centred_ranks():
     assert gradient[0] < 0 < gradient[1]
 
 
+def test_a_baseline_is_where_the_search_starts_and_what_the_best_is_judged_beside(tmp_path):
+    spec = tune_spec_from_dict(document(tune={"baseline": {"alpha": 2.0}, "budget": 30}))
+    rho_n = float(make("iwd").default_params.rho_n)
+    assert baseline_values(spec) == {"alpha": 2.0, "beta": 2.0, "rho_n": pytest.approx(rho_n)}
+    result = tune(spec, tmp_path / "tune", log=lambda _: None)
+    first = result.held_out.iloc[0]
+    assert first["label"] == "baseline" and first["alpha"] == first["beta"] == 2.0
+    runs = pd.read_parquet(tmp_path / "tune" / "runs")
+    assert (runs.loc[runs["setting"] == 0, "param.alpha"] == 2.0).all()
+
+
+def test_a_calibrated_setting_is_the_default_exactly_where_it_is_at_least_as_good_everywhere():
+    # results/calibration/defaults.csv: per paper swarm, the best setting against the defaults
+    # it started from, overall and on every held-out map; the registry's defaults today must be
+    # the best setting where (and only where) both hold.
+    folder = REPO / "results" / "calibration"
+    table = pd.read_csv(folder / "defaults.csv")
+    assert set(table["algorithm"]) == {path.stem for path in (REPO / "tunes").glob("*.toml")}
+    adopted = set()
+    for row in table.itertuples():
+        spec = load_tune_spec(REPO / "tunes" / f"{row.algorithm}.toml")
+        best = json.loads((folder / row.algorithm / "best.json").read_text())
+        registered = default_values(spec)
+        is_default = all(np.float32(registered[name]) == np.float32(value)
+                         for name, value in best.items())
+        assert is_default == row.adopted == (row.overall and row.every_map), row.algorithm
+        if is_default:
+            adopted.add(row.algorithm)
+            assert baseline_values(spec) != registered  # the study still starts where it did
+    assert adopted == set(SAME_RESULTS_SINCE_BY_SWARM)  # and their stores of 0.7 are refused
+
+
 @pytest.fixture(scope="module")
 def finished_tune(tmp_path_factory):
     out = tmp_path_factory.mktemp("tune") / "tiny"
@@ -183,11 +222,12 @@ def finished_tune(tmp_path_factory):
     return spec, out, tune(spec, out, log=lambda _: None)
 
 
-def test_a_tune_rescores_the_best_beside_the_defaults_on_held_out_instances(finished_tune):
+def test_a_tune_rescores_the_best_beside_its_baseline_on_held_out_instances(finished_tune):
     spec, out, result = finished_tune
     assert 0 < result.runs_spent <= spec.budget
     table = result.held_out
-    assert list(table["label"][:2]) == ["default", "best"]
+    assert list(table["label"][:2]) == ["baseline", "best"]
+    assert table["alpha"].iloc[0] == float(make("iwd").default_params.alpha)  # no [tune.baseline]
     assert (table["runs"] == 2).all()
     assert (table["low"] <= table["objective"]).all() and (
         table["objective"] <= table["high"]).all()
@@ -280,7 +320,6 @@ def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
 
 def test_every_paper_swarm_has_a_committed_spec_and_twins_of_the_same_space():
     from jaxswarm.swarm import registry
-    from jaxswarm.tune import load_tune_spec
     paper = {name for name in registry.registered() if registry.entry(name).faithful}
     specs = {path.stem: load_tune_spec(path) for path in sorted((REPO / "tunes").glob("*.toml"))}
     assert set(specs) == paper and all(spec.algorithm == name for name, spec in specs.items())
@@ -307,7 +346,9 @@ def test_the_calibration_script_writes_its_tables(tmp_path, monkeypatch):
                       "--out", str(out), "--stores", str(tmp_path / "stores")])
     held_out = pd.read_csv(out / "held_out.csv")
     assert set(held_out["algorithm"]) == {"iwd", "aco_star"}
-    assert set(held_out["label"]) >= {"default", "best"}
+    assert set(held_out["label"]) >= {"baseline", "best"}
+    defaults = pd.read_csv(out / "defaults.csv").set_index("algorithm")
+    assert not defaults["adopted"].any()  # a quick race's best is no swarm's default
     comparison = pd.read_csv(out / "comparison.csv")
     assert len(comparison) == 2 * 3
     assert (comparison["runs"] <= comparison["budget"]).all()
@@ -339,19 +380,19 @@ def test_the_comparison_verdicts(objective, race, grid, random, race_runs, near,
     assert "near_grid" not in alone and alone["race_median"] == race
 
 
-def test_the_per_map_table_sets_the_defaults_against_the_best_in_the_objectives_direction():
+def test_the_per_map_table_sets_the_baseline_against_the_best_in_the_objectives_direction():
     calibration = load_script("sweeps/calibration.py")
     per_map = pd.DataFrame(dict(
         algorithm=["iwd"] * 4 + ["bees"] * 2, map=["a", "a", "b", "b", "p", "p"],
-        label=["default", "best"] * 3, objective=[2.0, 1.0, 0.5, 0.7, 0.4, 0.6],
+        label=["baseline", "best"] * 3, objective=[2.0, 1.0, 0.5, 0.7, 0.4, 0.6],
         found=[0.5, 1.0, 1.0, 1.0, 0.4, 0.6],
         objective_name=["gap"] * 4 + ["success"] * 2))
-    table = calibration._default_against_best(per_map)
+    table = calibration._baseline_against_best(per_map)
     assert list(zip(table["algorithm"], table["map"])) == [("iwd", "a"), ("iwd", "b"),
                                                           ("bees", "p")]
     assert list(table["at_least_as_good"]) == [True, False, True]
-    assert list(table["best"]) == [1.0, 0.7, 0.6] and list(table["default_found"]) == [0.5, 1.0,
-                                                                                     0.4]
+    assert list(table["best"]) == [1.0, 0.7, 0.6] and list(table["baseline_found"]) == [0.5, 1.0,
+                                                                                      0.4]
     assert table["paper_gap"].isna().all() and table["reaches_paper"].isna().all()
 
 
@@ -360,9 +401,9 @@ def test_the_per_map_table_says_where_the_rfd_papers_claim_is_not_reached():
     per_map = pd.DataFrame(dict(
         algorithm=["rfd_star"] * 4 + ["ant_system"] * 2,
         map=["maze100", "maze100", "mosaic100", "mosaic100", "alley100", "alley100"],
-        label=["default", "best"] * 3, objective=[10.0, 10.0, 0.3, 5e-5, 10.0, 25.0],
+        label=["baseline", "best"] * 3, objective=[10.0, 10.0, 0.3, 5e-5, 10.0, 25.0],
         found=[0.0, 0.0, 1.0, 1.0, 0.0, 1.0], objective_name="gap"))
-    table = calibration._default_against_best(per_map).set_index("map")
+    table = calibration._baseline_against_best(per_map).set_index("map")
     # RFD* claims the optimum on every 100 x 100 map; its ACO 5435.08 on alley100 (optimum
     # 170.42): a gap of 30.9 that a best setting at 25 with every run finding a path reaches.
     assert table.loc["maze100", "paper_gap"] == pytest.approx(0.0)
@@ -378,7 +419,7 @@ def test_the_comparison_gives_the_other_methods_a_third_of_what_the_grid_spent(
     def fake_tune(spec, out):  # the grid fills 440 of its 450 runs on seed 0, 449 on seed 1
         asked.append((spec.method, spec.budget))
         spent = {0: 440, 1: 449}[spec.seed] if spec.method == "grid" else spec.budget
-        held_out = pd.DataFrame(dict(label=["default", "best"], objective=[1.0, 0.5]))
+        held_out = pd.DataFrame(dict(label=["baseline", "best"], objective=[1.0, 0.5]))
         return types.SimpleNamespace(runs_spent=spent, held_out=held_out)
 
     monkeypatch.setattr(calibration, "tune", fake_tune)

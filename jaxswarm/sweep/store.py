@@ -97,12 +97,23 @@ SAME_RESULTS_SINCE = (0, 7)
 that does not depend on the batch (:mod:`jaxswarm.runtime.arithmetic`; see CHANGELOG.md), so a
 store of an older release is not resumed."""
 
+SAME_RESULTS_SINCE_BY_SWARM = {"ant_system": (0, 8), "iwd": (0, 8), "max_min_aco": (0, 8),
+                               "rfd": (0, 8)}
+"""Swarms whose results changed in a later release than ``SAME_RESULTS_SINCE``: 0.8.0 made the
+calibrated constants of these four their defaults (``results/calibration``)."""
 
-def _older_release(version: str | None) -> bool:
-    """Whether a version string (``0.2.0``, ``0.3.0.dev1``) is a release before
-    ``SAME_RESULTS_SINCE``; False when unknown (a source checkout that was not installed)."""
+
+def same_results_since(name: str) -> tuple[int, int]:
+    """``(major, minor)``: the release since which the registered swarm ``name`` gives the same
+    results (``SAME_RESULTS_SINCE_BY_SWARM``, else ``SAME_RESULTS_SINCE``)."""
+    return SAME_RESULTS_SINCE_BY_SWARM.get(name, SAME_RESULTS_SINCE)
+
+
+def _older_release(version: str | None, since: tuple[int, int]) -> bool:
+    """Whether a version string (``0.2.0``, ``0.3.0.dev1``) is a release before ``since``;
+    False when unknown (a source checkout that was not installed)."""
     try:
-        return tuple(int(part) for part in (version or "").split(".")[:2]) < SAME_RESULTS_SINCE
+        return tuple(int(part) for part in (version or "").split(".")[:2]) < since
     except ValueError:
         return False
 
@@ -113,14 +124,16 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
     Raises:
       StoreMismatchError: naming the difference (the config fields and default params that
         changed, or the jaxswarm version that wrote a store without a recorded definition or
-        before ``SAME_RESULTS_SINCE``).
+        before the release since which the swarm gives the same results,
+        :func:`same_results_since`).
     """
     stored = existing.get("swarm")
-    if stored is not None and _older_release(existing.get("jaxswarm")):
+    since = same_results_since(swarm["name"])
+    if stored is not None and _older_release(existing.get("jaxswarm"), since):
         raise StoreMismatchError(
-            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose swarms computed "
-            f"otherwise (results changed in 0.{SAME_RESULTS_SINCE[1]}.0, see CHANGELOG.md); "
-            "choose another --out or delete it")
+            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose {swarm['name']!r} "
+            f"computed otherwise (its results changed in {since[0]}.{since[1]}.0, see "
+            "CHANGELOG.md); choose another --out or delete it")
     if stored == swarm:
         return
     if stored is None:

@@ -2,17 +2,18 @@
 
 A tune of budget ``B`` runs over ``d`` free params makes ``N_iter = floor(2 + log2 d)`` iterations.
 Iteration ``j`` has a budget ``B_j = (B - spent) / (N_iter - j + 1)`` and races ``N_j = floor(B_j /
-(first_test + min(5, j)))`` settings (at least one more than the elites): in the first, the swarm's
-defaults and settings drawn uniformly; later, the elites of the race before and new settings drawn
-around them. A race takes the training instances (``(map, seed)`` pairs, in an order the tuner's
-key shuffles once: blocking, every setting sees the same instances in the same order) one after
-another, the settings still alive as one batch of runs; from the ``first_test``-th instance on,
-after each, the Friedman test on the ranks at level ``alpha`` and, when it rejects, Conover's
-pairwise comparisons against the best (:func:`jaxswarm.tune.stats.race_step`) drop the settings
-worse than the best. A race ends when at most ``N_min = floor(2 + log2 d)`` settings are alive,
-when its budget cannot pay for the next instance, or when the instances run out; its survivors,
-best mean rank first, are the elites (at most ``N_min``). A setting keeps its results from race to
-race (an elite is not run again on an instance it has seen).
+(first_test + min(5, j)))`` settings (at least one more than the elites): in the first, the tune's
+baseline (the swarm's defaults, or the spec's ``[tune.baseline]``) and settings drawn uniformly;
+later, the elites of the race before and new settings drawn around them. A race takes the training
+instances (``(map, seed)`` pairs, in an order the tuner's key shuffles once: blocking, every setting
+sees the same instances in the same order) one after another, the settings still alive as one batch
+of runs; from the ``first_test``-th instance on, after each, the Friedman test on the ranks at level
+``alpha`` and, when it rejects, Conover's pairwise comparisons against the best
+(:func:`jaxswarm.tune.stats.race_step`) drop the settings worse than the best. A race ends when at
+most ``N_min = floor(2 + log2 d)`` settings are alive, when its budget cannot pay for the next
+instance, or when the instances run out; its survivors, best mean rank first, are the elites (at
+most ``N_min``). A setting keeps its results from race to race (an elite is not run again on an
+instance it has seen).
 
 New settings: a parent elite of rank ``r`` (of ``k``) is picked with probability ``(k - r + 1) / (k
 (k + 1) / 2)``; each numeric param is drawn from a normal around the parent's value on the unit
@@ -52,14 +53,14 @@ class RaceResult:
     settings: dict
 
 
-def iterated_race(evaluator: Evaluator, space: Space, defaults: dict,
+def iterated_race(evaluator: Evaluator, space: Space, baseline: dict,
                   rng: np.random.Generator) -> RaceResult:
     """Run an iterated race within ``evaluator.spec.budget`` training runs.
 
     Args:
       evaluator: scores settings on the training instances (:mod:`jaxswarm.tune.evaluate`).
       space: the search space.
-      defaults: the swarm's default value of every param of the space (the first setting).
+      baseline: the tune's baseline, a value for every param of the space (the first setting).
       rng: the tuner's generator (draws and the instance order).
     """
     spec = evaluator.spec
@@ -89,7 +90,7 @@ def iterated_race(evaluator: Evaluator, space: Space, defaults: dict,
             break
         fresh = size - len(elites)
         if j == 1:
-            first = new_setting({name: defaults[name] for name in space.free})
+            first = new_setting({name: baseline[name] for name in space.free})
             candidates = [first] + [new_setting({n: s[n] for n in space.free})
                                     for s in space.uniform(rng, fresh - 1)]
         else:

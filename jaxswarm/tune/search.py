@@ -1,7 +1,7 @@
 """The tuner's other methods, at the same budget as the race: random search, the grid, and
 evolution strategies stepped with optax.
 
-* **random**: the swarm's defaults and settings drawn uniformly (log-uniformly on log ranges),
+* **random**: the tune's baseline and settings drawn uniformly (log-uniformly on log ranges),
   each run on the same first ``m`` training instances of the shuffled order, ``m`` the most
   instances that leave room for at least ``first_test + 5`` settings (all instances when the
   budget allows); the best mean loss wins.
@@ -9,11 +9,11 @@ evolution strategies stepped with optax.
   points whose grid fits the budget on ``first_test`` instances) and every value of each choice,
   each run on the same ``m`` instances (the most the budget allows for the whole grid).
 * **es**: evolution strategies on the unit cube of the numeric params (log-scaled where the
-  range is), from the swarm's defaults: each step runs ``es_pairs`` antithetic pairs
+  range is), from the tune's baseline: each step runs ``es_pairs`` antithetic pairs
   ``x +- es_sigma eps`` on the next ``first_test`` instances of the order (cycling; both members
   of a pair on the same instances), estimates the gradient of the mean loss from their centred
   ranks (:func:`jaxswarm.runtime.evolution.antithetic_gradient`) and steps ``optax.adam``
-  (``es_learning_rate``), keeping ``x`` in the cube; choices stay at their defaults. The last
+  (``es_learning_rate``), keeping ``x`` in the cube; choices stay at the baseline's. The last
   mean is the result.
 """
 from __future__ import annotations
@@ -37,14 +37,14 @@ class SearchResult:
     settings: dict
 
 
-def random_search(evaluator: Evaluator, space: Space, defaults: dict,
+def random_search(evaluator: Evaluator, space: Space, baseline: dict,
                   rng: np.random.Generator) -> SearchResult:
     """Random search (see the module docstring)."""
     spec = evaluator.spec
     order = instance_order(spec.training.pairs, rng)
     least = spec.first_test + 5
     count = min(len(order), max(1, spec.budget // least))
-    settings = _numbered([{name: defaults[name] for name in space.free}]
+    settings = _numbered([{name: baseline[name] for name in space.free}]
                          + [{name: s[name] for name in space.free}
                             for s in space.uniform(rng, max(0, spec.budget // count - 1))],
                          space)
@@ -61,13 +61,13 @@ def grid_search(evaluator: Evaluator, space: Space, rng: np.random.Generator) ->
     return _best_of(evaluator, _numbered(grid, space), order[:count])
 
 
-def es_search(evaluator: Evaluator, space: Space, defaults: dict,
+def es_search(evaluator: Evaluator, space: Space, baseline: dict,
               rng: np.random.Generator) -> SearchResult:
     """Evolution strategies with ``optax.adam`` (see the module docstring)."""
     spec = evaluator.spec
     order = instance_order(spec.training.pairs, rng)
     numeric = space.numeric
-    mean = np.array([min(max(to_unit(space.domains[n], defaults[n]), 0.0), 1.0)
+    mean = np.array([min(max(to_unit(space.domains[n], baseline[n]), 0.0), 1.0)
                      for n in numeric])
     optimizer = optax.adam(spec.es_learning_rate)
     state = optimizer.init(mean)
@@ -76,7 +76,7 @@ def es_search(evaluator: Evaluator, space: Space, defaults: dict,
     start = 0
 
     def setting(unit: np.ndarray) -> Setting:
-        values = {name: defaults[name] for name in space.free}
+        values = {name: baseline[name] for name in space.free}
         values |= {name: from_unit(space.domains[name], u) for name, u in zip(numeric, unit)}
         made_setting = Setting(len(made), space.complete(values))
         made[made_setting.number] = made_setting

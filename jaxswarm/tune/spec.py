@@ -25,6 +25,10 @@ budget, an objective and a method, checked before any compute::
     first_test = 5                   # instances before the first test
     alpha = 0.05                     # the tests' level
 
+    [tune.baseline]                  # optional: where the search starts, and what the
+    alpha = 1.0                      # held-out table compares against (default: the swarm's
+    rho_n = 0.9                      # defaults), for some or all searched params
+
     [config]                         # static: the swarm factory's options
     num_agents = 50                  # fixed
     # num_agents = { choices = [16, 64] } would tune it: each value compiles on its own
@@ -39,7 +43,9 @@ Also ``{ low = 1, high = 8, integer = true }`` and ``{ choices = [0.1, 0.5, 0.9]
 ``[tune]`` ``grid_points`` (method grid: values per numeric param, default the most that fit
 the budget), ``es_pairs``, ``es_sigma`` and ``es_learning_rate`` (method es), and
 ``unsolved_gap`` (objective gap: the gap a run without a path counts, default 10.0, worse than
-the paths these swarms find). Every
+the paths these swarms find). A ``[tune.baseline]`` pins the setting a calibration started
+from once its best setting has become the swarm's default, so the study still runs as it ran
+(each value inside its param's range, or one of its choices). Every
 mistake raises :class:`TuneSpecError` naming the file and the key.
 """
 from __future__ import annotations
@@ -64,7 +70,7 @@ OBJECTIVES = ("success", "gap", "time_to_target", "evaluations")
 
 TUNE_KEYS = {"name", "algorithm", "method", "budget", "objective", "iterations", "patience",
              "seed", "chunk_size", "training", "held_out", "race", "grid_points", "es_pairs",
-             "es_sigma", "es_learning_rate", "unsolved_gap"}
+             "es_sigma", "es_learning_rate", "unsolved_gap", "baseline"}
 RACE_KEYS = {"first_test", "alpha"}
 INSTANCE_KEYS = {"maps", "seeds"}
 DOMAIN_KEYS = {"low", "high", "log", "integer", "choices", "tied"}
@@ -117,6 +123,7 @@ class TuneSpec:
     es_sigma: float = 0.1
     es_learning_rate: float = 0.05
     unsolved_gap: float = 10.0
+    baseline: dict = dataclasses.field(default_factory=dict)
     source: str = "<dict>"
 
     def as_dict(self) -> dict:
@@ -198,7 +205,7 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
         es_learning_rate=_positive(tune.get("es_learning_rate", 0.05), "tune.es_learning_rate",
                                    fail),
         unsolved_gap=_positive(tune.get("unsolved_gap", 10.0), "tune.unsolved_gap", fail),
-        source=source)
+        baseline=_baseline(tune.get("baseline", {}), space, fail), source=source)
     _check_corners(spec, fail)
     return spec
 
@@ -323,6 +330,27 @@ def _domain(table: dict, key: str, fail):
             fail(key, "an integer range needs integer low and high")
         return Integer(int(low), int(high), log)
     return Real(float(low), float(high), log)
+
+
+def _baseline(table: Any, space: Space, fail) -> dict:
+    """The ``[tune.baseline]`` values: searched params only, each inside its domain."""
+    if not isinstance(table, dict):
+        fail("tune.baseline", "must be a table")
+    baseline = {}
+    for name, value in table.items():
+        key = f"tune.baseline.{name}"
+        domain = space.domains.get(name)
+        if domain is None or isinstance(domain, Tied):
+            fail(key, "not a searched param of this spec; searched: " + ", ".join(space.free))
+        if isinstance(domain, Choice):
+            if value not in domain.values:
+                fail(key, f"must be one of the choices {list(domain.values)}, got {value!r}")
+        elif not is_number(value) or not domain.low <= value <= domain.high:
+            fail(key, f"must be a number in [{domain.low}, {domain.high}], got {value!r}")
+        elif isinstance(domain, Integer) and not float(value).is_integer():
+            fail(key, f"must be an integer, got {value!r}")
+        baseline[name] = value if isinstance(domain, Choice) and domain.static else float(value)
+    return baseline
 
 
 def _check_corners(spec: TuneSpec, fail) -> None:

@@ -1,5 +1,6 @@
 """``jaxswarm tune``: search a swarm's open constants on training instances, then rescore the
-best settings beside the swarm's defaults on held-out instances.
+best settings beside its baseline (the swarm's defaults, or the spec's ``[tune.baseline]``) on
+held-out instances.
 
 A tune writes to its directory (``out/tune/<name>`` by default)::
 
@@ -9,7 +10,7 @@ A tune writes to its directory (``out/tune/<name>`` by default)::
     race.csv        the race's log (method race): who ran on which instance, who was dropped
                     after which instance and by which test
     race.png        the race drawn: each setting's life over the instances
-    held_out.csv    the defaults and the best settings on the held-out instances: the objective
+    held_out.csv    the baseline and the best settings on the held-out instances: the objective
                     with a 95 % bootstrap interval over the instances
     held_out_maps.csv  the same per held-out map
     best.json       the best setting's values
@@ -44,7 +45,7 @@ class TuneResult:
 
     Attributes:
       best: the best setting's values (name -> value).
-      held_out: one row per rescored setting (``label``: ``default``, ``best``, ``elite 2``
+      held_out: one row per rescored setting (``label``: ``baseline``, ``best``, ``elite 2``
         ...; its values; ``objective``, ``low`` and ``high`` of the 95 % interval, ``found``
         and ``success``: the shares of its runs that found a path and that were within the
         success gap of the optimum, ``runs``).
@@ -84,21 +85,21 @@ def tune(spec: TuneSpec, out=None, *, log: Callable[[str], None] = print) -> Tun
     out = Path(out) if out is not None else default_tune_out(spec)
     evaluator = Evaluator(spec, out, log)
     rng = np.random.default_rng(spec.seed)
-    defaults = default_values(spec)
+    baseline = baseline_values(spec)
     space = spec.space
     race = None
     if spec.method == "race":
-        result = iterated_race(evaluator, space, defaults, rng)
+        result = iterated_race(evaluator, space, baseline, rng)
         best, race = result.elites, result.log
     elif spec.method == "random":
-        best = random_search(evaluator, space, defaults, rng).best
+        best = random_search(evaluator, space, baseline, rng).best
     elif spec.method == "grid":
         best = grid_search(evaluator, space, rng).best
     else:
-        best = es_search(evaluator, space, defaults, rng).best
+        best = es_search(evaluator, space, baseline, rng).best
     spent = evaluator.runs_spent
-    rescored = [Setting(-1, space.complete({n: defaults[n] for n in space.free}))] + best[:3]
-    labels = ["default", "best"] + [f"elite {i}" for i in range(2, len(rescored))]
+    rescored = [Setting(-1, baseline)] + best[:3]
+    labels = ["baseline", "best"] + [f"elite {i}" for i in range(2, len(rescored))]
     rows = evaluator.rows(rescored, spec.held_out.pairs, phase=HELD_OUT)
     held_out = _held_out_table(spec, rescored, labels, rows)
     held_out_maps = _per_map(spec, labels, rows)
@@ -117,6 +118,13 @@ def default_values(spec: TuneSpec) -> dict:
     values = dict(swarm.default_params._asdict()) | spec.fixed
     values |= {name: getattr(swarm.config, name) for name in spec.space.static}
     return {name: values[name] for name in spec.space.domains}
+
+
+def baseline_values(spec: TuneSpec) -> dict:
+    """The setting a tune starts from and rescores beside its best: :func:`default_values`
+    with the spec's ``[tune.baseline]`` over them (a tied param follows its param)."""
+    values = default_values(spec) | spec.baseline
+    return spec.space.complete({name: values[name] for name in spec.space.free})
 
 
 def _held_out_table(spec: TuneSpec, settings: list[Setting], labels: list[str],

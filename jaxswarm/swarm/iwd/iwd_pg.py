@@ -47,7 +47,7 @@ from jaxswarm.swarm.core import Swarm, Task, best_solution, keep_best
 from jaxswarm.swarm.iwd import fuzzy
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pairs, first_intersection,
                                           second_intersection)
-from jaxswarm.swarm.iwd.iwd import (DEFAULT_IWD, SOIL_LABEL, IWDConfig, IWDParams, build_iwd,
+from jaxswarm.swarm.iwd.iwd import (STANDARD_IWD, SOIL_LABEL, IWDConfig, IWDParams, build_iwd,
                                     check_iwd, drop_walk, initial_soil, soil_after_best,
                                     soil_per_node, soil_rule)
 from jaxswarm.swarm.iwd.local import connect_all, splice_if_shorter
@@ -554,13 +554,15 @@ def _adapt(state: IWDPGState, before: Graph, after: Graph, old: Task, new: Task,
 
 
 def build_iwd_pg(config: IWDPGConfig) -> Swarm:
-    """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams`: its init, step
-    and change rule, the step's stages sharing one local-search swarm."""
+    """IWD_PG (see the module docstring), with IWD's :class:`~.iwd.IWDParams` at their standard
+    values (:data:`~.iwd.STANDARD_IWD`: IWD_PG's calibration, ``tunes/iwd_pg.toml``, found no
+    setting at least as good on every held-out map): its init, step and change rule, the step's
+    stages sharing one local-search swarm."""
     local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps,
                                 local_updates=config.local_updates,
                                 backtrack=config.backtrack))
     setup = _Setup(config=config, local=local)
     return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, setup)), best=best_solution,
-                 default_params=DEFAULT_IWD, check_params=check_iwd, memory=soil_per_node,
+                 default_params=STANDARD_IWD, check_params=check_iwd, memory=soil_per_node,
                  memory_label=SOIL_LABEL, adapt=_adapt, vmap_one_at_a_time=True)
