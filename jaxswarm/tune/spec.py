@@ -133,6 +133,8 @@ class TuneSpec:
         record["space"] = {name: dict(kind=type(domain).__name__, **dataclasses.asdict(domain))
                            for name, domain in self.space.domains.items()}
         record.pop("source")
+        if not self.baseline:  # the swarm's defaults: the record of a spec without the key
+            record.pop("baseline")
         return record
 
 
