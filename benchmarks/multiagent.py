@@ -1,5 +1,6 @@
-"""Multi-agent planning: prioritised planning on a MAPF benchmark instance, and the batched JAX
-conflict check beside a pure-Python one on the same solutions.
+"""Multi-agent planning: prioritised planning on a MAPF benchmark instance, the batched JAX
+conflict check beside a pure-Python one on the same solutions, PIBT's step and LaCAM's solve
+times.
 
 What is measured
 ----------------
@@ -57,6 +58,18 @@ What is measured
    tables (one entry per node per time step, 128 steps per chunk here) small beside the agents,
    where Berlin's 65,536 nodes give 8 steps per chunk (``--check-map Berlin_1_256``).
 
+3. PIBT and LaCAM. PIBT's step for the first ``--pibt-agents`` rows (default 400) of
+   ``random-32-32-20-random-1.scen``: :func:`jaxswarm.multiagent.pibt.configuration` timed alone,
+   one call per step, over ``--pibt-steps`` steps (default 200) from the starts with the
+   priorities PIBT updates; the distance fields and the first (compiling) step are left out.
+   ``median us`` is the median step, ``steps/s`` its inverse, the goal a step under 1 ms. Then
+   :func:`jaxswarm.multiagent.lacam` on ``--lacam`` (default: random-32-32-20 and both 64 x 64
+   maps, 400 agents each, ``random-1`` scenarios): one warm-up call on 2 agents (it loads the
+   kernels and compiles the hop fields for the map's shape), then one timed call per instance:
+   ``fields s`` the distance fields (one batched JAX call), ``search s`` the search,
+   ``total s`` the call as users make it; the goal is the total within 10 s on one core.
+   ``configurations`` counts LaCAM's high-level nodes, the useful work.
+
 XLA:CPU runs on ``--threads`` intra-op threads (default 1, as in ``benchmarks/rfd.py``: the
 Python check runs on one core too; see :mod:`jaxswarm.runtime.cpu`).
 
@@ -86,8 +99,11 @@ import numba
 import numpy as np
 
 from jaxswarm.maps.movingai import read_map
-from jaxswarm.multiagent import (ORDERS, find_conflicts, load_instance, lower_bound, prioritized,
-                                 validate)
+from jaxswarm.multiagent import (ORDERS, find_conflicts, hop_fields, lacam, load_instance,
+                                 lower_bound, prioritized, validate)
+from jaxswarm.multiagent.agents import agent_nodes
+from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
+                                      initial_priorities, next_priorities)
 from jaxswarm.runtime.cpu import configure, cpu_model
 from jaxswarm.world.graph import grid_graph
 
@@ -95,6 +111,10 @@ REPO = Path(__file__).resolve().parents[1]
 MAPF_DIR = Path("benchdata", "movingai", "mapf")
 PLAN_MAP = "random-32-32-10"
 GOAL_SPEEDUP = 20.0
+PIBT_MAP = "random-32-32-20"
+LACAM_INSTANCES = "random-32-32-20:400,random-64-64-10:400,room-64-64-8:400"
+GOAL_STEP_MS = 1.0
+GOAL_LACAM_S = 10.0
 
 
 def machine() -> str:
@@ -276,6 +296,51 @@ def bench_conflicts(graph, solutions: dict[str, np.ndarray], repeats: int):
     return rows, speedups
 
 
+# --- 3. PIBT and LaCAM ------------------------------------------------------------------------
+
+
+def bench_pibt(mapf: Path, agents: int, steps: int) -> tuple[str, float, int]:
+    """Part 3a: ``(instance, median seconds of one PIBT step, agents at their goals after the
+    steps)``; the distance fields and the first step (which loads the kernel) untimed."""
+    instance = load_instance(mapf / f"{PIBT_MAP}.map", mapf / f"{PIBT_MAP}-random-1.scen", agents)
+    starts, goals = agent_nodes(instance.graph, instance.starts, instance.goals)
+    moves = Moves.build(instance.graph, goals, hop_fields(instance.graph, goals))
+    work = Workspace(moves)
+    current, priorities = starts, initial_priorities(moves, starts)
+    nothing = np.zeros(0, np.int32)
+    times = []
+    for _ in range(steps + 1):
+        order = by_priority(priorities)
+        following = np.empty_like(current)
+        began = time.perf_counter()
+        configuration(moves, work, current, order, nothing, nothing, following)
+        times.append(time.perf_counter() - began)
+        priorities = next_priorities(priorities, following == goals)
+        current = following
+    return instance.name, statistics.median(times[1:]), int((current == goals).sum())
+
+
+def bench_lacam(mapf: Path, instances: list[tuple[str, int]]) -> tuple[list[tuple], bool]:
+    """Part 3b: (table rows, whether every instance was solved with a valid plan)."""
+    rows, ok = [], True
+    for name, agents in instances:
+        instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-random-1.scen", agents)
+        graph, starts, goals = instance.graph, instance.starts, instance.goals
+        lacam(graph, starts[:2], goals[:2])  # kernels and the hop fields' compile
+        began = time.perf_counter()
+        plan = lacam(graph, starts, goals)
+        total = time.perf_counter() - began
+        valid = plan.solved and not validate(graph, plan.paths, starts, goals, plan.lengths)
+        ok &= valid
+        bound = lower_bound(graph, starts, goals)
+        rows.append((name, agents, "yes" if valid else f"NO: {plan.reason}",
+                     f"{plan.stats['field_seconds']:.2f}", f"{plan.stats['seconds']:.2f}",
+                     f"{total:.2f}", f"{plan.stats['configurations']:,}",
+                     f"{plan.sum_of_costs / bound:.2f}" if plan.solved else "-",
+                     "met" if valid and total <= GOAL_LACAM_S else "NOT met"))
+    return rows, ok
+
+
 def main(argv: list[str] | None = None) -> int:
     """Parse the options, run both parts, print the tables; 1 if a result is wrong."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -291,6 +356,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--check-repeats", type=int, default=7,
                         help="timed calls of each check per solution")
     parser.add_argument("--seed", type=int, default=0, help="seed of part 2's walks")
+    parser.add_argument("--pibt-agents", type=int, default=400,
+                        help=f"agents of PIBT's step: the first rows of {PIBT_MAP}-random-1.scen")
+    parser.add_argument("--pibt-steps", type=int, default=200, help="PIBT steps timed")
+    parser.add_argument("--lacam", default=LACAM_INSTANCES,
+                        help="LaCAM's instances, MAP:AGENTS comma-separated (random-1 scenarios)")
     parser.add_argument("--threads", type=int, default=1,
                         help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
     parser.add_argument("--data", type=Path, default=REPO.parent / "shared",
@@ -302,7 +372,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.quick:
         args.repeats, args.check_repeats, args.check_agents, args.check_steps = 2, 2, 200, 200
-    for name in ("agents", "repeats", "check_agents", "check_repeats", "threads"):
+        args.pibt_steps, args.lacam = 20, "random-32-32-20:100"
+    for name in ("agents", "repeats", "check_agents", "check_repeats", "threads", "pibt_agents",
+                 "pibt_steps"):
         if getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
     if args.check_steps < 2:
@@ -343,6 +415,24 @@ def main(argv: list[str] | None = None) -> int:
           f" Goal: the batched check at least {GOAL_SPEEDUP:.0f}x faster than the Python one: "
           f"met on {len(met)} of {len(speedups)} solutions"
           f"{' (' + ', '.join(met) + ')' if met and len(met) < len(speedups) else ''}.")
+    name, step, arrived = bench_pibt(mapf, args.pibt_agents, args.pibt_steps)
+    print(f"\nPIBT on {name}: median of {args.pibt_steps} steps after the first, distance fields "
+          f"excluded\n")
+    print(markdown(("agents", "median us", "steps/s", "at goals after", f"{GOAL_STEP_MS:g} ms goal"),
+                   [(args.pibt_agents, f"{1e6 * step:.0f}", f"{1 / step:,.0f}",
+                     f"{arrived} of {args.pibt_agents}",
+                     "met" if 1e3 * step < GOAL_STEP_MS else "NOT met")], "rrrrl"))
+    try:
+        instances = [(name, int(count)) for name, count in
+                     (entry.split(":") for entry in args.lacam.split(","))]
+    except ValueError:
+        parser.error(f"--lacam: expected MAP:AGENTS,..., got {args.lacam!r}")
+    rows, lacam_ok = bench_lacam(mapf, instances)
+    print(f"\nLaCAM, one call per instance after a warm-up on 2 agents, {args.threads} XLA "
+          f"thread(s)\n")
+    print(markdown(("map", "agents", "valid", "fields s", "search s", "total s", "configurations",
+                    "SoC/bound", f"{GOAL_LACAM_S:g} s goal"), rows, "lrlrrrrrl"))
+    plans_ok &= lacam_ok
     verdict = "every plan valid" if plans_ok else "A PLAN IS INVALID OR DIFFERS (see above)"
     print(f"plans: {verdict} | benchmark took {time.perf_counter() - began:.0f} s")
     return 0 if plans_ok else 1

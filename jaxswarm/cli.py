@@ -156,12 +156,18 @@ def _add_mapf_parser(subparsers) -> None:
     mapf.add_argument("--planner", choices=PLANNERS, default="prioritized",
                       help="report: the A* report's two-robot scheme, pairwise; prioritized "
                            "(default): space-time A* in priority order; cbs: Conflict-Based "
-                           "Search (optimal, few agents)")
+                           "Search (optimal, few agents); pibt: PIBT steps (fast, incomplete); "
+                           "lacam: LaCAM (complete, hundreds of agents; --refine for LaCAM*)")
     mapf.add_argument("--order", choices=ORDERS,
                       help="prioritized only: the priority order (default given)")
-    mapf.add_argument("--seed", type=int, help="prioritized only: seed of --order random")
+    mapf.add_argument("--seed", type=int,
+                      help="prioritized: seed of --order random; pibt, lacam: of the "
+                           "tie-breaks (default 0)")
     mapf.add_argument("--time-limit", type=float,
-                      help="cbs only: give up after this many seconds (default 60)")
+                      help="cbs, lacam: give up after this many seconds (default 60)")
+    mapf.add_argument("--refine", type=float,
+                      help="lacam only: LaCAM*, lower the sum of costs for this many more "
+                           "seconds after the first solution")
     gif = mapf.add_mutually_exclusive_group()
     gif.add_argument("--gif", type=Path,
                      help="GIF of the agents moving (default out/mapf_MAP_PLANNER.gif)")
@@ -420,14 +426,18 @@ def run_mapf(args: argparse.Namespace) -> int:
 
 def _planner_options(args: argparse.Namespace) -> dict:
     """The keyword arguments of the chosen planner; ValueError for an option of another."""
-    given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit}
-    owner = {"order": "prioritized", "seed": "prioritized", "time_limit": "cbs"}
+    given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
+             "refine": args.refine}
+    owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam"),
+              "time_limit": ("cbs", "lacam"), "refine": ("lacam",)}
     for option, value in given.items():
-        if value is not None and owner[option] != args.planner:
+        if value is not None and args.planner not in owners[option]:
             raise ValueError(f"--{option.replace('_', '-')} applies to --planner "
-                             f"{owner[option]}, not {args.planner}")
+                             f"{' or '.join(owners[option])}, not {args.planner}")
     if args.time_limit is not None and not args.time_limit > 0:
         raise ValueError(f"--time-limit must be positive, got {args.time_limit}")
+    if args.refine is not None and args.refine < 0:
+        raise ValueError(f"--refine must be at least 0, got {args.refine}")
     return {option: value for option, value in given.items() if value is not None}
 
 

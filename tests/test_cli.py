@@ -150,7 +150,9 @@ def _mapf_row(text: str, planner: str) -> dict:
 
 @pytest.mark.parametrize("planner, options", [("report", []),
                                               ("prioritized", ["--order", "distance"]),
-                                              ("cbs", ["--time-limit", "30"])])
+                                              ("cbs", ["--time-limit", "30"]),
+                                              ("pibt", ["--seed", "2"]),
+                                              ("lacam", ["--refine", "0.5"])])
 def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner, options):
     assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "5", "--planner", planner,
                  *options, "--no-gif"]) == 0
@@ -199,6 +201,10 @@ def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
     text = capsys.readouterr().out
     assert _mapf_row(text, "prioritized")["solved"] == "False"
     assert re.search(r"^not solved: agent 1 could not be planned", text, re.MULTILINE), text
+    assert main(["mapf", str(tmp_path / "corridor.map"), str(tmp_path / "swap.scen"),
+                 "--agents", "2", "--planner", "lacam"]) == 1
+    assert re.search(r"^not solved: no solution: every configuration reachable from the starts",
+                     capsys.readouterr().out, re.MULTILINE)
     assert not (tmp_path / "out").exists()
 
 
@@ -212,6 +218,12 @@ def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
      "--order applies to --planner prioritized, not cbs"),
     (["{map}", "{scen}", "--planner", "cbs", "--time-limit", "0"],
      "--time-limit must be positive, got 0.0"),
+    (["{map}", "{scen}", "--planner", "cbs", "--refine", "1"],
+     "--refine applies to --planner lacam, not cbs"),
+    (["{map}", "{scen}", "--planner", "report", "--seed", "1"],
+     "--seed applies to --planner prioritized or pibt or lacam, not report"),
+    (["{map}", "{scen}", "--planner", "lacam", "--refine", "-1"],
+     "--refine must be at least 0, got -1.0"),
     (["{map}", "{scen}", "--gif", "a.gif", "--no-gif"], "--no-gif: not allowed with argument"),
 ])
 def test_mapf_rejects_bad_input_in_a_line_with_exit_status_2(movingai_dir, capsys, arguments,

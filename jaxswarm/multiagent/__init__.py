@@ -1,11 +1,15 @@
-"""Many agents on one map: the A* report's two-robot scheme, prioritised space-time A* and
-Conflict-Based Search, with one solution format and one validator.
+"""Many agents on one map: the A* report's two-robot scheme, prioritised space-time A*,
+Conflict-Based Search, PIBT and LaCAM, with one solution format and one validator.
 
 * :func:`report_scheme` (:mod:`~jaxswarm.multiagent.report`): A* per robot, then at a collision
   one robot side-steps while the other waits, or one moves first (the report's section 5).
 * :func:`prioritized` (:mod:`~jaxswarm.multiagent.prioritized`): space-time A* per agent around a
   reservation table, in a given, distance or seeded random order.
 * :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs.
+* :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
+  step for all agents at a time; fast, incomplete.
+* :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
+  configurations with PIBT as its generator, and LaCAM*'s anytime refinement (``refine``).
 * :func:`validate` (:mod:`~jaxswarm.multiagent.validate`) checks any solution;
   :func:`find_conflicts` (:mod:`~jaxswarm.multiagent.conflicts`) is its batched JAX conflict
   check; :class:`Plan` (:mod:`~jaxswarm.multiagent.plan`) is the one result format.
@@ -18,14 +22,18 @@ from jaxswarm.multiagent.agents import (UNREACHABLE, Instance, agent_nodes, hop_
                                         load_instance, lower_bound)
 from jaxswarm.multiagent.cbs import cbs
 from jaxswarm.multiagent.conflicts import Conflicts, find_conflicts
+from jaxswarm.multiagent.lacam import lacam
+from jaxswarm.multiagent.pibt import pibt
 from jaxswarm.multiagent.plan import Plan, arrival_steps, pack
 from jaxswarm.multiagent.prioritized import ORDERS, prioritized
 from jaxswarm.multiagent.report import report_scheme
 from jaxswarm.multiagent.validate import Violation, validate
 
-PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs}
+PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs, "pibt": pibt,
+            "lacam": lacam}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
 __all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",
-           "agent_nodes", "arrival_steps", "cbs", "find_conflicts", "hop_fields", "load_instance",
-           "lower_bound", "pack", "prioritized", "report_scheme", "validate"]
+           "agent_nodes", "arrival_steps", "cbs", "find_conflicts", "hop_fields", "lacam",
+           "load_instance", "lower_bound", "pack", "pibt", "prioritized", "report_scheme",
+           "validate"]

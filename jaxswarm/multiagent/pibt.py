@@ -1,0 +1,302 @@
+"""PIBT: priority inheritance with backtracking (Okumura, Machida, Défago and Tamura, AIJ 2022).
+
+One step moves every agent at once. Agents are taken by priority; each tries its candidate nodes
+(its neighbours and its own node) in the order of its distance field (ties broken by a keyed
+random number per node), skipping a node that another agent already takes next or that would
+swap it with the agent there. Taking a node held by an agent that has not moved yet makes that
+agent *inherit* the priority: it must move out first, recursively, and when it cannot, the node
+is given up and the next candidate tried (backtracking). An agent left without a candidate stays.
+Priorities grow by one per step away from the goal and drop to their fractional part at it, so
+the agent that has waited longest goes first.
+
+PIBT alone is incomplete (agents can circle for ever, or block a corridor); it is the
+configuration generator of LaCAM (:mod:`jaxswarm.multiagent.lacam`), which adds constraints
+(agents whose next node is fixed before PIBT runs) and a search over configurations that is
+complete.
+
+The step is numba-compiled as the exact planners are (:mod:`jaxswarm.exact.kernels`): the
+recursion becomes an explicit stack, and the keyed tie-breaks come from a SplitMix64 counter, so
+a step is a pure function of its inputs.
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import numpy as np
+
+from jaxswarm.exact._host import edge_arrays
+from jaxswarm.exact.kernels import inline, jit
+from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.plan import Plan, arrival_steps
+from jaxswarm.world.graph import Graph
+
+NONE = -1
+"""No agent (on a node), or no next node yet (of an agent)."""
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Moves:
+    """What a PIBT step reads of an instance: the map's moves and the agents' distance fields.
+
+    Attributes:
+      indptr: i64[N + 1]; the nodes one move from ``u`` are ``heads[indptr[u]:indptr[u + 1]]``.
+      heads: i32[E] the heads of the valid edges.
+      fields: i32[A, N] steps from every node to each agent's goal (``UNREACHABLE``: none).
+      goals: i32[A] the agents' goals.
+      candidates: the most candidate nodes of one agent (the largest degree, plus staying).
+    """
+
+    indptr: np.ndarray
+    heads: np.ndarray
+    fields: np.ndarray
+    goals: np.ndarray
+    candidates: int
+
+    @classmethod
+    def build(cls, graph: Graph, goals: np.ndarray, fields: np.ndarray) -> "Moves":
+        """The moves of ``graph`` (its valid edges) with the agents' ``goals`` (i32[A]) and
+        ``fields`` (i32[A, N], :func:`~jaxswarm.multiagent.agents.hop_fields`)."""
+        arrays = edge_arrays(graph)
+        return cls(indptr=arrays.indptr, heads=arrays.heads,
+                   fields=np.ascontiguousarray(fields, np.int32),
+                   goals=np.ascontiguousarray(goals, np.int32),
+                   candidates=int(np.diff(arrays.indptr).max(initial=0)) + 1)
+
+
+class Workspace:
+    """The buffers of :func:`configuration`, made once per instance and reused every step.
+
+    Attributes:
+      occupied_now: i32[N] the agent on each node (NONE: none); all NONE between calls.
+      occupied_next: i32[N] the agent taking each node next; all NONE between calls.
+      stack: i32[A, 2 + C] the explicit recursion: agent, next candidate, then its candidates.
+      counts: i32[A] how many candidates each stack frame holds.
+      keys: u64[C] the sort keys of one frame's candidates.
+      random: u64[1] the SplitMix64 counter of the tie-breaks.
+    """
+
+    def __init__(self, moves: Moves, seed: int = 0):
+        agents, nodes = moves.fields.shape
+        self.occupied_now = np.full(nodes, NONE, np.int32)
+        self.occupied_next = np.full(nodes, NONE, np.int32)
+        self.stack = np.zeros((agents, 2 + moves.candidates), np.int32)
+        self.counts = np.zeros(agents, np.int32)
+        self.keys = np.zeros(moves.candidates, np.uint64)
+        self.random = np.array([(seed * 0x9E3779B97F4A7C15) % 2**64], np.uint64)
+
+
+def configuration(moves: Moves, work: Workspace, current: np.ndarray, order: np.ndarray,
+                  fixed: np.ndarray, fixed_to: np.ndarray, following: np.ndarray) -> bool:
+    """One PIBT step from ``current``: every agent's next node, written to ``following``.
+
+    Args:
+      moves: the instance.
+      work: its buffers (left clean for the next call).
+      current: i32[A] every agent's node.
+      order: i32[A] the agents, highest priority first.
+      fixed: i32[F] agents whose next node is given (LaCAM's constraints; empty for PIBT).
+      fixed_to: i32[F] their next nodes.
+      following: i32[A] out: every agent's next node.
+
+    Returns:
+      True when every agent got a next node with no two agents on one node and no two
+      swapping; False when the fixed moves collide, or when an agent with no free candidate
+      would stay where a fixed agent moves in (``following`` is then not a configuration).
+      Without fixed agents the step always succeeds: an agent with no free candidate stays.
+    """
+    return bool(_configuration(moves.indptr, moves.heads, moves.fields, current, order, fixed,
+                               fixed_to, following, work.occupied_now, work.occupied_next,
+                               work.stack, work.counts, work.keys, work.random))
+
+
+@inline
+def _splitmix(state):
+    state[0] += np.uint64(0x9E3779B97F4A7C15)
+    z = state[0]
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@inline
+def _candidates(indptr, heads, fields, agent, node, stack, frame, counts, keys, random):
+    """Write ``agent``'s candidates (its neighbours and ``node``) to stack frame ``frame``,
+    nearest to its goal first, ties in a keyed random order."""
+    count = 0
+    for e in range(indptr[node], indptr[node + 1] + 1):
+        v = heads[e] if e < indptr[node + 1] else node
+        distance = fields[agent, v]
+        key = (np.uint64(min(distance, 0x7FFFFFFF)) << np.uint64(32)) | (
+            _splitmix(random) >> np.uint64(32))
+        i = count
+        while i > 0 and keys[i - 1] > key:  # insertion sort of at most degree + 1 entries
+            keys[i] = keys[i - 1]
+            stack[frame, 2 + i] = stack[frame, 1 + i]
+            i -= 1
+        keys[i] = key
+        stack[frame, 2 + i] = v
+        count += 1
+    stack[frame, 0] = agent
+    stack[frame, 1] = 0
+    counts[frame] = count
+
+
+@jit
+def _configuration(indptr, heads, fields, current, order, fixed, fixed_to, following,
+                   occupied_now, occupied_next, stack, counts, keys, random):
+    for a in range(current.shape[0]):
+        following[a] = NONE
+        occupied_now[current[a]] = a
+    ok = _fix(current, fixed, fixed_to, following, occupied_now, occupied_next)
+    for r in range(current.shape[0]):
+        if not ok:
+            break
+        if following[order[r]] == NONE:
+            ok = _inherit(indptr, heads, fields, current, order[r], following, occupied_now,
+                          occupied_next, stack, counts, keys, random)
+    for a in range(current.shape[0]):
+        occupied_now[current[a]] = NONE
+        if following[a] != NONE:
+            occupied_next[following[a]] = NONE
+    for k in range(fixed.shape[0]):
+        occupied_next[fixed_to[k]] = NONE
+    return ok
+
+
+@inline
+def _fix(current, fixed, fixed_to, following, occupied_now, occupied_next):
+    """Give the fixed agents their next nodes; False if two share one or two swap."""
+    ok = True
+    for k in range(fixed.shape[0]):
+        a, v = fixed[k], fixed_to[k]
+        if occupied_next[v] != NONE:
+            ok = False
+        following[a] = v
+        occupied_next[v] = a
+    for k in range(fixed.shape[0]):
+        a, v = fixed[k], fixed_to[k]
+        other = occupied_now[v]
+        if other != NONE and other != a and following[other] == current[a]:
+            ok = False
+    return ok
+
+
+@inline
+def _inherit(indptr, heads, fields, current, root, following, occupied_now, occupied_next,
+             stack, counts, keys, random):
+    """PIBT from ``root`` (not yet moved): the recursion on an explicit stack. False when an
+    agent left to stay finds a fixed agent moving onto its node."""
+    ok = True
+    depth = 1
+    _candidates(indptr, heads, fields, root, current[root], stack, 0, counts, keys, random)
+    child = -1  # -1: a fresh frame; 0: its child failed; 1: its child succeeded
+    while depth > 0:
+        frame = depth - 1
+        a = stack[frame, 0]
+        if child == 1:
+            depth -= 1
+            continue
+        child = 0
+        while stack[frame, 1] < counts[frame]:
+            v = stack[frame, 2 + stack[frame, 1]]
+            stack[frame, 1] += 1
+            other = occupied_now[v]
+            if occupied_next[v] != NONE or (other != NONE and following[other] == current[a]):
+                continue  # taken, or a swap
+            following[a] = v
+            occupied_next[v] = a
+            if other != NONE and other != a and following[other] == NONE:
+                _candidates(indptr, heads, fields, other, current[other], stack, depth,
+                            counts, keys, random)
+                depth += 1
+                child = -1
+            else:
+                child = 1
+                depth -= 1
+            break
+        if child == 0:  # no candidate left: stay (the node the parent asked for is given back)
+            here = current[a]
+            holder = occupied_next[here]
+            if holder != NONE and holder != a and following[holder] == here and (
+                    depth == 1 or stack[depth - 2, 0] != holder):
+                ok = False  # a fixed agent moves in
+            following[a] = here
+            occupied_next[here] = a
+            depth -= 1
+    return ok
+
+
+def initial_priorities(moves: Moves, starts: np.ndarray) -> np.ndarray:
+    """f64[A] the first priorities: each agent's distance to its goal over the number of nodes
+    (in [0, 1), so the first step goes to the farthest agents)."""
+    agents = np.arange(len(starts))
+    distances = moves.fields[agents, starts].astype(np.float64)
+    return np.where(distances >= UNREACHABLE, 0.0, distances) / moves.fields.shape[1]
+
+
+def next_priorities(priorities: np.ndarray, at_goal: np.ndarray) -> np.ndarray:
+    """f64[A]: one more for every agent away from its goal, the fractional part at it."""
+    return np.where(at_goal, priorities - np.floor(priorities), priorities + 1.0)
+
+
+def by_priority(priorities: np.ndarray) -> np.ndarray:
+    """i32[A] the agents, highest priority first (ties by agent number)."""
+    return np.lexsort((np.arange(len(priorities)), -priorities)).astype(np.int32)
+
+
+def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -> Plan:
+    """PIBT steps from the starts until every agent is at its goal at once.
+
+    Args:
+      graph: the map; its valid edges are the moves, one step each.
+      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
+      max_steps: give up after this many steps.
+      seed: the key of the tie-breaks.
+
+    Returns:
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="pibt"``); not solved when an
+      agent's goal cannot be reached (naming it) or after ``max_steps`` (naming an agent still
+      away). ``stats``: ``steps``, ``field_seconds`` (the distance fields) and ``seconds`` (the
+      steps).
+
+    Raises:
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
+    """
+    if max_steps < 1:
+        raise ValueError(f"max_steps must be at least 1, got {max_steps}")
+    began = time.perf_counter()
+    start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
+    fields = hop_fields(graph, goal_nodes)
+    field_seconds = time.perf_counter() - began
+    stats = dict(field_seconds=field_seconds)
+    unreachable = np.nonzero(fields[np.arange(len(start_nodes)), start_nodes] == UNREACHABLE)[0]
+    if unreachable.size:
+        a = int(unreachable[0])
+        paths = start_nodes[:, None]
+        return Plan(paths, np.zeros(len(start_nodes), np.int32), solved=False, planner="pibt",
+                    reason=f"agent {a} cannot reach its goal {place(graph, goal_nodes[a])} "
+                           f"from {place(graph, start_nodes[a])}", agent=a,
+                    stats=dict(stats, steps=0, seconds=0.0))
+    moves = Moves.build(graph, goal_nodes, fields)
+    work = Workspace(moves, seed)
+    searching = time.perf_counter()
+    configurations = [start_nodes]
+    priorities = initial_priorities(moves, start_nodes)
+    empty = np.zeros(0, np.int32)
+    current = start_nodes
+    while not np.array_equal(current, goal_nodes) and len(configurations) <= max_steps:
+        following = np.empty_like(current)
+        configuration(moves, work, current, by_priority(priorities), empty, empty, following)
+        priorities = next_priorities(priorities, following == goal_nodes)
+        configurations.append(following)
+        current = following
+    paths = np.stack(configurations, axis=1)
+    stats |= dict(steps=len(configurations) - 1, seconds=time.perf_counter() - searching)
+    if not np.array_equal(current, goal_nodes):
+        away = int(np.nonzero(current != goal_nodes)[0][0])
+        return Plan(paths, arrival_steps(paths, goal_nodes), solved=False, planner="pibt",
+                    reason=f"agent {away} (and {int((current != goal_nodes).sum()) - 1} more) "
+                           f"not at its goal after {max_steps} steps", agent=away, stats=stats)
+    return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner="pibt",
+                stats=stats)

@@ -1,0 +1,181 @@
+"""PIBT and LaCAM: PIBT's step by hand and against the rules of a configuration, LaCAM against
+the joint-state search on tiny instances (a solution exactly when one exists; "no solution" only
+when there is none), LaCAM* to the joint-state optimum, and both on benchmark instances against
+the validator."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import oracle
+from jaxswarm.multiagent import (hop_fields, lacam, load_instance, lower_bound, pibt,
+                                 prioritized, validate)
+from jaxswarm.multiagent.pibt import Moves, Workspace, by_priority, configuration
+from jaxswarm.world.graph import grid_graph
+
+NOTHING = np.zeros(0, np.int32)
+
+
+def grid(rows):
+    blocked = np.array([[c == "#" for c in row] for row in rows])
+    return grid_graph(blocked, connectivity=4), oracle.grid_adjacency(blocked.tolist(),
+                                                                       connectivity=4)
+
+
+def step(graph, current, goals, order, fixed=NOTHING, fixed_to=NOTHING, seed=0):
+    current, goals = np.asarray(current, np.int32), np.asarray(goals, np.int32)
+    moves = Moves.build(graph, goals, hop_fields(graph, goals))
+    following = np.empty_like(current)
+    ok = configuration(moves, Workspace(moves, seed), current, np.asarray(order, np.int32),
+                       np.asarray(fixed, np.int32), np.asarray(fixed_to, np.int32), following)
+    return ok, following.tolist()
+
+
+def test_a_pushed_agent_inherits_the_priority_and_steps_aside():
+    # A corridor 0-1-2 with a pocket 4 under node 1. Agent 0 (first) at 0 is bound for 2;
+    # agent 1 rests at its goal 1. Agent 0 takes 1, so agent 1 must leave: back to 0 would swap
+    # with agent 0, so it goes on to 2 or into the pocket (as near its goal, a keyed tie).
+    graph, _ = grid(["...", "#.#"])
+    ok, following = step(graph, [0, 1], [2, 1], order=[0, 1])
+    assert ok and following[0] == 1 and following[1] in (2, 4)
+    # With agent 1 first, it keeps its goal and agent 0 waits.
+    ok, following = step(graph, [0, 1], [2, 1], order=[1, 0])
+    assert ok and following == [0, 1]
+
+
+def test_a_step_is_a_configuration_on_random_instances():
+    rng = np.random.default_rng(4)
+    graph, _ = grid(["......", ".#..#.", "......", "..##..", "......"])
+    free = np.nonzero(np.asarray(graph.free))[0]
+    nbr = np.asarray(graph.nbr)
+    for trial in range(40):
+        picks = rng.permutation(free)
+        agents = int(rng.integers(2, 12))
+        current, goals = picks[:agents], rng.permutation(free)[:agents]
+        ok, following = step(graph, current, goals, rng.permutation(agents), seed=trial)
+        following = np.array(following)
+        assert ok
+        assert len(set(following.tolist())) == agents  # no two on one node
+        for a in range(agents):
+            assert following[a] == current[a] or following[a] in nbr[current[a]]  # a move
+            for b in range(agents):
+                assert not (a != b and following[a] == current[b]
+                            and following[b] == current[a])  # no swap
+
+
+def test_fixed_moves_are_kept_and_colliding_ones_refused():
+    graph, _ = grid(["...."])
+    ok, following = step(graph, [0, 2], [3, 0], order=[0, 1], fixed=[1], fixed_to=[1])
+    assert ok and following[1] == 1 and following[0] == 0  # agent 0 gives way
+    ok, _ = step(graph, [0, 2], [3, 0], order=[0, 1], fixed=[0, 1], fixed_to=[1, 1])
+    assert not ok  # two agents on node 1
+    ok, _ = step(graph, [0, 1], [1, 0], order=[0, 1], fixed=[0, 1], fixed_to=[1, 0])
+    assert not ok  # a swap
+    ok, _ = step(graph, [0, 1], [3, 0], order=[1, 0], fixed=[1], fixed_to=[0])
+    assert not ok  # agent 0 has nowhere to go but node 1, swapping with agent 1
+
+
+def test_priorities_put_the_longest_waiting_first():
+    assert by_priority(np.array([0.5, 2.25, 2.25, 1.0])).tolist() == [1, 2, 3, 0]
+
+
+TINY = [  # (obstacle rows, starts, goals): the joint-state search's instances of test_multiagent
+    (["....", ".#..", "....", "...."], [(0, 0), (2, 0)], [(2, 0), (0, 0)]),
+    (["....", "##.#", "....", "...."], [(0, 0), (3, 0), (2, 3)], [(3, 0), (0, 0), (2, 0)]),
+    (["#..#", "#.##", "#...", "...."], [(1, 0), (0, 3)], [(3, 2), (2, 0)]),
+    (["....", "....", "....", "...."], [(0, 0), (1, 0), (2, 0)], [(2, 0), (0, 0), (1, 0)]),
+    (["...", "#.#"], [(2, 0), (0, 0)], [(1, 0), (2, 0)]),  # prioritised fails in both orders
+]
+
+
+@pytest.mark.parametrize("rows, starts, goals", TINY)
+def test_lacam_solves_and_lacam_star_reaches_the_joint_state_optimum(rows, starts, goals):
+    graph, adjacency = grid(rows)
+    optimum = oracle.mapf_optimum(adjacency, starts, goals)
+    first = lacam(graph, starts, goals)
+    assert first.solved and validate(graph, first.paths, starts, goals, first.lengths) == []
+    assert first.sum_of_costs >= optimum
+    refined = lacam(graph, starts, goals, refine=30.0)
+    assert refined.solved and refined.stats["optimal"]  # the search ran out: nothing better
+    assert refined.sum_of_costs == optimum <= refined.stats["first_soc"]
+    assert validate(graph, refined.paths, starts, goals, refined.lengths) == []
+
+
+def test_lacam_solves_where_prioritized_planning_fails_in_both_orders():
+    graph, _ = grid(["...", "#.#"])
+    starts, goals = [(2, 0), (0, 0)], [(1, 0), (2, 0)]
+    assert not any(prioritized(graph, starts, goals, order=o).solved for o in ([0, 1], [1, 0]))
+    assert lacam(graph, starts, goals).solved
+
+
+def test_lacam_proves_there_is_no_solution():
+    graph, adjacency = grid(["...."])  # two agents swapping ends of a corridor
+    starts, goals = [(0, 0), (3, 0)], [(3, 0), (0, 0)]
+    assert oracle.mapf_optimum(adjacency, starts, goals) is None
+    plan = lacam(graph, starts, goals)
+    assert not plan.solved and plan.reason.startswith("no solution: every configuration")
+    assert plan.stats["configurations"] == 6  # ({0..3} choose 2 with 0 left of 1)
+
+
+def test_lacam_finds_a_solution_exactly_when_the_joint_state_search_does():
+    rng = np.random.default_rng(1)
+    solved = unsolvable = 0
+    for _ in range(40):
+        height, width = rng.integers(2, 4, size=2)
+        blocked = rng.random((height, width)) < 0.25
+        free = [(x, y) for y in range(height) for x in range(width) if not blocked[y, x]]
+        agents = int(rng.integers(2, 4))
+        if len(free) <= agents:
+            continue
+        starts = [free[i] for i in rng.permutation(len(free))[:agents]]
+        goals = [free[i] for i in rng.permutation(len(free))[:agents]]
+        graph = grid_graph(blocked, connectivity=4)
+        optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
+                                      starts, goals)
+        plan = lacam(graph, starts, goals)
+        assert plan.solved == (optimum is not None), (blocked, starts, goals, plan.reason)
+        if plan.solved:
+            assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
+            assert plan.sum_of_costs >= optimum
+            solved += 1
+        else:
+            unsolvable += 1
+    assert solved >= 15 and unsolvable >= 5
+
+
+def test_a_limit_ends_lacam_cleanly_and_a_seed_replays():
+    graph, _ = grid(["....", ".#..", "....", "...."])
+    starts, goals = [(0, 0), (2, 0), (3, 3)], [(2, 0), (0, 0), (0, 3)]
+    limited = lacam(graph, starts, goals, max_configurations=2)
+    assert not limited.solved and limited.reason == "reached the limit of 2 configurations"
+    again = [lacam(graph, starts, goals, seed=7).paths for _ in range(2)]
+    assert np.array_equal(*again)
+    with pytest.raises(ValueError, match="refine at least 0"):
+        lacam(graph, starts, goals, refine=-1)
+
+
+def test_pibt_reaches_the_goals_on_an_open_map_and_stops_at_its_limit():
+    graph, _ = grid(["......"] * 6)
+    starts = [(x, 0) for x in range(6)]
+    goals = [(5 - x, 5) for x in range(6)]
+    plan = pibt(graph, starts, goals)
+    assert plan.solved and validate(graph, plan.paths, starts, goals, plan.lengths) == []
+    assert plan.sum_of_costs >= lower_bound(graph, starts, goals)
+    corridor, _ = grid(["...."])
+    stuck = pibt(corridor, [(0, 0), (3, 0)], [(3, 0), (0, 0)], max_steps=20)
+    assert not stuck.solved and "after 20 steps" in stuck.reason
+    assert stuck.paths.shape[1] == 21
+
+
+@pytest.mark.parametrize("name, agents", [("random-32-32-10", 100), ("room-32-32-4", 100)])
+def test_lacam_and_pibt_on_benchmark_instances_validate(movingai_dir, name, agents):
+    mapf = movingai_dir / "mapf"
+    instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-random-1.scen", agents)
+    graph, starts, goals = instance.graph, instance.starts, instance.goals
+    bound = lower_bound(graph, starts, goals)
+    plan = lacam(graph, starts, goals, time_limit=60)
+    assert plan.solved and validate(graph, plan.paths, starts, goals, plan.lengths) == []
+    assert plan.sum_of_costs >= bound and plan.stats["field_seconds"] > 0
+    stepped = pibt(graph, starts, goals)
+    if stepped.solved:
+        assert validate(graph, stepped.paths, starts, goals, stepped.lengths) == []
