@@ -156,15 +156,20 @@ def _add_mapf_parser(subparsers) -> None:
     mapf.add_argument("--planner", choices=PLANNERS, default="prioritized",
                       help="report: the A* report's two-robot scheme, pairwise; prioritized "
                            "(default): space-time A* in priority order; cbs: Conflict-Based "
-                           "Search (optimal, few agents); pibt: PIBT steps (fast, incomplete); "
-                           "lacam: LaCAM (complete, hundreds of agents; --refine for LaCAM*)")
+                           "Search (optimal, few agents); icbs: CBS with prioritised "
+                           "collisions and bypassing (optimal); ecbs: Enhanced CBS (within "
+                           "--w of the optimum); pibt: PIBT steps (fast, incomplete); lacam: "
+                           "LaCAM (complete, hundreds of agents; --refine for LaCAM*)")
     mapf.add_argument("--order", choices=ORDERS,
                       help="prioritized only: the priority order (default given)")
     mapf.add_argument("--seed", type=int,
                       help="prioritized: seed of --order random; pibt, lacam: of the "
                            "tie-breaks (default 0)")
     mapf.add_argument("--time-limit", type=float,
-                      help="cbs, lacam: give up after this many seconds (default 60)")
+                      help="cbs, icbs, ecbs, lacam: give up after this many seconds "
+                           "(default 60)")
+    mapf.add_argument("--w", type=float,
+                      help="ecbs only: the suboptimality bound (default 1.2)")
     mapf.add_argument("--refine", type=float,
                       help="lacam only: LaCAM*, lower the sum of costs for this many more "
                            "seconds after the first solution")
@@ -427,9 +432,10 @@ def run_mapf(args: argparse.Namespace) -> int:
 def _planner_options(args: argparse.Namespace) -> dict:
     """The keyword arguments of the chosen planner; ValueError for an option of another."""
     given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
-             "refine": args.refine}
+             "refine": args.refine, "w": args.w}
     owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam"),
-              "time_limit": ("cbs", "lacam"), "refine": ("lacam",)}
+              "time_limit": ("cbs", "icbs", "ecbs", "lacam"), "refine": ("lacam",),
+              "w": ("ecbs",)}
     for option, value in given.items():
         if value is not None and args.planner not in owners[option]:
             raise ValueError(f"--{option.replace('_', '-')} applies to --planner "
@@ -438,6 +444,8 @@ def _planner_options(args: argparse.Namespace) -> dict:
         raise ValueError(f"--time-limit must be positive, got {args.time_limit}")
     if args.refine is not None and args.refine < 0:
         raise ValueError(f"--refine must be at least 0, got {args.refine}")
+    if args.w is not None and not args.w >= 1:
+        raise ValueError(f"--w must be at least 1, got {args.w}")
     return {option: value for option, value in given.items() if value is not None}
 
 

@@ -151,6 +151,8 @@ def _mapf_row(text: str, planner: str) -> dict:
 @pytest.mark.parametrize("planner, options", [("report", []),
                                               ("prioritized", ["--order", "distance"]),
                                               ("cbs", ["--time-limit", "30"]),
+                                              ("icbs", ["--time-limit", "30"]),
+                                              ("ecbs", ["--w", "1.1"]),
                                               ("pibt", ["--seed", "2"]),
                                               ("lacam", ["--refine", "0.5"])])
 def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner, options):
@@ -164,8 +166,8 @@ def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner,
     cost, bound = int(row["sum of costs"]), int(row["lower bound"])
     assert bound == 114 and cost >= bound  # the sum of the scenario's optimal lengths
     assert float(row["ratio"]) == pytest.approx(cost / bound, abs=1e-3)
-    if planner == "cbs":
-        assert cost == bound  # optimal, and here no agent has to give way
+    if planner in ("cbs", "icbs", "ecbs"):
+        assert cost == bound  # optimal (ECBS: within 1.1), and here no agent has to give way
     # The longest path is the makespan: at least the mean, at most the sum of the paths.
     assert cost / 5 <= int(row["makespan"]) <= cost
     assert 0 < float(row["time [ms]"]) < 30_000
@@ -224,6 +226,9 @@ def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
      "--seed applies to --planner prioritized or pibt or lacam, not report"),
     (["{map}", "{scen}", "--planner", "lacam", "--refine", "-1"],
      "--refine must be at least 0, got -1.0"),
+    (["{map}", "{scen}", "--planner", "ecbs", "--w", "0.5"], "--w must be at least 1, got 0.5"),
+    (["{map}", "{scen}", "--planner", "cbs", "--w", "1.5"],
+     "--w applies to --planner ecbs, not cbs"),
     (["{map}", "{scen}", "--gif", "a.gif", "--no-gif"], "--no-gif: not allowed with argument"),
 ])
 def test_mapf_rejects_bad_input_in_a_line_with_exit_status_2(movingai_dir, capsys, arguments,

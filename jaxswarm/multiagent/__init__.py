@@ -5,7 +5,11 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
   one robot side-steps while the other waits, or one moves first (the report's section 5).
 * :func:`prioritized` (:mod:`~jaxswarm.multiagent.prioritized`): space-time A* per agent around a
   reservation table, in a given, distance or seeded random order.
-* :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs.
+* :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs;
+  ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements (``"icbs"`` in
+  ``PLANNERS``: both), with MDDs from :mod:`~jaxswarm.multiagent.mdd`.
+* :func:`ecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS, within a factor ``w`` of the
+  optimum.
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
   step for all agents at a time; fast, incomplete.
 * :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
@@ -18,10 +22,13 @@ Time is in steps: every agent moves along one edge or waits per step, and an age
 step from which it stays at its goal. On the MAPF benchmark maps (:func:`load_instance`, loaded
 4-connected) that is the benchmark's sum of costs.
 """
+import functools
+
 from jaxswarm.multiagent.agents import (UNREACHABLE, Instance, agent_nodes, hop_fields,
                                         load_instance, lower_bound)
 from jaxswarm.multiagent.cbs import cbs
 from jaxswarm.multiagent.conflicts import Conflicts, find_conflicts
+from jaxswarm.multiagent.ecbs import ecbs
 from jaxswarm.multiagent.lacam import lacam
 from jaxswarm.multiagent.pibt import pibt
 from jaxswarm.multiagent.plan import Plan, arrival_steps, pack
@@ -29,11 +36,12 @@ from jaxswarm.multiagent.prioritized import ORDERS, prioritized
 from jaxswarm.multiagent.report import report_scheme
 from jaxswarm.multiagent.validate import Violation, validate
 
-PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs, "pibt": pibt,
-            "lacam": lacam}
+PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
+            "icbs": functools.partial(cbs, prioritize=True, bypass=True), "ecbs": ecbs,
+            "pibt": pibt, "lacam": lacam}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
 __all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",
-           "agent_nodes", "arrival_steps", "cbs", "find_conflicts", "hop_fields", "lacam",
+           "agent_nodes", "arrival_steps", "cbs", "ecbs", "find_conflicts", "hop_fields", "lacam",
            "load_instance", "lower_bound", "pack", "pibt", "prioritized", "report_scheme",
            "validate"]

@@ -8,6 +8,12 @@ earliest collision (:func:`jaxswarm.multiagent.conflicts.pair_collisions`; the l
 equal steps) splits it into two children, each forbidding the collision to one of the two agents
 and re-planning only that agent. The first node without a collision is an optimal solution.
 
+Two improvements of Boyarski et al. (IJCAI 2015), each a switch: ``prioritize`` splits on a
+cardinal collision first, then a semi-cardinal one, then the earliest (from the agents' MDDs,
+:mod:`jaxswarm.multiagent.mdd`; a pair's first collision stands for the pair); ``bypass`` takes a
+child's path into its parent instead of splitting when the child costs no more and collides less.
+Both keep CBS optimal.
+
 CBS is for few agents: the number of nodes grows exponentially with the number of collisions
 that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
 """
@@ -21,6 +27,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from jaxswarm.exact._host import edge_arrays
+from jaxswarm.multiagent import mdd
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
@@ -29,7 +37,7 @@ from jaxswarm.world.graph import Graph
 
 
 def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,
-        max_expansions: int = 10_000_000) -> Plan:
+        max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False) -> Plan:
     """Conflict-Based Search.
 
     Args:
@@ -38,11 +46,16 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       max_nodes: give up after expanding this many constraint-tree nodes.
       time_limit: give up after this many seconds.
       max_expansions: the limit on expanded space-time states per low-level search.
+      prioritize: split on cardinal collisions first, then semi-cardinal (from MDDs).
+      bypass: take a child's path instead of splitting where it costs no more, collides less.
 
     Returns:
-      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="cbs"``) with the least sum of
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with both
+      improvements, ``cbs+prioritize`` or ``cbs+bypass`` with one) with the least sum of
       costs; not solved when an agent's goal cannot be reached (naming it), when no solution exists
       (the tree runs out), or at a limit (naming the agents of the collision it was resolving).
+      ``stats``: ``expanded`` space-time states, ``nodes`` split, ``bypasses``, ``mdds`` built,
+      ``seconds``.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
@@ -51,14 +64,13 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     agents = len(start_nodes)
     instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
-                         max_expansions=max_expansions, began=began)
+                         max_expansions=max_expansions, began=began,
+                         name=_name(prioritize, bypass))
+    choose = instance.prioritized_collision if prioritize else _earliest_collision_of
     waiting = [np.array([s], np.int32) for s in start_nodes]
     unreachable = np.nonzero(instance.fields[np.arange(agents), start_nodes] == UNREACHABLE)[0]
     if unreachable.size:
-        a = int(unreachable[0])
-        return instance.stop(waiting, False, f"agent {a} cannot reach its goal "
-                                             f"{place(graph, goal_nodes[a])} from "
-                                             f"{place(graph, start_nodes[a])}", a)
+        return instance.stop(waiting, False, *_cut_off(instance, int(unreachable[0])))
     no_constraints = [(frozenset(), frozenset())] * agents
     root = [instance.plan_agent(a, *no_constraints[a]) for a in range(agents)]
     tiebreak = itertools.count()
@@ -66,7 +78,7 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     last = None
     while frontier:
         node = heapq.heappop(frontier)
-        collision = _earliest_collision(node.collisions)
+        collision = choose(node)
         if collision is None:
             return instance.stop(node.paths, True)
         last, step = collision
@@ -76,7 +88,10 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
                                                     f"collision of agents {last[0]} and "
                                                     f"{last[1]}", last[1])
         instance.counts["nodes"] += 1
-        for child in _children(instance, node, last, step, tiebreak):
+        children = _children(instance, node, last, step, tiebreak)
+        if bypass:
+            children = _bypassed(instance, node, children, last, tiebreak)
+        for child in children:
             heapq.heappush(frontier, child)
     return instance.stop(waiting, False, "no solution exists: every way of resolving the "
                                          f"collisions of agents {last[0]} and {last[1]} "
@@ -123,7 +138,10 @@ class _Instance:
     fields: np.ndarray
     max_expansions: int
     began: float
-    counts: dict = dataclasses.field(default_factory=lambda: {"expanded": 0, "nodes": 0})
+    counts: dict = dataclasses.field(
+        default_factory=lambda: {"expanded": 0, "nodes": 0, "bypasses": 0, "mdds": 0})
+    mdds: dict = dataclasses.field(default_factory=dict)
+    name: str = "cbs"
 
     def plan_agent(self, agent: int, vertex: frozenset, edge: frozenset):
         """The agent's fewest-steps path (i32[T]) under its constraints, or None."""
@@ -134,12 +152,68 @@ class _Instance:
         self.counts["expanded"] += expanded
         return path
 
+    def agent_mdd(self, agent: int, path, constraints: tuple) -> list[frozenset]:
+        """The agent's MDD at its path's cost under its constraints (cached)."""
+        key = (agent, len(path) - 1, *constraints)
+        levels = self.mdds.get(key)
+        if levels is None:
+            arrays = edge_arrays(self.graph)
+            levels = self.mdds[key] = mdd.mdd(
+                arrays.indptr, arrays.heads, int(self.start_nodes[agent]),
+                int(self.goal_nodes[agent]), len(path) - 1, self.fields[agent], *constraints)
+            self.counts["mdds"] += 1
+        return levels
+
+    def prioritized_collision(self, node: "_Node") -> tuple[tuple[int, int], int] | None:
+        """``((a, b), step)``: of every colliding pair's first collision, a cardinal one first,
+        then a semi-cardinal one, then the earliest (then the lowest pair); None when none."""
+        pairs = np.argwhere(np.triu(node.collisions >= 0, 1))
+        if not pairs.size:
+            return None
+        padded = pack(node.paths)[0]
+        best = None
+        for a, b in pairs.tolist():
+            step = int(node.collisions[a, b])
+            sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
+                                      int(self.goal_nodes[x]), step, int(padded[x, step]),
+                                      int(padded[x, step - 1]) if _swap(padded, a, b, step)
+                                      else int(padded[x, step]))
+                     for x in (a, b)]
+            key = (mdd.classify(*sides), step, a, b)
+            best = key if best is None or key < best else best
+        return (best[2], best[3]), best[1]
+
     def stop(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
         """The search's :class:`~jaxswarm.multiagent.plan.Plan` of ``paths`` (one node list
         per agent)."""
-        return Plan(*pack(paths, self.goal_nodes), solved=solved, planner="cbs", reason=reason,
+        return Plan(*pack(paths, self.goal_nodes), solved=solved, planner=self.name, reason=reason,
                     agent=agent,
                     stats={**self.counts, "seconds": time.perf_counter() - self.began})
+
+
+def _cut_off(instance: _Instance, agent: int) -> tuple[str, int]:
+    """``(reason, agent)`` of an agent that cannot reach its goal at all."""
+    graph = instance.graph
+    return (f"agent {agent} cannot reach its goal {place(graph, instance.goal_nodes[agent])} "
+            f"from {place(graph, instance.start_nodes[agent])}", agent)
+
+
+def _name(prioritize: bool, bypass: bool) -> str:
+    """The planner's name in a Plan: ``icbs`` with both improvements, ``cbs`` with none."""
+    if prioritize and bypass:
+        return "icbs"
+    return "cbs" + ("+prioritize" if prioritize else "") + ("+bypass" if bypass else "")
+
+
+def _swap(padded: np.ndarray, a: int, b: int, step: int) -> bool:
+    """Whether agents ``a`` and ``b`` of ``padded`` (i32[A, T]) collide at ``step`` by
+    swapping rather than on one node."""
+    return bool(padded[a, step] != padded[b, step])
+
+
+def _earliest_collision_of(node: "_Node") -> tuple[tuple[int, int], int] | None:
+    """CBS's choice: the earliest collision of the node (:func:`_earliest_collision`)."""
+    return _earliest_collision(node.collisions)
 
 
 def _earliest_collision(collisions: np.ndarray) -> tuple[tuple[int, int], int] | None:
@@ -175,6 +249,20 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
         if path is not None:
             children.append(_child(node, agent, path, constraints, next(tiebreak)))
     return children
+
+
+def _bypassed(instance: _Instance, node: _Node, children: list[_Node], pair: tuple[int, int],
+              tiebreak) -> list[_Node]:
+    """Bypassing: where a child costs no more than ``node`` and collides less, ``node`` with
+    the child's path and its own constraints (the path keeps them: the child's include them)
+    in place of the children."""
+    taken = next((child for child in children if child.cost == node.cost
+                  and child.colliding_pairs < node.colliding_pairs), None)
+    if taken is None:
+        return children
+    agent = next(a for a in pair if taken.paths[a] is not node.paths[a])
+    instance.counts["bypasses"] += 1
+    return [_child(node, agent, taken.paths[agent], node.constraints[agent], next(tiebreak))]
 
 
 def _forbid(constraints: tuple, padded: np.ndarray, agent: int, other: int,

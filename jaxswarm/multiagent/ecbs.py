@@ -1,0 +1,251 @@
+"""Enhanced CBS (Barer, Sharon, Stern and Felner, SoCS 2014): bounded-suboptimal, within a factor
+w of the least sum of costs.
+
+Both levels are focal searches. The low level plans one agent in space-time under its CBS
+constraints: of the states whose f = steps + steps to go is at most w times the least f open, it
+expands the one whose path so far collides least with the other agents' current paths (on a node
+at a step, or resting at their goals), then the lowest f. It returns the path and that least f,
+a lower bound on the agent's cost under its constraints. The high level keeps, per constraint-tree
+node, the sum of those bounds (LB) and the sum of costs; of the nodes whose cost is at most w
+times the least LB open, it splits the one with the fewest colliding pairs (then the lowest
+cost) on its earliest collision, as CBS does. The first node without collisions is a solution
+whose sum of costs is at most w times the least LB, itself at most the optimum: the bound it
+proves is ``stats["lower_bound"]``.
+
+EECBS (Li, Ruml and Koenig, AAAI 2021) replaces the high level's focal list by an explicit
+estimation search and adds CBS's improvements; it is not implemented here.
+"""
+from __future__ import annotations
+
+import dataclasses
+import heapq
+import itertools
+import time
+
+import numpy as np
+
+from jaxswarm.exact._host import edge_arrays
+from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.cbs import _earliest_collision, _forbid
+from jaxswarm.multiagent.conflicts import pair_collisions
+from jaxswarm.multiagent.plan import Plan, pack
+from jaxswarm.world.graph import Graph
+
+
+def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_000,
+         time_limit: float = 60.0) -> Plan:
+    """Enhanced CBS with suboptimality bound ``w``.
+
+    Args:
+      graph: the map; its valid edges are the moves, one step each.
+      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
+      w: the bound: the sum of costs is at most w times the optimum (at least 1).
+      max_nodes: give up after splitting this many constraint-tree nodes.
+      time_limit: give up after this many seconds.
+
+    Returns:
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="ecbs"``); not solved when an
+      agent's goal cannot be reached (naming it) or at a limit. ``stats``: ``lower_bound`` (the
+      least LB open when it stopped: no solution costs less), ``nodes``, ``expanded``,
+      ``seconds``.
+
+    Raises:
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or w < 1.
+    """
+    if not w >= 1.0:
+        raise ValueError(f"w must be at least 1, got {w}")
+    began = time.perf_counter()
+    start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
+    search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began)
+    unreachable = np.nonzero(search.fields[np.arange(len(start_nodes)), start_nodes]
+                             == UNREACHABLE)[0]
+    if unreachable.size:
+        a = int(unreachable[0])
+        return search.stop([np.array([s]) for s in start_nodes], False,
+                           f"agent {a} cannot reach its goal {place(graph, goal_nodes[a])} "
+                           f"from {place(graph, start_nodes[a])}", a)
+    return search.run(max_nodes, time_limit)
+
+
+@dataclasses.dataclass(eq=False)
+class _Node:
+    """A constraint-tree node: per agent its path, its cost's lower bound and its constraints
+    (``(vertex, edge)`` as CBS's), and the pairs' first collisions."""
+
+    paths: list
+    bounds: list
+    constraints: list
+    collisions: np.ndarray
+
+    @property
+    def cost(self) -> int:
+        return sum(len(path) - 1 for path in self.paths)
+
+    @property
+    def lower_bound(self) -> int:
+        return sum(self.bounds)
+
+    @property
+    def colliding_pairs(self) -> int:
+        return int((self.collisions >= 0).sum()) // 2
+
+
+class _Search:
+    """One ECBS search (see the module docstring)."""
+
+    def __init__(self, graph, start_nodes, goal_nodes, fields, w: float, began: float):
+        arrays = edge_arrays(graph)
+        self.moves = [arrays.heads[arrays.indptr[u]:arrays.indptr[u + 1]].tolist() + [u]
+                      for u in range(graph.num_nodes)]
+        self.graph, self.starts, self.goals = graph, start_nodes, goal_nodes
+        self.fields, self.w, self.began = fields, w, began
+        self.counts = {"expanded": 0, "nodes": 0, "lower_bound": 0}
+
+    def run(self, max_nodes: int, time_limit: float) -> Plan:
+        agents = len(self.starts)
+        constraints = [(frozenset(), frozenset())] * agents
+        paths, bounds = [], []
+        for a in range(agents):
+            path, bound = self.plan_agent(a, constraints[a], paths)
+            paths.append(path)
+            bounds.append(bound)
+        root = _Node(paths, bounds, constraints, pair_collisions(pack(paths)[0]))
+        open_ = [root]
+        last = None
+        while open_:
+            least = min(node.lower_bound for node in open_)
+            self.counts["lower_bound"] = least
+            node = min((n for n in open_ if n.cost <= self.w * least),
+                       key=lambda n: (n.colliding_pairs, n.cost))
+            collision = _earliest_collision(node.collisions)
+            if collision is None:
+                return self.stop(node.paths, True)
+            last, step = collision
+            if self.counts["nodes"] >= max_nodes or time.perf_counter() - self.began > time_limit:
+                limit = (f"{max_nodes} nodes" if self.counts["nodes"] >= max_nodes
+                         else f"the time limit ({time_limit:g} s)")
+                return self.stop(node.paths, False, f"reached {limit} while resolving a "
+                                 f"collision of agents {last[0]} and {last[1]}", last[1])
+            open_.remove(node)
+            self.counts["nodes"] += 1
+            open_ += self.children(node, last, step)
+        return self.stop(root.paths, False, "no solution exists: every way of resolving the "
+                         f"collisions of agents {last[0]} and {last[1]} failed", last[1])
+
+    def children(self, node: _Node, pair: tuple[int, int], step: int) -> list[_Node]:
+        """One child per agent of the colliding ``pair``: the collision forbidden to it, the
+        agent re-planned (none where it then has no path)."""
+        padded = pack(node.paths)[0]
+        out = []
+        for agent, other in (pair, pair[::-1]):
+            constraints = _forbid(node.constraints[agent], padded, agent, other, step)
+            found = self.plan_agent(agent, constraints, node.paths)
+            if found is None:
+                continue
+            paths, bounds, all_constraints = list(node.paths), list(node.bounds), \
+                list(node.constraints)
+            paths[agent], bounds[agent] = found
+            all_constraints[agent] = constraints
+            collisions = node.collisions.copy()
+            changed = pair_collisions(pack(paths)[0], [agent])[0]
+            collisions[agent, :] = collisions[:, agent] = changed
+            out.append(_Node(paths, bounds, all_constraints, collisions))
+        return out
+
+    def plan_agent(self, agent: int, constraints: tuple, paths: list):
+        """``(path i32[T], lower bound on its cost)`` of the low-level focal search, or None."""
+        vertex, edge = constraints
+        others = [path for a, path in enumerate(paths) if a != agent]
+        occupied = _occupancy(others, self.graph.num_nodes)
+        horizon = max([t + 1 for t, _ in vertex] + [t + 1 for t, _, _ in edge]
+                      + [len(occupied)])
+        goal, field = int(self.goals[agent]), self.fields[agent]
+        keep_from = max([t + 1 for t, v in vertex if v == goal] + [0])
+        return _focal_search(self.moves, int(self.starts[agent]), goal, field, vertex, edge,
+                             occupied, horizon + self.graph.num_nodes, keep_from, self.w,
+                             self.counts)
+
+    def stop(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
+        return Plan(*pack(paths, self.goals), solved=solved, planner="ecbs", reason=reason,
+                    agent=agent,
+                    stats={**self.counts, "seconds": time.perf_counter() - self.began})
+
+
+def _occupancy(paths: list, num_nodes: int) -> list[np.ndarray]:
+    """Per step, i32[N] how many of ``paths`` are on each node (each resting at its end after
+    it; the last entry stands for every later step)."""
+    steps = max((len(path) for path in paths), default=1)
+    counts = np.zeros((steps, num_nodes), np.int32)
+    for path in paths:
+        padded = np.concatenate([path, np.full(steps - len(path), path[-1])])
+        counts[np.arange(steps), padded] += 1
+    return list(counts)
+
+
+def _focal_search(moves, start, goal, field, vertex, edge, occupied, limit, keep_from, w,
+                  counts):
+    """The low level: the focal search of the module docstring over ``(node, step)``; a state
+    past the other paths' last step sees them resting. ``(path, least f)`` or None."""
+    last = len(occupied) - 1
+    tiebreak = itertools.count()
+    h0 = int(field[start])
+    best = {(start, 0): 0}  # state -> least collisions of a path to it; -1 once expanded
+    parent = {(start, 0): None}
+    by_f = {h0: [(start, 0)]}  # f -> the states generated with it (f = step + steps to go)
+    open_count = {h0: 1}
+    f_heap = [h0]
+    focal = [(0, h0, 0, next(tiebreak), start)]
+    bound = w * h0
+    while focal:
+        conflicts, f, back, _, v = heapq.heappop(focal)
+        t = -back
+        state = (v, t)
+        if best[state] != conflicts:
+            continue  # expanded already, or reached with fewer collisions since
+        best[state] = -1
+        open_count[f] -= 1
+        counts["expanded"] += 1
+        least = _least_open(f_heap, open_count)
+        if v == goal and t >= keep_from:
+            return _path(parent, state), f if least is None else min(least, f)
+        if t < limit:
+            for u in moves[v]:
+                if (t + 1, u) in vertex or (t, v, u) in edge or field[u] >= UNREACHABLE:
+                    continue
+                g = t + 1 + int(field[u])
+                c = conflicts + int(occupied[min(t + 1, last)][u])
+                known = best.get((u, t + 1))
+                if known is not None and (known < 0 or known <= c):
+                    continue
+                best[(u, t + 1)], parent[(u, t + 1)] = c, state
+                if known is None:
+                    if not open_count.get(g):  # (a value dropped from the heap comes back)
+                        heapq.heappush(f_heap, g)
+                    open_count[g] = open_count.get(g, 0) + 1
+                    by_f.setdefault(g, []).append((u, t + 1))
+                if g <= bound:
+                    heapq.heappush(focal, (c, g, -(t + 1), next(tiebreak), u))
+            least = _least_open(f_heap, open_count)
+        if least is not None and w * least > bound:  # states newly within the bound
+            for g in sorted(by_f):
+                if bound < g <= w * least:
+                    focal += [(best[s], g, -s[1], next(tiebreak), s[0]) for s in by_f[g]
+                              if best[s] >= 0]
+            heapq.heapify(focal)
+            bound = w * least
+    return None
+
+
+def _least_open(f_heap: list, open_count: dict) -> int | None:
+    """The least f of an open state (dropping the f values with none open left)."""
+    while f_heap and open_count[f_heap[0]] == 0:
+        heapq.heappop(f_heap)
+    return f_heap[0] if f_heap else None
+
+
+def _path(parent: dict, state) -> np.ndarray:
+    out = []
+    while state is not None:
+        out.append(state[0])
+        state = parent[state]
+    return np.array(out[::-1], np.int32)
