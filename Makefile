@@ -64,7 +64,8 @@ IWD_PG_FULL := --experiments 1,2,3,4,5,6,7 --runs-smooth 50 --runs 10 --runs-com
 	--iterations 50 --drops 50
 BEES_FULL := --tables 1,2,3,4,5,6,7 --runs 20 --cycle-runs 30
 BEES_INVERSE_FULL := --maps map1,map2 --seeds 30 --grid 6x6x6 --pairs 6
-MAPF_FULL := --maps all --agents 5,10,20,50,100 --seeds 5 --cbs-time-limit 30
+MAPF_FULL := --maps all --scenarios random,even --agents 10,20,50,100,200,400,700,1000 --seeds 3 \
+	--time-limit 30
 CALIBRATION_FULL := --stores out/calibration/stores --compare-specs tunes/compare/aco_star.toml \
 	tunes/compare/iwd.toml tunes/compare/max_min_aco.toml tunes/compare/rfd_star.toml
 TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
@@ -77,7 +78,7 @@ IWD_QUICK := --maps maze20 --seeds 2 --iterations 3 --patience 2 --drops 8 --mov
 IWD_PG_QUICK := --experiments 1 --runs-smooth 1 --iterations 2 --drops 8
 BEES_QUICK := --tables 6 --runs 1 --cycle-runs 1
 BEES_INVERSE_QUICK := --maps map1 --seeds 1 --grid 2x1x1 --pairs 1
-MAPF_QUICK := --maps random-32-32-10 --agents 5 --seeds 1 --cbs-time-limit 1
+MAPF_QUICK := --maps random-32-32-10 --scenarios random --agents 5 --seeds 1 --time-limit 1
 CALIBRATION_QUICK := --specs tunes/quick/iwd.toml tunes/quick/aco_star.toml \
 	--stores $(QUICK_OUT)/calibration/stores --compare-specs tunes/quick/aco_star.toml \
 	--methods race,grid --tuner-seeds 1

@@ -1,21 +1,32 @@
-"""The A* report's multi-robot scheme, prioritised planning and Conflict-Based Search on the Moving
-AI MAPF benchmark.
+"""Multi-agent path finding at the benchmark's scale: the A* report's scheme, prioritised planning,
+CBS (plain, improved, bounded), PIBT and LaCAM on every Moving AI MAPF map, with ``pymapf`` as an
+independent baseline where it is installed.
 
-On each map of ``--maps`` (default: ``empty-32-32``, ``random-32-32-10``, ``room-32-32-4``,
-``maze-32-32-2``, ``den312d``) and each count k of ``--agents`` (default 5, 10, 20, 50, 100), the
-instance is the first k rows of the map's ``<map>-random-1.scen``
+On each map of ``--maps`` (default: every ``*.map`` of ``--data`` with both scenario files), each
+scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-random-1.scen``,
+``<map>-even-1.scen``) and each count k of ``--agents`` (default 10, 20, 50, 100, 200, 400, 700,
+1,000) that the file has rows for, the instance is the file's first k rows
 (:func:`jaxswarm.multiagent.load_instance`). Rows, the planners of :mod:`jaxswarm.multiagent`:
 
 * ``report``: :func:`~jaxswarm.multiagent.report_scheme`, the A* report's scheme (A* per robot,
   then side-steps, waits and "one robot moves first" at collisions; the report has two robots,
   the pairwise extension to more is jaxswarm's choice);
-* ``prioritized (given)``, ``prioritized (distance)``: :func:`~jaxswarm.multiagent.prioritized`
-  (space-time A* around a reservation table) with the agents in the file's order, or farthest
-  from its goal first;
-* ``prioritized (random)``: the same in a random order, once per seed 0 .. ``--seeds`` - 1;
-* ``cbs``: :func:`~jaxswarm.multiagent.cbs` (optimal sum of costs) with ``--cbs-time-limit``
-  seconds per instance (default 30). It runs out of time at the larger counts: that is a result,
-  recorded as not solved with CBS's reason.
+* ``prioritized (given)``, ``prioritized (distance)``, ``prioritized (random)``:
+  :func:`~jaxswarm.multiagent.prioritized` in the file's order, farthest first, and a random
+  order once per seed 0 .. ``--seeds`` - 1;
+* ``cbs``: :func:`~jaxswarm.multiagent.cbs` (optimal sum of costs); ``icbs``: the same with
+  prioritised collisions and bypassing (optimal too); ``ecbs``: :func:`~jaxswarm.multiagent.ecbs`
+  with w = ``--w`` (1.2);
+* ``pibt``: :func:`~jaxswarm.multiagent.pibt` (1,000 steps at most); ``lacam``:
+  :func:`~jaxswarm.multiagent.lacam` (its first solution);
+* ``pymapf lacam``, ``pymapf cbs``: ``pymapf.solve`` with its ``lacam`` and ``cbs`` solvers (the
+  peer a Python user would try first), their paths validated and costed as ours.
+
+Every planner has ``--time-limit`` seconds an instance (default 30): the search planners stop
+there; a run of the others that takes longer counts as not solved. A planner is run up to its
+``MAX_AGENTS`` (the report's scheme, CBS and pymapf's solvers stop early: tens to hundreds of
+agents are their scale), and, on one map and scenario file, not again above a count it did not
+solve (recorded as not solved, "not run").
 
 Conventions (the MAPF benchmark's): the maps are 4-connected, every move or wait takes one step,
 and an agent's cost is the step from which it stays at its goal for good (waits before that
@@ -24,44 +35,44 @@ largest. The lower bound is the sum of each agent's own shortest 4-connected dis
 goal (:func:`~jaxswarm.multiagent.lower_bound`), ignoring the others; the ``.scen`` files' last
 column is an 8-connected optimum and is **not** used. Every solved plan is checked by
 :func:`~jaxswarm.multiagent.validate` (an invalid one raises :class:`InvalidPlan`: a planner bug),
-its sum of costs must be at least the lower bound, and no planner may beat a solved CBS plan on the
-same instance (else :class:`InvalidPlan` too). A planner that raises is recorded as not solved,
-with the exception as its reason and ``error`` set; the study goes on, writes its files and
-exits with status 1.
+its sum of costs must be at least the lower bound, no planner may beat a solved optimal one (CBS
+or ICBS) on the same instance, and ECBS must stay within w of its proven bound (else
+:class:`InvalidPlan` too). A planner that raises is recorded as not solved, with the exception as
+its reason and ``error`` set; the study goes on, writes its files and exits with status 1.
 
-Per run (map, agents, planner, seed) ``runs.csv`` holds: solved, sum of costs, lower bound, their
-ratio, makespan (blank when not solved), time (s, wall time of the planner call, after a warm-up
-that leaves out numba's and JAX's one-off compilation), the reason when not solved, and the
-planner's counters (low-level expansions, CBS nodes, the report's repairs).
+Per run (map, scenario, agents, planner, seed) ``runs.csv`` holds: solved, sum of costs, lower
+bound, their ratio, makespan (blank when not solved), time (s, wall time of the planner call,
+after a warm-up that leaves out numba's and JAX's one-off compilation), of which ``field_seconds``
+the agents' distance fields (PIBT and LaCAM report them apart), the reason when not solved, and
+the planner's counters (low-level expansions, CBS nodes, LaCAM configurations).
 
 Outputs (in ``--out``, default ``out/mapf_study/``, each written atomically):
 
 * ``runs.csv``: one row per run;
-* ``summary.csv``: per planner and agent count over all maps (``map`` = ``all``), then per map,
-  agent count and planner: runs, solved, success rate, mean SoC / lower bound and mean makespan
-  over the solved runs, median time over all runs, runs that raised;
-* ``table.md``: the provenance (:mod:`jaxswarm.studies.provenance`), then both summaries as
-  Markdown tables;
-* ``mapf_study.png``: success rate, mean SoC / lower bound and median time against the number of
-  agents, one line per planner (over all maps);
+* ``summary.csv``: per planner and agent count over all instances (``map`` = ``all``), then per
+  map (and scenario), agent count and planner: runs, solved, success rate, mean SoC / lower
+  bound and mean makespan over the solved runs, median time over all runs, runs that raised;
+* ``table.md``: the provenance (:mod:`jaxswarm.studies.provenance`), the published LaCAM figures
+  beside ours, then both summaries as Markdown tables;
+* ``mapf_study.png``: success rate (the MAPF literature's plot), mean SoC / lower bound and
+  median time against the number of agents, one line per planner (over all instances);
 * ``provenance.json``: the provenance and the arguments.
 
-``make reproduce`` writes them to ``results/mapf_study/``. The full default run took 8.8 minutes
-on 2 cores (AMD EPYC, shared, load 2-3): mostly CBS at its time limit (13 of the 25 instances,
-6.5 min) and the report's scheme repairing collisions at 50 and 100 agents (up to about 20 s an
-instance); prioritised planning takes well under a second an instance. The tiny run of
-``make reproduce-quick`` takes seconds.
+``make reproduce`` writes them to ``results/mapf_study/``; ``make reproduce-quick`` runs a tiny
+version in seconds.
 
 The maps are read from ``--data`` (default: ``$JAXSWARM_MOVINGAI/mapf`` if that variable is set,
 else ``../shared/benchdata/movingai/mapf`` beside the repository). Run from the repository root::
 
     python sweeps/mapf_study.py
-    python sweeps/mapf_study.py --maps room-32-32-4,maze-32-32-2 --agents 5,10 --seeds 1 \\
-        --cbs-time-limit 2 --out out/mapf_quick
+    python sweeps/mapf_study.py --maps room-32-32-4,maze-32-32-2 --scenarios random \\
+        --agents 5,10 --seeds 1 --time-limit 2 --out out/mapf_quick
 """
 from __future__ import annotations
 
 import argparse
+import functools
+import importlib.util
 import math
 import statistics
 import sys
@@ -72,59 +83,77 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.multiagent import (Instance, cbs, load_instance, lower_bound, prioritized,
-                                 report_scheme, validate)
+from jaxswarm.multiagent import (Instance, Plan, cbs, ecbs, lacam, load_instance, lower_bound,
+                                 pack, pibt, prioritized, report_scheme, validate)
+from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts
 from jaxswarm.studies.problems import movingai_folder
 
 
-MAPS = ("empty-32-32", "random-32-32-10", "room-32-32-4", "maze-32-32-2", "den312d")
-"""The default maps (all: ``--maps all``)."""
-AGENTS = (5, 10, 20, 50, 100)
-"""The default agent counts."""
+SCENARIOS = ("random", "even")
+"""The scenario files of a map: ``<map>-<name>-1.scen``."""
+AGENTS = (10, 20, 50, 100, 200, 400, 700, 1000)
+"""The default agent counts (each map runs those its scenario files have rows for)."""
 PLANNERS = ("report", "prioritized (given)", "prioritized (distance)", "prioritized (random)",
-            "cbs")
+            "cbs", "icbs", "ecbs", "pibt", "lacam", "pymapf lacam", "pymapf cbs")
 """The rows, in the order they run on every instance."""
+PYMAPF = ("pymapf lacam", "pymapf cbs")
+"""The rows of pymapf's solvers (left out when pymapf is not installed)."""
+MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "ecbs": 400, "pymapf lacam": 200,
+              "pymapf cbs": 50}
+"""The most agents a planner is run with (the others: every count)."""
+OPTIMAL = ("cbs", "icbs")
+"""The rows whose solved plans have the least sum of costs."""
 RANDOM = "prioritized (random)"
 """The row run once per seed."""
-SCENARIO = "{map}-random-1.scen"
-"""The scenario file of a map: its first k rows are the k agents."""
-RUN_COLUMNS = ("map", "agents", "planner", "seed", "solved", "sum_of_costs", "lower_bound",
-               "ratio", "makespan", "seconds", "reason", "error", "expanded", "nodes", "repairs")
+RUN_COLUMNS = ("map", "scenario", "agents", "planner", "seed", "solved", "sum_of_costs",
+               "lower_bound", "ratio", "makespan", "seconds", "field_seconds", "reason", "error",
+               "expanded", "nodes", "configurations", "repairs")
 SUMMARY_COLUMNS = ("map", "agents", "planner", "runs", "solved", "success_rate", "mean_ratio",
                    "mean_makespan", "median_seconds", "errors")
 ALL_MAPS = "all"
-"""The ``map`` of summary rows over every map."""
-TITLE = "Multi-agent path finding on Moving AI MAPF maps: the A* report's scheme, prioritised " \
-        "planning and CBS"
+"""The ``map`` of summary rows over every instance."""
+TITLE = "Multi-agent path finding on the Moving AI MAPF benchmark"
 """Title of table.md."""
 ABOUT = (
     "Rows: the A* report's two-robot scheme (`report_scheme`; its pairwise extension to more "
     "robots is jaxswarm's choice), prioritised planning with space-time A* (Silver 2005; "
-    "`prioritized`) in the scenario's order, farthest-first and seeded random orders, and "
-    "Conflict-Based Search (Sharon et al. 2015; `cbs`, optimal sum of costs, with a time limit "
-    "per instance). Instances: the first k rows of each map's `-random-1.scen`, 4-connected, "
-    "unit moves, an agent's cost is the step from which it stays at its goal. SoC / LB is the "
-    "sum of costs over the sum of the agents' own 4-connected distances (the `.scen` optimum "
-    "column is 8-connected and not used); it and the makespan are means over the solved runs "
-    "only, so planners that solve different instances are not compared on the same ones. "
-    "Every solved plan passed `validate`.")
+    "`prioritized`) in the scenario's order, farthest-first and seeded random orders, "
+    "Conflict-Based Search (Sharon et al. 2015; `cbs`, optimal), CBS with prioritised "
+    "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), Enhanced CBS (Barer et "
+    "al. 2014; `ecbs`, within w of the optimum), PIBT (Okumura et al. 2022) and LaCAM (Okumura "
+    "2023; its first solution), and pymapf's LaCAM and CBS where pymapf is installed. "
+    "Instances: the first k rows of each map's `-random-1.scen` and `-even-1.scen`, "
+    "4-connected, unit moves; an agent's cost is the step from which it stays at its goal. A run "
+    "counts as solved only within the time limit; a planner is not run above its agent cap, nor "
+    "above a count it did not solve on the same map and scenario (those runs count as not "
+    "solved). SoC / LB is the sum of costs over the sum of the agents' own 4-connected "
+    "distances; it and the makespan are means over the solved runs only. Every solved plan "
+    "passed `validate`.")
 """What the rows are (the paragraph under the provenance)."""
 LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (given)",
           "prioritized (distance)": "prioritized (distance)",
-          "prioritized (random)": "prioritized (random)", "cbs": "CBS"}
+          "prioritized (random)": "prioritized (random)", "cbs": "CBS", "icbs": "ICBS",
+          "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "pymapf lacam": "pymapf LaCAM",
+          "pymapf cbs": "pymapf CBS"}
+PUBLISHED = (
+    ("LaCAM (Okumura, AAAI 2023; the lacam2 README)", "random-32-32-20", 400, "about 0.031 s"),
+    ("LaCAM* (Okumura, IJCAI 2023, arXiv 2305.03632)", "the MAPF benchmark", "up to 1,000",
+     "99 % of instances solved within 10 s"),
+)
+"""Published LaCAM figures on the same benchmark (C++ implementations, their machines)."""
 
 
 class InvalidPlan(RuntimeError):
-    """A planner's solved plan breaks a rule (validate, the lower bound or CBS's optimality)."""
+    """A planner's solved plan breaks a rule (validate, the lower bound, an optimum, a bound)."""
 
 
-def parse_maps(text: str) -> list[str]:
-    """``"all"`` or a comma list of map names (without ``.map``)."""
+def parse_maps(text: str) -> list[str] | None:
+    """``"all"`` (None: every map of the data folder) or a comma list of map names."""
     if text.strip() == "all":
-        return list(MAPS)
+        return None
     maps = [name.strip() for name in text.split(",") if name.strip()]
     if not maps:
         raise argparse.ArgumentTypeError(f"expected map names or 'all', got {text!r}")
@@ -139,20 +168,82 @@ def parse_agents(text: str) -> list[int]:
         raise argparse.ArgumentTypeError(f"expected a comma list of integers, got {text!r}")
     if not counts or min(counts) < 1:
         raise argparse.ArgumentTypeError(f"agent counts must be at least 1, got {text!r}")
-    return counts
+    return sorted(set(counts))
 
 
-def planner_calls(seeds: int, cbs_time_limit: float) -> list[tuple[str, int | None, Callable]]:
+def parse_scenarios(text: str) -> list[str]:
+    """A comma list of scenario names from :data:`SCENARIOS`."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in SCENARIOS]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"scenarios are {', '.join(SCENARIOS)}; got {text!r}")
+    return names
+
+
+def scenario_path(data: Path, map_name: str, scenario: str) -> Path:
+    """The scenario file of ``map_name``."""
+    return data / f"{map_name}-{scenario}-1.scen"
+
+
+def scenario_rows(path: Path) -> int:
+    """The agents a scenario file has rows for."""
+    with open(path, encoding="utf-8") as file:
+        return sum(1 for line in file if line.strip()) - 1
+
+
+def pymapf_installed() -> bool:
+    """Whether the pymapf package can be imported."""
+    return importlib.util.find_spec("pymapf") is not None
+
+
+def pymapf_planner(solver: str, time_limit: float) -> Callable:
+    """``call(graph, starts, goals) -> Plan`` of pymapf's ``solver`` on a grid map: pymapf's
+    cells are (row, column); its paths come back as our node lists, packed and costed as ours
+    (the validator judges them)."""
+    import pymapf
+
+    def call(graph, starts, goals) -> Plan:
+        began = time.perf_counter()
+        start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
+        height, width = graph.shape
+        blocked = ~np.asarray(graph.free).reshape(height, width)
+        cell = {node: (int(node) // width, int(node) % width) for node in
+                (*start_nodes.tolist(), *goal_nodes.tolist())}
+        problem = pymapf.MAPFProblem(pymapf.GridMap(blocked.tolist()), [
+            pymapf.Agent(str(a), cell[s], cell[g])
+            for a, (s, g) in enumerate(zip(start_nodes.tolist(), goal_nodes.tolist()))])
+        solution = pymapf.solve(problem, solver, time_limit=time_limit)
+        seconds = time.perf_counter() - began
+        name = f"pymapf {solver}"
+        if solution is None:
+            return Plan(start_nodes[:, None], np.zeros(len(start_nodes), np.int32), False, name,
+                        reason=f"pymapf's {solver} returned no solution",
+                        stats={"seconds": seconds})
+        paths = [[r * width + c for r, c in solution.paths[str(a)]]
+                 for a in range(len(start_nodes))]
+        return Plan(*pack(paths, goal_nodes), solved=True, planner=name,
+                    stats={"seconds": seconds})
+
+    return call
+
+
+def planner_calls(seeds: int, time_limit: float, w: float,
+                  with_pymapf: bool) -> list[tuple[str, int | None, Callable]]:
     """``(planner, seed or None, call(graph, starts, goals) -> Plan)`` in the order they run."""
     calls = [("report", None, report_scheme),
-             ("prioritized (given)", None,
-              lambda g, s, t: prioritized(g, s, t, order="given")),
-             ("prioritized (distance)", None,
-              lambda g, s, t: prioritized(g, s, t, order="distance"))]
-    calls += [(RANDOM, seed, lambda g, s, t, seed=seed: prioritized(g, s, t, order="random",
-                                                                   seed=seed))
+             ("prioritized (given)", None, functools.partial(prioritized, order="given")),
+             ("prioritized (distance)", None, functools.partial(prioritized, order="distance"))]
+    calls += [(RANDOM, seed, functools.partial(prioritized, order="random", seed=seed))
               for seed in range(seeds)]
-    calls.append(("cbs", None, lambda g, s, t: cbs(g, s, t, time_limit=cbs_time_limit)))
+    calls += [("cbs", None, functools.partial(cbs, time_limit=time_limit)),
+              ("icbs", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
+                                               bypass=True)),
+              ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
+              ("pibt", None, pibt),
+              ("lacam", None, functools.partial(lacam, time_limit=time_limit))]
+    if with_pymapf:
+        calls += [(f"pymapf {solver}", None, pymapf_planner(solver, time_limit))
+                  for solver in ("lacam", "cbs")]
     return calls
 
 
@@ -163,96 +254,123 @@ def warm_up(instance: Instance) -> None:
     graph, starts, goals = instance.graph, instance.starts, instance.goals
     lower_bound(graph, starts, goals)
     report_scheme(graph, starts, goals, max_repairs=0)
-    prioritized(graph, starts[:2], goals[:2])
-    cbs(graph, starts[:2], goals[:2], time_limit=1.0)
+    for planner in (prioritized, cbs, pibt, lacam):
+        planner(graph, starts[:2], goals[:2])
 
 
-def run_instance(instance: Instance, map_name: str, agents: int, seeds: int,
-                 cbs_time_limit: float) -> list[dict]:
-    """Every planner on one instance; one row per run.
+def run_instance(instance: Instance, where: dict, calls: list, time_limit: float, *,
+                 skip: dict | None = None) -> list[dict]:
+    """Every planner of ``calls`` on one instance (``where``: its ``map``, ``scenario``,
+    ``agents``); one row per run. ``skip``: planner -> why it is not run here.
 
     Raises:
-      InvalidPlan: a solved plan fails ``validate``, is below the lower bound, or beats CBS.
+      InvalidPlan: a solved plan fails ``validate``, is below the lower bound, beats an optimal
+        planner, or ECBS's is above its bound.
     """
     graph, starts, goals = instance.graph, instance.starts, instance.goals
     bound = lower_bound(graph, starts, goals)
     warm_up(instance)
     rows = []
-    for planner, seed, call in planner_calls(seeds, cbs_time_limit):
+    for planner, seed, call in calls:
+        if (where["agents"] > MAX_AGENTS.get(planner, where["agents"])):
+            continue
+        row = dict(where, planner=planner, seed="" if seed is None else seed, solved=False,
+                   sum_of_costs="", lower_bound=bound, ratio="", makespan="", seconds=0.0,
+                   field_seconds="", reason="", error=False, expanded="", nodes="",
+                   configurations="", repairs="")
+        if skip and planner in skip:
+            rows.append(dict(row, reason=skip[planner], seconds=""))
+            continue
         began = time.perf_counter()
         try:
-            plan = call(graph, starts, goals)
-            error = None
+            plan, error = call(graph, starts, goals), None
         except Exception as exc:  # noqa: BLE001 - a crash is recorded, the study goes on
             plan, error = None, f"raised {type(exc).__name__}: {exc}"
-        seconds = time.perf_counter() - began
-        row = {"map": map_name, "agents": agents, "planner": planner,
-               "seed": "" if seed is None else seed, "solved": bool(plan is not None
-                                                                    and plan.solved),
-               "sum_of_costs": "", "lower_bound": bound, "ratio": "", "makespan": "",
-               "seconds": seconds, "reason": error or (plan.reason if plan else ""),
-               "error": error is not None, "expanded": "", "nodes": "", "repairs": ""}
+        row.update(seconds=time.perf_counter() - began, error=error is not None,
+                   reason=error or (plan.reason if plan else ""))
         if plan is not None:
-            for key in ("expanded", "nodes", "repairs"):
+            for key in ("expanded", "nodes", "configurations", "repairs", "field_seconds"):
                 row[key] = plan.stats.get(key, "")
+            row["solved"] = plan.solved
+            if plan.solved and row["seconds"] > time_limit:
+                row.update(solved=False, reason=f"solved in {row['seconds']:.1f} s, over the "
+                                                f"{time_limit:g} s limit")
         if row["solved"]:
-            where = f"{planner} on {instance.name}" + ("" if seed is None else f", seed {seed}")
-            violations = validate(graph, plan.paths, starts, goals, plan.lengths)
-            if violations:
-                shown = "; ".join(map(str, violations[:5]))
-                raise InvalidPlan(f"{where}: a solved plan with {len(violations)} violations: "
-                                  f"{shown}")
-            if plan.sum_of_costs < bound:
-                raise InvalidPlan(f"{where}: sum of costs {plan.sum_of_costs} below the lower "
-                                  f"bound {bound}")
-            row.update(sum_of_costs=plan.sum_of_costs, makespan=plan.makespan,
-                       ratio=plan.sum_of_costs / bound if bound > 0 else math.nan)
+            _check(instance, row, plan, bound, seed)
         rows.append(row)
-    check_cbs_optimal(rows, instance.name)
+    check_optimal(rows, instance.name)
     return rows
 
 
-def check_cbs_optimal(rows: list[dict], name: str) -> None:
+def _check(instance: Instance, row: dict, plan: Plan, bound: int, seed) -> None:
+    """Validate a solved run and record its costs; :class:`InvalidPlan` if it breaks a rule."""
+    graph, starts, goals = instance.graph, instance.starts, instance.goals
+    where = f"{row['planner']} on {instance.name}" + ("" if seed is None else f", seed {seed}")
+    violations = validate(graph, plan.paths, starts, goals, plan.lengths)
+    if violations:
+        shown = "; ".join(map(str, violations[:5]))
+        raise InvalidPlan(f"{where}: a solved plan with {len(violations)} violations: {shown}")
+    if plan.sum_of_costs < bound:
+        raise InvalidPlan(f"{where}: sum of costs {plan.sum_of_costs} below the lower bound "
+                          f"{bound}")
+    proven = plan.stats.get("lower_bound")
+    if row["planner"] == "ecbs" and plan.sum_of_costs > plan.stats["w"] * proven:
+        raise InvalidPlan(f"{where}: sum of costs {plan.sum_of_costs} above w times its "
+                          f"bound {proven}")
+    row.update(sum_of_costs=plan.sum_of_costs, makespan=plan.makespan,
+               ratio=plan.sum_of_costs / bound if bound > 0 else math.nan)
+
+
+def check_optimal(rows: list[dict], name: str) -> None:
     """Raise :class:`InvalidPlan` if a solved run of one instance has a smaller sum of costs
-    than a solved CBS run (CBS's is the least)."""
-    optimum = [row["sum_of_costs"] for row in rows if row["planner"] == "cbs" and row["solved"]]
-    if not optimum:
+    than a solved optimal one (CBS's and ICBS's are the least), or if those two differ."""
+    optima = {row["sum_of_costs"] for row in rows if row["planner"] in OPTIMAL and row["solved"]}
+    if len(optima) > 1:
+        raise InvalidPlan(f"CBS and ICBS on {name}: different optima {sorted(optima)}")
+    if not optima:
         return
+    optimum = optima.pop()
     for row in rows:
-        if row["solved"] and row["sum_of_costs"] < optimum[0]:
+        if row["solved"] and row["sum_of_costs"] < optimum:
             raise InvalidPlan(f"{row['planner']} on {name} (seed {row['seed']}): sum of costs "
-                              f"{row['sum_of_costs']} below CBS's optimum {optimum[0]}")
+                              f"{row['sum_of_costs']} below the optimum {optimum}")
 
 
-def run_study(maps, agent_counts, seeds: int, cbs_time_limit: float, data: Path, *,
-              log: Callable[[str], None] | None = print) -> list[dict]:
-    """Run every planner on every (map, agent count); the tidy rows.
+def run_study(instances: list[tuple[str, str]], agent_counts, calls: list, time_limit: float,
+              data: Path, *, log: Callable[[str], None] | None = print) -> list[dict]:
+    """Run every planner on every (map, scenario) at every count its file has rows for; the
+    tidy rows. A planner not solving at a count is not run at larger ones on the same file.
 
     Args:
-      maps: map names (files ``data / NAME.map`` and ``data / NAME-random-1.scen``).
+      instances: ``(map, scenario)`` pairs (files ``data / MAP.map`` and their scenario).
       agent_counts: numbers of agents (the first rows of the scenario file).
-      seeds: runs of the random order (seeds 0 .. seeds - 1).
-      cbs_time_limit: CBS's seconds per instance.
+      calls: :func:`planner_calls`.
+      time_limit: seconds an instance, per planner.
       data: the folder of the maps.
       log: called with one progress line per instance (None: silent).
     """
     rows = []
     began = time.perf_counter()
-    for map_name in maps:
-        for agents in agent_counts:
-            instance = load_instance(data / f"{map_name}.map",
-                                     data / SCENARIO.format(map=map_name), agents)
+    for map_name, scenario in instances:
+        scen = scenario_path(data, map_name, scenario)
+        failed: dict[str, str] = {}
+        for agents in [k for k in agent_counts if k <= scenario_rows(scen)]:
+            instance = load_instance(data / f"{map_name}.map", scen, agents)
+            where = dict(map=map_name, scenario=scenario, agents=agents)
             instance_began = time.perf_counter()
-            new = run_instance(instance, map_name, agents, seeds, cbs_time_limit)
+            new = run_instance(instance, where, calls, time_limit, skip=failed)
             rows += new
+            for row in new:
+                if not row["solved"] and row["planner"] not in failed and row["planner"] != RANDOM:
+                    failed[row["planner"]] = f"not run: not solved at {agents} agents"
             if log is not None:
                 solved = {}
                 for row in new:
                     done, runs = solved.get(row["planner"], (0, 0))
                     solved[row["planner"]] = (done + row["solved"], runs + 1)
-                took = time.perf_counter() - instance_began
-                log(f"{map_name:>16} {agents:>4} agents: {took:6.1f} s (elapsed "
-                    f"{time.perf_counter() - began:6.1f} s) | solved "
+                log(f"{map_name:>22} {scenario:>6} {agents:>4}: "
+                    f"{time.perf_counter() - instance_began:6.1f} s (elapsed "
+                    f"{time.perf_counter() - began:6.0f} s) | "
                     + ", ".join(f"{LABELS[p]} {d}/{n}" for p, (d, n) in solved.items()))
     return rows
 
@@ -266,22 +384,29 @@ def _group(rows: list[dict], key: tuple) -> dict:
                            else math.nan)
     entry["mean_makespan"] = (float(np.mean([row["makespan"] for row in solved])) if solved
                               else math.nan)
-    entry["median_seconds"] = float(statistics.median(row["seconds"] for row in rows))
+    ran = [row["seconds"] for row in rows if row["seconds"] != ""]
+    entry["median_seconds"] = float(statistics.median(ran)) if ran else math.nan
     entry["errors"] = sum(bool(row["error"]) for row in rows)
     return entry
 
 
+def instance_set(row: dict) -> str:
+    """The instances a run belongs to in the summaries: its map and scenario file."""
+    return f"{row['map']} ({row['scenario']})"
+
+
 def summarise(rows: list[dict]) -> list[dict]:
-    """Per (agents, planner) over all maps (``map`` = :data:`ALL_MAPS`), then per (map, agents,
-    planner): runs, solved, success rate, mean ratio and makespan over the solved runs, median
-    seconds over all runs, errors. Sorted by map (all first), agents, then planner order."""
+    """Per (agents, planner) over all maps (``map`` = :data:`ALL_MAPS`), then per (map and
+    scenario, agents, planner): runs, solved, success rate, mean ratio and makespan over the
+    solved runs, median seconds over all runs, errors. Sorted by map (all first), agents, then
+    planner order."""
     order = {name: i for i, name in enumerate(PLANNERS)}
-    maps = list(dict.fromkeys(row["map"] for row in rows))
+    maps = list(dict.fromkeys(instance_set(row) for row in rows))
     overall: dict[tuple, list[dict]] = {}
     each: dict[tuple, list[dict]] = {}
     for row in rows:
         overall.setdefault((ALL_MAPS, row["agents"], row["planner"]), []).append(row)
-        each.setdefault((row["map"], row["agents"], row["planner"]), []).append(row)
+        each.setdefault((instance_set(row), row["agents"], row["planner"]), []).append(row)
 
     def sort_key(item):
         (map_name, agents, planner), _ = item
@@ -306,14 +431,15 @@ def summary_markdown(summary: list[dict], rows: list[dict]) -> str:
     def cells(e):
         return (f"{e['solved']}/{e['runs']} | {100 * e['success_rate']:.0f}% | "
                 f"{_number(e['mean_ratio'], 3)} | {_number(e['mean_makespan'], 1)} | "
-                f"{e['median_seconds']:.3f}")
+                f"{_number(e['median_seconds'], 3)}")
 
     overall = [*head] + [f"| {e['agents']} | {LABELS[e['planner']]} | {cells(e)} |"
                          for e in summary if e["map"] == ALL_MAPS]
     reasons = {}
     for row in rows:
         if not row["solved"]:
-            reasons.setdefault((row["map"], row["agents"], row["planner"]), row["reason"])
+            reasons.setdefault((instance_set(row), row["agents"], row["planner"]),
+                               row["reason"])
     per_map = ["| map | agents | planner | solved | success | SoC / LB | makespan | "
                "median time s | first reason not solved |",
                "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | --- |"]
@@ -324,12 +450,28 @@ def summary_markdown(summary: list[dict], rows: list[dict]) -> str:
         per_map.append(f"| {e['map']} | {e['agents']} | {LABELS[e['planner']]} | {cells(e)} | "
                        f"{reason} |")
     errors = sum(e["errors"] for e in summary if e["map"] == ALL_MAPS)
-    sections = [("Over all maps", overall), ("Per map", per_map)]
+    sections = [("Published LaCAM figures beside ours", published_markdown(rows)),
+                ("Over all maps", overall), ("Per map", per_map)]
     if errors:
         sections.append(("Runs that raised", [
             f"{errors} runs raised an exception (recorded as not solved; the `error` column of "
             "`runs.csv`, the reason says which)."]))
     return provenance.join_sections(sections)
+
+
+def published_markdown(rows: list[dict]) -> list[str]:
+    """The published LaCAM figures (:data:`PUBLISHED`) beside ours on the same instances."""
+    ours = [row for row in rows if row["planner"] == "lacam"]
+    dense = [row for row in ours if (row["map"], row["scenario"], row["agents"])
+             == ("random-32-32-20", "random", 400)]
+    first = "-" if not dense else (f"{dense[0]['seconds']:.2f} s"
+                                   + ("" if dense[0]["solved"] else " (not solved)"))
+    quick = sum(bool(row["solved"]) and row["seconds"] <= 10.0 for row in ours)
+    second = f"{quick} of {len(ours)} runs solved within 10 s" if ours else "-"
+    return ["| published | instances | agents | published figure | ours (jaxswarm's LaCAM, "
+            "this run) |", "| --- | --- | --- | --- | --- |"] + [
+        f"| {who} | {where} | {agents} | {figure} | {value} |"
+        for (who, where, agents, figure), value in zip(PUBLISHED, (first, second))]
 
 
 def format_summary(summary: list[dict]) -> str:
@@ -344,7 +486,7 @@ def format_summary(summary: list[dict]) -> str:
                                     f"{100 * e['success_rate']:.0f}%",
                                     _number(e["mean_ratio"], 3),
                                     _number(e["mean_makespan"], 1),
-                                    f"{e['median_seconds']:.3f}"))
+                                    _number(e["median_seconds"], 3)))
     return "\n".join(lines)
 
 
@@ -358,7 +500,7 @@ def plot_summary(summary: list[dict], path) -> None:
     fig = Figure(figsize=(15, 4.5), layout="constrained")
     axes = fig.subplots(1, len(panels))
     for ax, (metric, title) in zip(axes, panels):
-        for planner, marker, style in zip(PLANNERS, "osD^v", ("-", "-", "--", ":", "-")):
+        for planner, marker, style in zip(PLANNERS, "osD^vP*Xhd<", ("-", "-", "--", ":") * 3):
             entries = sorted((e for e in overall if e["planner"] == planner),
                              key=lambda e: e["agents"])
             if entries:  # markers and dashes tell apart the lines that coincide
@@ -374,55 +516,43 @@ def plot_summary(summary: list[dict], path) -> None:
     axes[0].set_ylim(-0.05, 1.05)
     axes[2].set_yscale("log")
     axes[0].legend()
-    maps = list(dict.fromkeys(e["map"] for e in summary if e["map"] != ALL_MAPS))
-    fig.suptitle(f"MAPF planners on {len(maps)} Moving AI map{'s' * (len(maps) > 1)} "
-                 f"({', '.join(maps)})")
+    sets = [e["map"] for e in summary if e["map"] != ALL_MAPS]
+    maps = sorted({name.split(" (")[0] for name in sets})
+    fig.suptitle(f"MAPF planners on {len(maps)} Moving AI map{'s' * (len(maps) > 1)}, "
+                 f"{len(set(sets))} scenario files: success rate against agents (over all)")
     with atomic_path(path) as temporary:
         fig.savefig(temporary, format="png", dpi=120)
 
 
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--maps", type=parse_maps, default=list(MAPS),
-                        help="comma list of MAPF map names or 'all' (default all: "
-                             + ", ".join(MAPS) + ")")
-    parser.add_argument("--agents", type=parse_agents, default=list(AGENTS),
-                        help="comma list of agent counts (default 5,10,20,50,100)")
-    parser.add_argument("--seeds", type=int, default=5,
-                        help="runs of the random priority order, seeds 0.. (default 5)")
-    parser.add_argument("--cbs-time-limit", type=float, default=30.0,
-                        help="CBS's seconds per instance (default 30)")
-    parser.add_argument("--data", type=Path, default=movingai_folder(),
-                        help="the folder of the MAPF .map and .scen files (default "
-                             "$JAXSWARM_MOVINGAI/mapf, else ../shared/benchdata/movingai/mapf)")
-    add_out_argument(parser, "mapf_study")
-    args = parser.parse_args(argv)
+    args = _parser().parse_args(argv)
+    parser = _parser()
     check_counts(parser, args, "seeds")
-    if args.cbs_time_limit <= 0:
-        parser.error("--cbs-time-limit must be positive")
-    for name in args.maps:
-        for path in (args.data / f"{name}.map", args.data / SCENARIO.format(map=name)):
+    if args.time_limit <= 0 or args.w < 1:
+        parser.error("--time-limit must be positive and --w at least 1")
+    maps = args.maps or sorted(path.stem for path in args.data.glob("*.map")
+                               if all(scenario_path(args.data, path.stem, s).is_file()
+                                      for s in args.scenarios))
+    instances = [(name, scenario) for name in maps for scenario in args.scenarios]
+    for name, scenario in instances:
+        for path in (args.data / f"{name}.map", scenario_path(args.data, name, scenario)):
             if not path.is_file():
                 parser.error(f"no {path} (see --data)")
-
+    with_pymapf = pymapf_installed() and not args.no_pymapf
     record = provenance.begin(__file__, argv)
-    instances = len(args.maps) * len(args.agents)
-    print(f"MAPF study: {len(args.maps)} maps x agents {args.agents}, {args.seeds} random "
-          f"orders, CBS limit {args.cbs_time_limit:g} s -> {args.out}")
-    print(f"at most about {instances * args.cbs_time_limit / 60:.1f} min of CBS "
-          f"({instances} instances), plus the report's repairs (up to ~20 s an instance at "
-          "100 agents)")
-
+    print(f"MAPF study: {len(maps)} maps x {len(args.scenarios)} scenario files, agents "
+          f"{args.agents}, {args.seeds} random orders, {args.time_limit:g} s a planner and "
+          f"instance, pymapf {'on' if with_pymapf else 'off'} -> {args.out}")
     began = time.perf_counter()
-    rows = run_study(args.maps, args.agents, args.seeds, args.cbs_time_limit, args.data)
+    calls = planner_calls(args.seeds, args.time_limit, args.w, with_pymapf)
+    rows = run_study(instances, args.agents, calls, args.time_limit, args.data)
     summary = summarise(rows)
-    record.finish(title=TITLE, about=ABOUT, arguments=vars(args))
+    record.finish(title=TITLE, about=ABOUT, arguments=vars(args), pymapf=with_pymapf)
     write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
     write_csv(args.out / "summary.csv", summary, SUMMARY_COLUMNS)
     plot_summary(summary, args.out / "mapf_study.png")
     record.publish(args.out, summary_markdown(summary, rows))
-
     print("\n" + format_summary(summary))
     print(f"\n{len(rows)} runs in {time.perf_counter() - began:.0f} s; every solved plan "
           f"passed validate. Wrote {args.out / 'runs.csv'}, {args.out / 'summary.csv'}, "
@@ -433,6 +563,30 @@ def main(argv: list[str] | None = None) -> int:
               "of runs.csv)", file=sys.stderr)
         return 1
     return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--maps", type=parse_maps, default=None,
+                        help="comma list of MAPF map names, or 'all' (default: every map of "
+                             "--data with its scenario files)")
+    parser.add_argument("--scenarios", type=parse_scenarios, default=list(SCENARIOS),
+                        help="comma list of scenario files: random, even (default both)")
+    parser.add_argument("--agents", type=parse_agents, default=list(AGENTS),
+                        help="comma list of agent counts (default 10,20,50,100,200,400,700,"
+                             "1000; each map runs those its scenario files have rows for)")
+    parser.add_argument("--seeds", type=int, default=3,
+                        help="runs of the random priority order, seeds 0.. (default 3)")
+    parser.add_argument("--time-limit", type=float, default=30.0,
+                        help="seconds a planner has per instance (default 30)")
+    parser.add_argument("--w", type=float, default=1.2, help="ECBS's bound (default 1.2)")
+    parser.add_argument("--no-pymapf", action="store_true",
+                        help="leave out pymapf's solvers even where pymapf is installed")
+    parser.add_argument("--data", type=Path, default=movingai_folder(),
+                        help="the folder of the MAPF .map and .scen files (default "
+                             "$JAXSWARM_MOVINGAI/mapf, else ../shared/benchdata/movingai/mapf)")
+    add_out_argument(parser, "mapf_study")
+    return parser
 
 
 if __name__ == "__main__":

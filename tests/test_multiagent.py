@@ -3,6 +3,9 @@ check against an all-pairs oracle, and every planner against the validator, a jo
 optimum and each other."""
 from __future__ import annotations
 
+import dataclasses
+
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
@@ -12,6 +15,7 @@ from jaxswarm.multiagent import (PLANNERS, UNREACHABLE, cbs, find_conflicts, hop
                                  load_instance, lower_bound, pack, prioritized, report_scheme,
                                  validate)
 from jaxswarm.multiagent import conflicts as conflicts_module
+from jaxswarm.multiagent.agents import distance_fields
 from jaxswarm.multiagent.plan import arrival_steps
 from jaxswarm.multiagent.prioritized import priority_order
 from jaxswarm.multiagent.report import report_example
@@ -322,6 +326,18 @@ def test_hop_fields_count_steps_not_lengths():
     graph = grid_graph(np.zeros((3, 3), bool), connectivity=8)
     fields = hop_fields(graph, np.array([0]))
     assert fields[0, 8] == 2  # two diagonal steps, not 2 sqrt 2
+
+
+def test_hop_fields_are_the_jax_distance_fields_of_unit_moves(instances):
+    # The breadth-first fields against the batched JAX relaxation on the graph whose every
+    # edge is one step long (and UNREACHABLE where it gives inf).
+    graph = instances["room-32-32-4"].graph
+    goals = np.array([0, 37, 500, 1023])
+    unit = dataclasses.replace(graph, cost=(graph.nbr >= 0).astype(jnp.float32))
+    relaxed = distance_fields(unit, goals)
+    expected = np.full(relaxed.shape, UNREACHABLE, np.int64)
+    expected[np.isfinite(relaxed)] = relaxed[np.isfinite(relaxed)]
+    np.testing.assert_array_equal(hop_fields(graph, goals), expected)
 
 
 @pytest.mark.parametrize("planner", PLANNERS)

@@ -2,8 +2,10 @@
 
 Time is counted in steps: every agent moves along one edge or waits in each step, whatever the
 edge's length, so distances here are hop counts. :func:`hop_fields` computes them for all agents
-in one batched call of :func:`jaxswarm.exact.distance_field` (vmapped over the goals), on the
-graph with every edge length set to 1.
+by a compiled breadth-first search per goal (numba, as :mod:`jaxswarm.exact.kernels`): O(N) per
+agent, where the batched relaxation of :func:`jaxswarm.exact.distance_field` takes a sweep per
+step of the longest path (40 s for 1,000 agents on maze-128-128-10 against well under a second).
+:func:`distance_fields` keeps the batched JAX call for fields in edge lengths.
 """
 from __future__ import annotations
 
@@ -15,6 +17,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.exact import distance_field
+from jaxswarm.exact._host import edge_arrays
+from jaxswarm.exact.kernels import jit
 from jaxswarm.maps.movingai import MovingAIFormatError, load_scenarios, read_map
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import as_node
@@ -79,11 +83,6 @@ def place(graph: Graph, node: int) -> str:
     return f"node {node}"
 
 
-def hop_graph(graph: Graph) -> Graph:
-    """``graph`` with every edge length 1 (one step per move)."""
-    return dataclasses.replace(graph, cost=(graph.nbr >= 0).astype(jnp.float32))
-
-
 @jax.jit
 def _fields(graph: Graph, goals: jax.Array) -> jax.Array:
     return jax.vmap(distance_field, in_axes=(None, 0))(graph, goals)
@@ -102,18 +101,48 @@ def distance_fields(graph: Graph, goals) -> np.ndarray:
 
 def hop_fields(graph: Graph, goals) -> np.ndarray:
     """i32[A, N]: the number of steps from every node to each agent's goal, ``UNREACHABLE``
-    where the goal cannot be reached (:func:`~jaxswarm.multiagent.agents.distance_fields` on
-    :func:`~jaxswarm.multiagent.agents.hop_graph`).
+    where the goal cannot be reached (a breadth-first search back from each goal along the
+    valid edges).
 
     Args:
       graph: the map.
       goals: i32[A] goal node indices.
     """
-    fields = distance_fields(hop_graph(graph), goals)
-    steps = np.full(fields.shape, UNREACHABLE, np.int32)
-    reachable = np.isfinite(fields)
-    steps[reachable] = fields[reachable]
-    return steps
+    arrays = edge_arrays(graph)
+    goals = np.ascontiguousarray(np.asarray(goals).reshape(-1), np.int32)
+    return _hop_fields(arrays.rev_indptr, arrays.rev_tails, goals,
+                       np.zeros(graph.num_nodes, np.bool_))
+
+
+@jit
+def breadth_first(rev_indptr, rev_tails, goal, blocked):
+    """i32[N] steps from every node to ``goal`` along the edges (CSR of their reverse:
+    ``rev_indptr`` i64[N + 1], ``rev_tails`` i32[E]) avoiding the ``blocked`` nodes (bool[N]),
+    ``UNREACHABLE`` where there is no way."""
+    n = rev_indptr.shape[0] - 1
+    dist = np.full(n, UNREACHABLE, np.int32)
+    queue = np.empty(n, np.int64)
+    dist[goal] = 0
+    queue[0] = goal
+    head, tail = 0, 1
+    while head < tail:
+        v = queue[head]
+        head += 1
+        for e in range(rev_indptr[v], rev_indptr[v + 1]):
+            u = rev_tails[e]
+            if not blocked[u] and dist[u] == UNREACHABLE:
+                dist[u] = dist[v] + 1
+                queue[tail] = u
+                tail += 1
+    return dist
+
+
+@jit
+def _hop_fields(rev_indptr, rev_tails, goals, blocked):
+    out = np.empty((goals.shape[0], rev_indptr.shape[0] - 1), np.int32)
+    for a in range(goals.shape[0]):
+        out[a] = breadth_first(rev_indptr, rev_tails, goals[a], blocked)
+    return out
 
 
 def lower_bound(graph: Graph, starts, goals) -> int:

@@ -46,7 +46,7 @@ def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_00
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="ecbs"``); not solved when an
       agent's goal cannot be reached (naming it) or at a limit. ``stats``: ``lower_bound`` (the
-      least LB open when it stopped: no solution costs less), ``nodes``, ``expanded``,
+      least LB open when it stopped: no solution costs less), ``w``, ``nodes``, ``expanded``,
       ``seconds``.
 
     Raises:
@@ -99,7 +99,7 @@ class _Search:
                       for u in range(graph.num_nodes)]
         self.graph, self.starts, self.goals = graph, start_nodes, goal_nodes
         self.fields, self.w, self.began = fields, w, began
-        self.counts = {"expanded": 0, "nodes": 0, "lower_bound": 0}
+        self.counts = {"expanded": 0, "nodes": 0, "lower_bound": 0, "w": w}
 
     def run(self, max_nodes: int, time_limit: float) -> Plan:
         agents = len(self.starts)

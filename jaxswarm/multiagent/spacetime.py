@@ -29,7 +29,7 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import inline, jit
-from jaxswarm.multiagent.agents import UNREACHABLE
+from jaxswarm.multiagent.agents import UNREACHABLE, breadth_first
 from jaxswarm.world.graph import Graph
 
 FREE, FORBIDDEN = -1, -2
@@ -80,7 +80,7 @@ def static_field(graph: Graph, goal: int, blocked: np.ndarray) -> np.ndarray:
     """i32[N]: steps from every node to ``goal`` avoiding the ``blocked`` nodes (bool[N]),
     UNREACHABLE where there is no way."""
     arrays = edge_arrays(graph)
-    return _breadth_first(arrays.rev_indptr, arrays.rev_tails, goal, blocked)
+    return breadth_first(arrays.rev_indptr, arrays.rev_tails, goal, blocked)
 
 
 def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservations: Reservations,
@@ -106,26 +106,6 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
         arrays.indptr, arrays.heads, np.ascontiguousarray(heuristic, np.int32), finish, start,
         goal, reservations.holder, parked, reservations.banned, keep_from, max_expansions)
     return (path if outcome == FOUND else None), int(expanded), int(outcome)
-
-
-@jit
-def _breadth_first(rev_indptr, rev_tails, goal, blocked):
-    n = rev_indptr.shape[0] - 1
-    dist = np.full(n, UNREACHABLE, np.int32)
-    queue = np.empty(n, np.int64)
-    dist[goal] = 0
-    queue[0] = goal
-    head, tail = 0, 1
-    while head < tail:
-        v = queue[head]
-        head += 1
-        for e in range(rev_indptr[v], rev_indptr[v + 1]):
-            u = rev_tails[e]
-            if not blocked[u] and dist[u] == UNREACHABLE:
-                dist[u] = dist[v] + 1
-                queue[tail] = u
-                tail += 1
-    return dist
 
 
 @inline
