@@ -386,7 +386,7 @@ def run_mapf(args: argparse.Namespace) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from jaxswarm.plot.agents import animate_plan
+    from jaxswarm.plot.agents import animate_plan, drawn_agents
 
     options = _planner_options(args)
     if args.agents < 1:
@@ -425,7 +425,9 @@ def run_mapf(args: argparse.Namespace) -> int:
         gif = args.gif or Path("out") / f"mapf_{args.map.stem}_{args.planner}.gif"
         frames = animate_plan(graph, plan.paths, gif, title=f"{instance.name}, {plan.planner}: "
                                                             "step {step} of {steps}")
-        print(f"GIF written to {gif} ({frames} frames)")
+        drawn = drawn_agents(args.agents)
+        sample = "" if drawn == args.agents else f"; {drawn} of {args.agents} agents drawn"
+        print(f"GIF written to {gif} ({frames} frames{sample})")
     return 0 if solved else 1
 
 

@@ -14,9 +14,10 @@ The notebooks also check their own results with ``assert``. After a run, the tes
 * tuning: the JSON line of its ``checks`` cell (a race and a random search within their budget,
   each rescored on the held-out map), the race's figure shown inline and its files under
   ``tmp_path``.
-* many_agents: the JSON line of its ``checks`` cell (the three multi-agent planners solve, their
-  solutions validate, none beats the lower bound or CBS), the GIF it wrote under ``tmp_path`` and
-  the logs of the A* report's two examples.
+* many_agents: the JSON line of its ``checks`` cell (the seven multi-agent planners solve, their
+  solutions validate, none beats the lower bound or CBS; LaCAM plans 200 agents), the GIFs it
+  wrote under ``tmp_path`` (the crowd's drawing a sample of 100 agents) and the logs of the A*
+  report's two examples.
 * sweep_analysis: the Parquet store under ``tmp_path``. Read back with pandas, it holds
   maps x combinations x seeds rows, one per run, taken from the spec in ``metadata.json``. No gap
   is below -1e-6. The PNGs of ``plot_sweep`` exist. The figures were shown inline, which
@@ -219,7 +220,7 @@ def test_many_agents(notebook_env):
     result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
     assert result["agents"] == 20, "JAXSWARM_NOTEBOOK_SMALL ignored"
     planners = result["planners"]
-    assert set(planners) == {"report", "prioritized", "cbs"}
+    assert set(planners) == {"report", "prioritized", "cbs", "icbs", "ecbs", "pibt", "lacam"}
     bound = result["lower_bound"]
     for name, plan in planners.items():
         assert plan["solved"], f"{name}: {plan['reason']}"
@@ -232,6 +233,11 @@ def test_many_agents(notebook_env):
     animated = planners[result["animated"]]  # the plan of least sum of costs, a frame a step
     assert animated["sum_of_costs"] == planners["cbs"]["sum_of_costs"]
     assert result["frames"] >= animated["makespan"] + 1
+    crowd = result["crowd"]
+    assert crowd["agents"] == 200 and crowd["solved"]
+    assert crowd["sum_of_costs"] >= crowd["lower_bound"]
+    with Image.open(crowd["gif"]) as image:
+        assert image.n_frames == crowd["frames"]
     examples = result["examples"]
     assert "no collision found" in examples["map1"]["log"]
     assert "can not synchronize, robot 2 move first" in examples["map2"]["log"]

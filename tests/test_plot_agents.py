@@ -11,6 +11,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from PIL import Image  # noqa: E402
 
+from jaxswarm.plot import agents as agents_module  # noqa: E402
 from jaxswarm.plot.agents import agent_colors, animate_plan, draw_plan  # noqa: E402
 from jaxswarm.runtime.atomic import TEMPORARY_GLOB  # noqa: E402
 from jaxswarm.world.graph import grid_graph  # noqa: E402
@@ -93,6 +94,24 @@ def test_animate_plan_substeps_and_frame_cap(graph, tmp_path):
     assert animate_plan(graph, PATHS, out, substeps=3, max_frames=4) == 4
     with Image.open(out) as gif:
         assert gif.n_frames == 4
+
+
+def test_animate_plan_draws_an_even_sample_of_many_agents(graph, tmp_path, monkeypatch):
+    drawn = []
+    real = agents_module._draw_goals
+
+    def spy(ax, points, colors, size):
+        drawn.append(len(points))
+        return real(ax, points, colors, size)
+
+    monkeypatch.setattr(agents_module, "_draw_goals", spy)
+    out = tmp_path / "sample.gif"
+    assert animate_plan(graph, PATHS, out, max_agents=1) == PATHS.shape[1]  # 1 of 2 drawn
+    assert drawn == [1] and agents_module.drawn_agents(PATHS.shape[0], 1) == 1
+    assert animate_plan(graph, PATHS, out) == PATHS.shape[1]
+    assert drawn == [1, 2] and agents_module.drawn_agents(PATHS.shape[0]) == 2
+    with pytest.raises(ValueError, match="max_agents must be at least 1"):
+        animate_plan(graph, PATHS, out, max_agents=0)
 
 
 def test_animate_plan_leaves_nothing_half_written_on_error(graph, tmp_path, monkeypatch):

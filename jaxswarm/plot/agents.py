@@ -20,6 +20,9 @@ from jaxswarm.runtime.atomic import atomic_path
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node
 
+GIF_AGENTS = 100
+"""The most agents :func:`animate_plan` draws by default (beyond, an even sample)."""
+
 MAX_LEGEND = 10
 """Agents are named in a legend up to this many."""
 
@@ -77,13 +80,15 @@ def draw_plan(graph: Graph, paths, ax: Axes | None = None, *, goals=None, colors
 
 def animate_plan(graph: Graph, paths, path, *, goals=None, colors=None, fps: float = 4,
                  trail: int = 3, substeps: int = 1, title: str = "step {step} of {steps}",
-                 max_frames: int = 300) -> int:
+                 max_frames: int = 300, max_agents: int = GIF_AGENTS) -> int:
     """Write a GIF of the agents moving step by step, atomically: each agent a coloured dot, its
     goal a hollow ring of the same colour, its last ``trail`` moves a faint line.
 
     Frame ``k`` shows step ``k`` (and, with ``substeps`` > 1, ``substeps - 1`` frames in
     between, where each agent is part of the way along its move). Beyond ``max_frames`` frames,
-    steps are skipped evenly (the first and the last step always show).
+    steps are skipped evenly (the first and the last step always show). Beyond ``max_agents``
+    agents, an even sample of them is drawn (agents 0, k, 2k, ..., the last), and the title
+    says how many of how many: hundreds of dots on a small map are not readable.
 
     Args:
       graph: the map (N nodes).
@@ -97,16 +102,24 @@ def animate_plan(graph: Graph, paths, path, *, goals=None, colors=None, fps: flo
       title: the axes title, formatted with ``step`` (0-based) and ``steps`` (T - 1). Keep
         ``{step}`` in it: the GIF writer merges identical consecutive frames.
       max_frames: at most this many frames.
+      max_agents: at most this many agents drawn.
 
     Returns:
       The number of frames written: ``(T - 1) * substeps + 1`` (or fewer, at ``max_frames``).
 
     Raises:
-      ValueError: as :func:`draw_plan`, or ``fps`` not positive, ``substeps`` below 1,
-        ``max_frames`` below 2 or ``trail`` negative.
+      ValueError: as :func:`draw_plan`, or ``fps`` not positive, ``substeps`` or
+        ``max_agents`` below 1, ``max_frames`` below 2 or ``trail`` negative.
     """
     paths, goals, colors = _checked(graph, paths, goals, colors)
     _check_animation(fps, substeps, max_frames, trail)
+    if max_agents < 1:
+        raise ValueError(f"max_agents must be at least 1, got {max_agents}")
+    agents = paths.shape[0]
+    if agents > max_agents:
+        drawn = np.unique(np.linspace(0, agents - 1, max_agents).round().astype(np.int64))
+        paths, goals, colors = paths[drawn], goals[drawn], [colors[i] for i in drawn]
+        title = f"{title} ({len(drawn)} of {agents} agents drawn)"
     times = _frame_times(paths.shape[1], substeps, max_frames)
     xy = np.asarray(graph.xy, np.float64)
     fig, ax = plt.subplots(figsize=(6, 6.3), layout="constrained")
@@ -121,6 +134,11 @@ def animate_plan(graph: Graph, paths, path, *, goals=None, colors=None, fps: flo
     finally:
         plt.close(fig)
     return len(times)
+
+
+def drawn_agents(agents: int, max_agents: int = GIF_AGENTS) -> int:
+    """How many of ``agents`` :func:`animate_plan` draws."""
+    return min(agents, max_agents)
 
 
 def _check_animation(fps: float, substeps: int, max_frames: int, trail: int) -> None:
