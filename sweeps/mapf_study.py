@@ -22,8 +22,9 @@ scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-rando
 * ``pymapf lacam``, ``pymapf cbs``: ``pymapf.solve`` with its ``lacam`` and ``cbs`` solvers (the
   peer a Python user would try first), their paths validated and costed as ours.
 
-Every planner has ``--time-limit`` seconds an instance (default 30): the search planners stop
-there; a run of the others that takes longer counts as not solved. A planner is run up to its
+Every planner has ``--time-limit`` seconds an instance (default 30): prioritised planning, the
+CBS family, LaCAM and pymapf's solvers stop there; a run of the report's scheme or PIBT that
+takes longer counts as not solved. A planner is run up to its
 ``MAX_AGENTS`` (the report's scheme, CBS and pymapf's solvers stop early: tens to hundreds of
 agents are their scale), and, on one map and scenario file, not again above a count it did not
 solve (recorded as not solved, "not run").
@@ -230,10 +231,11 @@ def pymapf_planner(solver: str, time_limit: float) -> Callable:
 def planner_calls(seeds: int, time_limit: float, w: float,
                   with_pymapf: bool) -> list[tuple[str, int | None, Callable]]:
     """``(planner, seed or None, call(graph, starts, goals) -> Plan)`` in the order they run."""
+    ranked = functools.partial(prioritized, time_limit=time_limit)
     calls = [("report", None, report_scheme),
-             ("prioritized (given)", None, functools.partial(prioritized, order="given")),
-             ("prioritized (distance)", None, functools.partial(prioritized, order="distance"))]
-    calls += [(RANDOM, seed, functools.partial(prioritized, order="random", seed=seed))
+             ("prioritized (given)", None, functools.partial(ranked, order="given")),
+             ("prioritized (distance)", None, functools.partial(ranked, order="distance"))]
+    calls += [(RANDOM, seed, functools.partial(ranked, order="random", seed=seed))
               for seed in range(seeds)]
     calls += [("cbs", None, functools.partial(cbs, time_limit=time_limit)),
               ("icbs", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,

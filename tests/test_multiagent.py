@@ -289,6 +289,13 @@ def test_prioritized_is_incomplete_where_cbs_is_not():
     assert validate(graph, optimal.paths, starts, goals, optimal.lengths) == []
 
 
+def test_prioritized_time_limit_ends_cleanly():
+    graph = grid_graph(np.zeros((4, 4), bool), connectivity=4)
+    plan = prioritized(graph, [(0, 0), (3, 3)], [(3, 3), (0, 0)], time_limit=0.0)
+    assert not plan.solved and plan.agent == 0
+    assert plan.reason == "agent 0 not planned (priority 0): reached the time limit (0 s)"
+
+
 def test_cbs_limit_ends_cleanly():
     corridor = grid_graph(np.zeros((1, 3), bool), connectivity=4)
     plan = cbs(corridor, [(0, 0), (2, 0)], [(2, 0), (0, 0)], max_nodes=50)

@@ -7,6 +7,7 @@ an agent can find its way walled in by those before it, and the result depends o
 """
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Sequence
 
@@ -46,7 +47,8 @@ def priority_order(order, distances: np.ndarray, seed: int = 0) -> np.ndarray:
 
 
 def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "given",
-                seed: int = 0, max_expansions: int = 10_000_000) -> Plan:
+                seed: int = 0, max_expansions: int = 10_000_000,
+                time_limit: float = math.inf) -> Plan:
     """Prioritised planning with space-time A* and a reservation table.
 
     Args:
@@ -55,11 +57,12 @@ def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "gi
       order: "given", "distance", "random" (see ``ORDERS``) or a permutation of the agents.
       seed: the seed of the random order.
       max_expansions: the per-agent limit on expanded space-time states.
+      time_limit: give up after this many seconds (checked between agents).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="prioritized"``); not solved, naming
       the agent, when an agent's goal cannot be reached at all, or cannot be reached around the
-      agents planned before it.
+      agents planned before it, or when the time limit is reached before its turn.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or order.
@@ -84,6 +87,9 @@ def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "gi
         return stop(a, f"cannot reach its goal {place(graph, goal_nodes[a])} from "
                        f"{place(graph, start_nodes[a])}")
     for rank, a in enumerate(ranking.tolist()):
+        if time.perf_counter() - began > time_limit:
+            return stop(a, f"not planned (priority {rank}): reached the time limit "
+                           f"({time_limit:g} s)")
         path, count, outcome = search(graph, int(start_nodes[a]), int(goal_nodes[a]), fields[a],
                                       table, max_expansions=max_expansions)
         expanded += count
