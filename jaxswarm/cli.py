@@ -159,7 +159,8 @@ def _add_mapf_parser(subparsers) -> None:
                            "Search (optimal, few agents); icbs: CBS with prioritised "
                            "collisions and bypassing (optimal); ecbs: Enhanced CBS (within "
                            "--w of the optimum); pibt: PIBT steps (fast, incomplete); lacam: "
-                           "LaCAM (complete, hundreds of agents; --refine for LaCAM*)")
+                           "LaCAM (complete, hundreds of agents); lacam_star: with LaCAM*'s "
+                           "swap generator (--refine: its anytime refinement)")
     mapf.add_argument("--order", choices=ORDERS,
                       help="prioritized only: the priority order (default given)")
     mapf.add_argument("--seed", type=int,
@@ -171,8 +172,8 @@ def _add_mapf_parser(subparsers) -> None:
     mapf.add_argument("--w", type=float,
                       help="ecbs only: the suboptimality bound (default 1.2)")
     mapf.add_argument("--refine", type=float,
-                      help="lacam only: LaCAM*, lower the sum of costs for this many more "
-                           "seconds after the first solution")
+                      help="lacam, lacam_star: lower the sum of costs for this many more "
+                           "seconds after the first solution (LaCAM*'s refinement)")
     gif = mapf.add_mutually_exclusive_group()
     gif.add_argument("--gif", type=Path,
                      help="GIF of the agents moving (default out/mapf_MAP_PLANNER.gif)")
@@ -435,9 +436,9 @@ def _planner_options(args: argparse.Namespace) -> dict:
     """The keyword arguments of the chosen planner; ValueError for an option of another."""
     given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
              "refine": args.refine, "w": args.w}
-    owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam"),
-              "time_limit": ("cbs", "icbs", "ecbs", "lacam"), "refine": ("lacam",),
-              "w": ("ecbs",)}
+    owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam", "lacam_star"),
+              "time_limit": ("cbs", "icbs", "ecbs", "lacam", "lacam_star"),
+              "refine": ("lacam", "lacam_star"), "w": ("ecbs",)}
     for option, value in given.items():
         if value is not None and args.planner not in owners[option]:
             raise ValueError(f"--{option.replace('_', '-')} applies to --planner "

@@ -18,7 +18,8 @@ scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-rando
   prioritised collisions and bypassing (optimal too); ``ecbs``: :func:`~jaxswarm.multiagent.ecbs`
   with w = ``--w`` (1.2);
 * ``pibt``: :func:`~jaxswarm.multiagent.pibt` (1,000 steps at most); ``lacam``:
-  :func:`~jaxswarm.multiagent.lacam` (its first solution);
+  :func:`~jaxswarm.multiagent.lacam` (its first solution); ``lacam_star``: the same with LaCAM*'s
+  successor generator (PIBT with the swap operation), its first solution;
 * ``pymapf lacam``, ``pymapf cbs``: ``pymapf.solve`` with its ``lacam`` and ``cbs`` solvers (the
   peer a Python user would try first), their paths validated and costed as ours.
 
@@ -98,7 +99,7 @@ SCENARIOS = ("random", "even")
 AGENTS = (10, 20, 50, 100, 200, 400, 700, 1000)
 """The default agent counts (each map runs those its scenario files have rows for)."""
 PLANNERS = ("report", "prioritized (given)", "prioritized (distance)", "prioritized (random)",
-            "cbs", "icbs", "ecbs", "pibt", "lacam", "pymapf lacam", "pymapf cbs")
+            "cbs", "icbs", "ecbs", "pibt", "lacam", "lacam_star", "pymapf lacam", "pymapf cbs")
 """The rows, in the order they run on every instance."""
 PYMAPF = ("pymapf lacam", "pymapf cbs")
 """The rows of pymapf's solvers (left out when pymapf is not installed)."""
@@ -124,8 +125,10 @@ ABOUT = (
     "`prioritized`) in the scenario's order, farthest-first and seeded random orders, "
     "Conflict-Based Search (Sharon et al. 2015; `cbs`, optimal), CBS with prioritised "
     "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), Enhanced CBS (Barer et "
-    "al. 2014; `ecbs`, within w of the optimum), PIBT (Okumura et al. 2022) and LaCAM (Okumura "
-    "2023; its first solution), and pymapf's LaCAM and CBS where pymapf is installed. "
+    "al. 2014; `ecbs`, within w of the optimum), PIBT (Okumura et al. 2022), LaCAM (Okumura, "
+    "AAAI 2023; its first solution) and with LaCAM*'s successor generator (Okumura, IJCAI "
+    "2023: PIBT with the swap operation; its first solution), and pymapf's LaCAM and CBS where "
+    "pymapf is installed. "
     "Instances: the first k rows of each map's `-random-1.scen` and `-even-1.scen`, "
     "4-connected, unit moves; an agent's cost is the step from which it stays at its goal. A run "
     "counts as solved only within the time limit; a planner is not run above its agent cap, nor "
@@ -137,7 +140,8 @@ ABOUT = (
 LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (given)",
           "prioritized (distance)": "prioritized (distance)",
           "prioritized (random)": "prioritized (random)", "cbs": "CBS", "icbs": "ICBS",
-          "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "pymapf lacam": "pymapf LaCAM",
+          "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "lacam_star": "LaCAM* (swap)",
+          "pymapf lacam": "pymapf LaCAM",
           "pymapf cbs": "pymapf CBS"}
 PUBLISHED = (
     ("LaCAM (Okumura, AAAI 2023; the lacam2 README)", "random-32-32-20", 400, "about 0.031 s"),
@@ -242,7 +246,8 @@ def planner_calls(seeds: int, time_limit: float, w: float,
                                                bypass=True)),
               ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
               ("pibt", None, pibt),
-              ("lacam", None, functools.partial(lacam, time_limit=time_limit))]
+              ("lacam", None, functools.partial(lacam, time_limit=time_limit)),
+              ("lacam_star", None, functools.partial(lacam, time_limit=time_limit, swap=True))]
     if with_pymapf:
         calls += [(f"pymapf {solver}", None, pymapf_planner(solver, time_limit))
                   for solver in ("lacam", "cbs")]

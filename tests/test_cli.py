@@ -154,7 +154,8 @@ def _mapf_row(text: str, planner: str) -> dict:
                                               ("icbs", ["--time-limit", "30"]),
                                               ("ecbs", ["--w", "1.1"]),
                                               ("pibt", ["--seed", "2"]),
-                                              ("lacam", ["--refine", "0.5"])])
+                                              ("lacam", ["--refine", "0.5"]),
+                                              ("lacam_star", ["--seed", "1"])])
 def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner, options):
     assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "5", "--planner", planner,
                  *options, "--no-gif"]) == 0
@@ -221,9 +222,9 @@ def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
     (["{map}", "{scen}", "--planner", "cbs", "--time-limit", "0"],
      "--time-limit must be positive, got 0.0"),
     (["{map}", "{scen}", "--planner", "cbs", "--refine", "1"],
-     "--refine applies to --planner lacam, not cbs"),
+     "--refine applies to --planner lacam or lacam_star, not cbs"),
     (["{map}", "{scen}", "--planner", "report", "--seed", "1"],
-     "--seed applies to --planner prioritized or pibt or lacam, not report"),
+     "--seed applies to --planner prioritized or pibt or lacam or lacam_star, not report"),
     (["{map}", "{scen}", "--planner", "lacam", "--refine", "-1"],
      "--refine must be at least 0, got -1.0"),
     (["{map}", "{scen}", "--planner", "ecbs", "--w", "0.5"], "--w must be at least 1, got 0.5"),

@@ -22,12 +22,13 @@ def grid(rows):
                                                                        connectivity=4)
 
 
-def step(graph, current, goals, order, fixed=NOTHING, fixed_to=NOTHING, seed=0):
+def step(graph, current, goals, order, fixed=NOTHING, fixed_to=NOTHING, seed=0, swap=False):
     current, goals = np.asarray(current, np.int32), np.asarray(goals, np.int32)
     moves = Moves.build(graph, goals, hop_fields(graph, goals))
     following = np.empty_like(current)
     ok = configuration(moves, Workspace(moves, seed), current, np.asarray(order, np.int32),
-                       np.asarray(fixed, np.int32), np.asarray(fixed_to, np.int32), following)
+                       np.asarray(fixed, np.int32), np.asarray(fixed_to, np.int32), following,
+                       swap=swap)
     return ok, following.tolist()
 
 
@@ -43,7 +44,8 @@ def test_a_pushed_agent_inherits_the_priority_and_steps_aside():
     assert ok and following == [0, 1]
 
 
-def test_a_step_is_a_configuration_on_random_instances():
+@pytest.mark.parametrize("swap", [False, True])
+def test_a_step_is_a_configuration_on_random_instances(swap):
     rng = np.random.default_rng(4)
     graph, _ = grid(["......", ".#..#.", "......", "..##..", "......"])
     free = np.nonzero(np.asarray(graph.free))[0]
@@ -52,7 +54,8 @@ def test_a_step_is_a_configuration_on_random_instances():
         picks = rng.permutation(free)
         agents = int(rng.integers(2, 12))
         current, goals = picks[:agents], rng.permutation(free)[:agents]
-        ok, following = step(graph, current, goals, rng.permutation(agents), seed=trial)
+        ok, following = step(graph, current, goals, rng.permutation(agents), seed=trial,
+                             swap=swap)
         following = np.array(following)
         assert ok
         assert len(set(following.tolist())) == agents  # no two on one node
@@ -117,7 +120,8 @@ def test_lacam_proves_there_is_no_solution():
     assert plan.stats["configurations"] == 6  # ({0..3} choose 2 with 0 left of 1)
 
 
-def test_lacam_finds_a_solution_exactly_when_the_joint_state_search_does():
+@pytest.mark.parametrize("swap", [False, True])
+def test_lacam_finds_a_solution_exactly_when_the_joint_state_search_does(swap):
     rng = np.random.default_rng(1)
     solved = unsolvable = 0
     for _ in range(40):
@@ -132,7 +136,7 @@ def test_lacam_finds_a_solution_exactly_when_the_joint_state_search_does():
         graph = grid_graph(blocked, connectivity=4)
         optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                       starts, goals)
-        plan = lacam(graph, starts, goals)
+        plan = lacam(graph, starts, goals, swap=swap)
         assert plan.solved == (optimum is not None), (blocked, starts, goals, plan.reason)
         if plan.solved:
             assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
@@ -179,3 +183,20 @@ def test_lacam_and_pibt_on_benchmark_instances_validate(movingai_dir, name, agen
     stepped = pibt(graph, starts, goals)
     if stepped.solved:
         assert validate(graph, stepped.paths, starts, goals, stepped.lengths) == []
+
+
+def test_two_agents_head_on_in_a_corridor_swap_where_it_widens():
+    # A corridor 0..4 that widens at node 3 (a side cell under it). Agent 0 at 2 is bound for the
+    # dead end 0, agent 1 at 1 for 4: head on, they can only pass at node 3. With the swap
+    # operation agent 0 (first) steps back to 3 and pulls agent 1 onto 2; plain PIBT pushes
+    # agent 1 into the dead end instead.
+    graph, _ = grid([".....", "###.#"])
+    ok, following = step(graph, [2, 1], [0, 4], order=[0, 1], swap=True)
+    assert ok and following == [3, 2]
+    ok, following = step(graph, [2, 1], [0, 4], order=[0, 1])
+    assert ok and following == [1, 0]
+    starts, goals = [(2, 0), (1, 0)], [(0, 0), (4, 0)]
+    plain, swapped = (lacam(graph, starts, goals, swap=s) for s in (False, True))
+    assert plain.solved and swapped.solved and swapped.planner == "lacam_star"
+    for plan in (plain, swapped):
+        assert validate(graph, plan.paths, starts, goals, plan.lengths) == []

@@ -13,7 +13,8 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
   step for all agents at a time; fast, incomplete.
 * :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
-  configurations with PIBT as its generator, and LaCAM*'s anytime refinement (``refine``).
+  configurations with PIBT as its generator, and LaCAM*'s generator (``swap``; ``"lacam_star"``
+  in ``PLANNERS``) and anytime refinement (``refine``).
 * :func:`validate` (:mod:`~jaxswarm.multiagent.validate`) checks any solution;
   :func:`find_conflicts` (:mod:`~jaxswarm.multiagent.conflicts`) is its batched JAX conflict
   check; :class:`Plan` (:mod:`~jaxswarm.multiagent.plan`) is the one result format.
@@ -38,7 +39,7 @@ from jaxswarm.multiagent.validate import Violation, validate
 
 PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
             "icbs": functools.partial(cbs, prioritize=True, bypass=True), "ecbs": ecbs,
-            "pibt": pibt, "lacam": lacam}
+            "pibt": pibt, "lacam": lacam, "lacam_star": functools.partial(lacam, swap=True)}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
 __all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",

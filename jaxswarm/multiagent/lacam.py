@@ -17,7 +17,9 @@ configuration keeps its neighbours and its cost from the starts, where one step 
 of agents not resting at their goals through it (the "sum of loss"); a configuration reached
 again by a cheaper way passes the saving on to everything found from it (a Dijkstra update), and
 configurations that cannot beat the best solution found are dropped. When the search runs out,
-the solution is optimal in that cost (``stats["optimal"]``).
+the solution is optimal in that cost (``stats["optimal"]``). LaCAM*'s other change, its
+successor generator (``swap``: PIBT with the swap operation, which lets two agents meeting head
+on in a corridor trade places where it widens), is a switch of its own.
 """
 from __future__ import annotations
 
@@ -63,8 +65,8 @@ class _Configuration:
 
 
 def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: float = 0.0,
-          max_configurations: int = 10_000_000, seed: int = 0) -> Plan:
-    """LaCAM, and with ``refine`` LaCAM*.
+          swap: bool = False, max_configurations: int = 10_000_000, seed: int = 0) -> Plan:
+    """LaCAM, and with ``refine`` and ``swap`` LaCAM*.
 
     Args:
       graph: the map; its valid edges are the moves, one step each.
@@ -73,11 +75,14 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
         included).
       refine: LaCAM*: after the first solution, keep lowering its sum of loss for this many
         more seconds (0: return the first solution).
+      swap: LaCAM*'s successor generator: PIBT with the swap operation
+        (:func:`~jaxswarm.multiagent.pibt.configuration`), for corridors.
       max_configurations: give up after this many configurations.
       seed: the key of PIBT's tie-breaks and of the constraint trees' order.
 
     Returns:
-      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="lacam"``). Not solved when an
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``lacam``, or ``lacam_star``
+      with ``swap``). Not solved when an
       agent's goal cannot be reached (naming it), when every configuration reachable from the
       starts was explored without reaching the goals (a proof that there is no solution), or at
       a limit. ``stats``: ``configurations`` (high-level nodes), ``field_seconds`` (the distance
@@ -89,6 +94,7 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
     if time_limit <= 0 or refine < 0 or max_configurations < 1:
         raise ValueError("time_limit must be positive, refine at least 0 and max_configurations "
                          f"at least 1; got {time_limit}, {refine}, {max_configurations}")
+    name = "lacam_star" if swap else "lacam"
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     fields = hop_fields(graph, goal_nodes)
@@ -98,26 +104,27 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
     if unreachable.size:
         a = int(unreachable[0])
         return Plan(start_nodes[:, None], np.zeros(len(agents), np.int32), solved=False,
-                    planner="lacam", reason=f"agent {a} cannot reach its goal "
+                    planner=name, reason=f"agent {a} cannot reach its goal "
                     f"{place(graph, goal_nodes[a])} from {place(graph, start_nodes[a])}",
                     agent=a, stats=dict(stats, configurations=0, seconds=0.0))
-    search = _Search(Moves.build(graph, goal_nodes, fields), seed)
+    search = _Search(Moves.build(graph, goal_nodes, fields), seed, swap)
     found, why = search.run(start_nodes, deadline=began + time_limit, refine=refine,
                             max_configurations=max_configurations)
     stats |= search.stats(refine > 0)
     if found is None:
         return Plan(start_nodes[:, None], np.zeros(len(agents), np.int32), solved=False,
-                    planner="lacam", reason=why, stats=stats)
+                    planner=name, reason=why, stats=stats)
     paths = np.stack(found, axis=1)
-    return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner="lacam",
+    return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner=name,
                 stats=stats)
 
 
 class _Search:
     """One LaCAM (or LaCAM*) search over an instance's configurations."""
 
-    def __init__(self, moves: Moves, seed: int):
+    def __init__(self, moves: Moves, seed: int, swap: bool):
         self.moves = moves
+        self.swap = swap
         self.work = Workspace(moves, seed)
         self.rng = np.random.default_rng(seed)
         self.explored: dict[bytes, _Configuration] = {}
@@ -209,7 +216,7 @@ class _Search:
         following = np.empty_like(node.nodes)
         ok = configuration(self.moves, self.work, node.nodes, node.order,
                            np.array(constraint.who, np.int32),
-                           np.array(constraint.where, np.int32), following)
+                           np.array(constraint.where, np.int32), following, swap=self.swap)
         return following if ok else None
 
     def _rewire(self, start: _Configuration) -> None:

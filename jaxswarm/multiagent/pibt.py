@@ -70,7 +70,8 @@ class Workspace:
     Attributes:
       occupied_now: i32[N] the agent on each node (NONE: none); all NONE between calls.
       occupied_next: i32[N] the agent taking each node next; all NONE between calls.
-      stack: i32[A, 2 + C] the explicit recursion: agent, next candidate, then its candidates.
+      stack: i32[A, 3 + C] the explicit recursion: agent, next candidate, swap partner (NONE:
+        none), then its candidates.
       counts: i32[A] how many candidates each stack frame holds.
       keys: u64[C] the sort keys of one frame's candidates.
       random: u64[1] the SplitMix64 counter of the tie-breaks.
@@ -80,15 +81,21 @@ class Workspace:
         agents, nodes = moves.fields.shape
         self.occupied_now = np.full(nodes, NONE, np.int32)
         self.occupied_next = np.full(nodes, NONE, np.int32)
-        self.stack = np.zeros((agents, 2 + moves.candidates), np.int32)
+        self.stack = np.zeros((agents, 3 + moves.candidates), np.int32)
         self.counts = np.zeros(agents, np.int32)
         self.keys = np.zeros(moves.candidates, np.uint64)
         self.random = np.array([(seed * 0x9E3779B97F4A7C15) % 2**64], np.uint64)
 
 
 def configuration(moves: Moves, work: Workspace, current: np.ndarray, order: np.ndarray,
-                  fixed: np.ndarray, fixed_to: np.ndarray, following: np.ndarray) -> bool:
+                  fixed: np.ndarray, fixed_to: np.ndarray, following: np.ndarray, *,
+                  swap: bool = False) -> bool:
     """One PIBT step from ``current``: every agent's next node, written to ``following``.
+
+    With ``swap`` (LaCAM*'s successor generator, Okumura, IJCAI 2023), an agent that meets
+    another it can only pass by swapping places (head on in a corridor, both needing the other's
+    side) tries its candidates in reverse, stepping back, and on its first one pulls the other
+    into the node it leaves; repeated over steps, the two swap where the corridor widens.
 
     Args:
       moves: the instance.
@@ -98,6 +105,7 @@ def configuration(moves: Moves, work: Workspace, current: np.ndarray, order: np.
       fixed: i32[F] agents whose next node is given (LaCAM's constraints; empty for PIBT).
       fixed_to: i32[F] their next nodes.
       following: i32[A] out: every agent's next node.
+      swap: the swap operation above.
 
     Returns:
       True when every agent got a next node with no two agents on one node and no two
@@ -105,9 +113,10 @@ def configuration(moves: Moves, work: Workspace, current: np.ndarray, order: np.
       would stay where a fixed agent moves in (``following`` is then not a configuration).
       Without fixed agents the step always succeeds: an agent with no free candidate stays.
     """
-    return bool(_configuration(moves.indptr, moves.heads, moves.fields, current, order, fixed,
-                               fixed_to, following, work.occupied_now, work.occupied_next,
-                               work.stack, work.counts, work.keys, work.random))
+    return bool(_configuration(moves.indptr, moves.heads, moves.fields, moves.goals, current,
+                               order, fixed, fixed_to, following, work.occupied_now,
+                               work.occupied_next, work.stack, work.counts, work.keys,
+                               work.random, swap))
 
 
 @inline
@@ -132,19 +141,20 @@ def _candidates(indptr, heads, fields, agent, node, stack, frame, counts, keys, 
         i = count
         while i > 0 and keys[i - 1] > key:  # insertion sort of at most degree + 1 entries
             keys[i] = keys[i - 1]
-            stack[frame, 2 + i] = stack[frame, 1 + i]
+            stack[frame, 3 + i] = stack[frame, 2 + i]
             i -= 1
         keys[i] = key
-        stack[frame, 2 + i] = v
+        stack[frame, 3 + i] = v
         count += 1
     stack[frame, 0] = agent
     stack[frame, 1] = 0
+    stack[frame, 2] = NONE
     counts[frame] = count
 
 
 @jit
-def _configuration(indptr, heads, fields, current, order, fixed, fixed_to, following,
-                   occupied_now, occupied_next, stack, counts, keys, random):
+def _configuration(indptr, heads, fields, goals, current, order, fixed, fixed_to, following,
+                   occupied_now, occupied_next, stack, counts, keys, random, swap):
     for a in range(current.shape[0]):
         following[a] = NONE
         occupied_now[current[a]] = a
@@ -153,8 +163,8 @@ def _configuration(indptr, heads, fields, current, order, fixed, fixed_to, follo
         if not ok:
             break
         if following[order[r]] == NONE:
-            ok = _inherit(indptr, heads, fields, current, order[r], following, occupied_now,
-                          occupied_next, stack, counts, keys, random)
+            ok = _inherit(indptr, heads, fields, goals, current, order[r], following,
+                          occupied_now, occupied_next, stack, counts, keys, random, swap)
     for a in range(current.shape[0]):
         occupied_now[current[a]] = NONE
         if following[a] != NONE:
@@ -183,23 +193,27 @@ def _fix(current, fixed, fixed_to, following, occupied_now, occupied_next):
 
 
 @inline
-def _inherit(indptr, heads, fields, current, root, following, occupied_now, occupied_next,
-             stack, counts, keys, random):
+def _inherit(indptr, heads, fields, goals, current, root, following, occupied_now,
+             occupied_next, stack, counts, keys, random, swap):
     """PIBT from ``root`` (not yet moved): the recursion on an explicit stack. False when an
     agent left to stay finds a fixed agent moving onto its node."""
     ok = True
     depth = 1
     _candidates(indptr, heads, fields, root, current[root], stack, 0, counts, keys, random)
+    if swap:
+        _plan_swap(indptr, heads, fields, goals, current, following, occupied_now, stack, 0,
+                   counts)
     child = -1  # -1: a fresh frame; 0: its child failed; 1: its child succeeded
     while depth > 0:
         frame = depth - 1
         a = stack[frame, 0]
         if child == 1:
+            _pull(current, following, occupied_next, stack, frame)
             depth -= 1
             continue
         child = 0
         while stack[frame, 1] < counts[frame]:
-            v = stack[frame, 2 + stack[frame, 1]]
+            v = stack[frame, 3 + stack[frame, 1]]
             stack[frame, 1] += 1
             other = occupied_now[v]
             if occupied_next[v] != NONE or (other != NONE and following[other] == current[a]):
@@ -209,9 +223,13 @@ def _inherit(indptr, heads, fields, current, root, following, occupied_now, occu
             if other != NONE and other != a and following[other] == NONE:
                 _candidates(indptr, heads, fields, other, current[other], stack, depth,
                             counts, keys, random)
+                if swap:
+                    _plan_swap(indptr, heads, fields, goals, current, following, occupied_now,
+                               stack, depth, counts)
                 depth += 1
                 child = -1
             else:
+                _pull(current, following, occupied_next, stack, frame)
                 child = 1
                 depth -= 1
             break
@@ -225,6 +243,100 @@ def _inherit(indptr, heads, fields, current, root, following, occupied_now, occu
             occupied_next[here] = a
             depth -= 1
     return ok
+
+
+@inline
+def _pull(current, following, occupied_next, stack, frame):
+    """After the agent of ``frame`` moved to its first candidate: its swap partner, if it has
+    one that has not moved yet, takes the node it leaves."""
+    a, partner = stack[frame, 0], stack[frame, 2]
+    here = current[a]
+    if (partner != NONE and stack[frame, 1] == 1 and following[partner] == NONE
+            and occupied_next[here] == NONE):
+        following[partner] = here
+        occupied_next[here] = partner
+
+
+@inline
+def _plan_swap(indptr, heads, fields, goals, current, following, occupied_now, stack, frame,
+               counts):
+    """Find the swap partner of the agent of ``frame`` (none when it wants to stay): the agent
+    on its first candidate, if the two must and can swap, else a neighbour that must swap with
+    it; with one, reverse the frame's candidates and record the partner."""
+    a = stack[frame, 0]
+    here, first = current[a], stack[frame, 3]
+    if first == here:
+        return
+    partner = NONE
+    other = occupied_now[first]
+    if (other != NONE and following[other] == NONE
+            and _swap_required(indptr, heads, fields, goals, occupied_now, a, other, here, first)
+            and _swap_possible(indptr, heads, goals, occupied_now, first, here)):
+        partner = other
+    else:
+        for e in range(indptr[here], indptr[here + 1]):
+            other = occupied_now[heads[e]]
+            if other == NONE or first == current[other]:
+                continue
+            if (_swap_required(indptr, heads, fields, goals, occupied_now, other, a, here, first)
+                    and _swap_possible(indptr, heads, goals, occupied_now, first, here)):
+                partner = other
+                break
+    if partner != NONE:
+        count = counts[frame]
+        for i in range(count // 2):
+            j = count - 1 - i
+            stack[frame, 3 + i], stack[frame, 3 + j] = stack[frame, 3 + j], stack[frame, 3 + i]
+        stack[frame, 2] = partner
+
+
+@inline
+def _corridor_step(indptr, heads, goals, occupied_now, behind, ahead):
+    """``(ways on, next node)`` from ``ahead`` leaving ``behind``: its neighbours but
+    ``behind`` and dead ends held by an agent at its goal, and the last of them."""
+    ways, onward = indptr[ahead + 1] - indptr[ahead], NONE
+    for e in range(indptr[ahead], indptr[ahead + 1]):
+        u = heads[e]
+        held = occupied_now[u]
+        if u == behind or (indptr[u + 1] - indptr[u] == 1 and held != NONE
+                           and goals[held] == u):
+            ways -= 1
+        else:
+            onward = u
+    return ways, onward
+
+
+@inline
+def _swap_required(indptr, heads, fields, goals, occupied_now, pusher, puller, pusher_at,
+                   puller_at):
+    """Whether ``pusher`` (on ``pusher_at``) and ``puller`` (on ``puller_at``) can only pass
+    each other by swapping: following the corridor ahead of the pusher while it leads the pusher
+    closer to its goal, no branch opens, and each is better off on the other's side."""
+    behind, ahead = pusher_at, puller_at
+    while fields[pusher, ahead] < fields[pusher, behind]:
+        ways, onward = _corridor_step(indptr, heads, goals, occupied_now, behind, ahead)
+        if ways >= 2:
+            return False  # a branch: they can pass without swapping
+        if ways <= 0:
+            break
+        behind, ahead = ahead, onward
+    return (fields[puller, behind] < fields[puller, ahead]
+            and (fields[pusher, behind] == 0 or fields[pusher, ahead] < fields[pusher, behind]))
+
+
+@inline
+def _swap_possible(indptr, heads, goals, occupied_now, pusher_at, puller_at):
+    """Whether pulling along the corridor from ``puller_at`` (away from ``pusher_at``) reaches a
+    branch where the two can swap before it loops back or ends."""
+    behind, ahead = pusher_at, puller_at
+    while ahead != pusher_at:
+        ways, onward = _corridor_step(indptr, heads, goals, occupied_now, behind, ahead)
+        if ways >= 2:
+            return True
+        if ways <= 0:
+            return False
+        behind, ahead = ahead, onward
+    return False
 
 
 def initial_priorities(moves: Moves, starts: np.ndarray) -> np.ndarray:
