@@ -14,7 +14,7 @@ The notebooks also check their own results with ``assert``. After a run, the tes
 * tuning: the JSON line of its ``checks`` cell (a race and a random search within their budget,
   each rescored on the held-out map), the race's figure shown inline and its files under
   ``tmp_path``.
-* many_agents: the JSON line of its ``checks`` cell (the seven multi-agent planners solve, their
+* many_agents: the JSON line of its ``checks`` cell (the eight multi-agent planners solve, their
   solutions validate, none beats the lower bound or CBS; LaCAM plans 200 agents), the GIFs it
   wrote under ``tmp_path`` (the crowd's drawing a sample of 100 agents) and the logs of the A*
   report's two examples.
@@ -220,7 +220,8 @@ def test_many_agents(notebook_env):
     result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
     assert result["agents"] == 20, "JAXSWARM_NOTEBOOK_SMALL ignored"
     planners = result["planners"]
-    assert set(planners) == {"report", "prioritized", "cbs", "icbs", "ecbs", "pibt", "lacam"}
+    assert set(planners) == {"report", "prioritized", "cbs", "icbs", "ecbs", "pibt", "lacam",
+                             "lacam_star"}
     bound = result["lower_bound"]
     for name, plan in planners.items():
         assert plan["solved"], f"{name}: {plan['reason']}"
