@@ -424,7 +424,8 @@ def main(argv: list[str] | None = None) -> int:
     name, step, arrived = bench_pibt(mapf, args.pibt_agents, args.pibt_steps)
     print(f"\nPIBT on {name}: median of {args.pibt_steps} steps after the first, distance fields "
           f"excluded\n")
-    print(markdown(("agents", "median us", "steps/s", "at goals after", f"{GOAL_STEP_MS:g} ms goal"),
+    print(markdown(("agents", "median us", "steps/s", "at goals after",
+                    f"{GOAL_STEP_MS:g} ms goal"),
                    [(args.pibt_agents, f"{1e6 * step:.0f}", f"{1 / step:,.0f}",
                      f"{arrived} of {args.pibt_agents}",
                      "met" if 1e3 * step < GOAL_STEP_MS else "NOT met")], "rrrrl"))

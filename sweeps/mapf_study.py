@@ -243,7 +243,7 @@ def planner_calls(seeds: int, time_limit: float, w: float,
               for seed in range(seeds)]
     calls += [("cbs", None, functools.partial(cbs, time_limit=time_limit)),
               ("icbs", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
-                                               bypass=True)),
+                                               bypass=True, avoid=True)),
               ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
               ("pibt", None, pibt),
               ("lacam", None, functools.partial(lacam, time_limit=time_limit)),

@@ -11,6 +11,7 @@ import oracle
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import cbs, ecbs, hop_fields, load_instance, lower_bound, validate
 from jaxswarm.multiagent import mdd
+from jaxswarm.multiagent.spacetime import Reservations, occupancy, search
 from jaxswarm.world.graph import grid_graph
 
 
@@ -89,9 +90,9 @@ def test_the_switches_keep_cbs_optimal_and_ecbs_within_its_bound(rows, starts, g
     graph = grid_graph(blocked, connectivity=4)
     optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                   starts, goals)
-    for prioritize, bypass in itertools.product((False, True), repeat=2):
-        plan = cbs(graph, starts, goals, prioritize=prioritize, bypass=bypass)
-        assert plan.solved and plan.sum_of_costs == optimum, (prioritize, bypass)
+    for prioritize, bypass, avoid in itertools.product((False, True), repeat=3):
+        plan = cbs(graph, starts, goals, prioritize=prioritize, bypass=bypass, avoid=avoid)
+        assert plan.solved and plan.sum_of_costs == optimum, (prioritize, bypass, avoid)
         assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
     for w in (1.0, 1.5, 3.0):
         plan = ecbs(graph, starts, goals, w=w)
@@ -104,8 +105,8 @@ def test_the_switches_keep_cbs_optimal_and_ecbs_within_its_bound(rows, starts, g
 def test_planner_names_and_bad_bounds():
     graph = grid_graph(np.zeros((2, 3), bool), connectivity=4)
     starts, goals = [(0, 0), (2, 0)], [(2, 0), (0, 0)]
-    assert cbs(graph, starts, goals, prioritize=True, bypass=True).planner == "icbs"
-    assert cbs(graph, starts, goals, bypass=True).planner == "cbs+bypass"
+    assert cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True).planner == "icbs"
+    assert cbs(graph, starts, goals, bypass=True, avoid=True).planner == "cbs+bypass+avoid"
     assert ecbs(graph, starts, goals).planner == "ecbs"
     with pytest.raises(ValueError, match="w must be at least 1, got 0.9"):
         ecbs(graph, starts, goals, w=0.9)
@@ -118,7 +119,8 @@ def test_prioritized_collisions_solve_what_plain_cbs_cannot_in_the_time(movingai
     mapf = movingai_dir / "mapf"
     instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-random-1.scen", 20)
     graph, starts, goals = instance.graph, instance.starts, instance.goals
-    improved = cbs(graph, starts, goals, prioritize=True, bypass=True, time_limit=20)
+    improved = cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True,
+                   time_limit=20)
     assert improved.solved and improved.stats["mdds"] > 0
     assert validate(graph, improved.paths, starts, goals, improved.lengths) == []
     plain = cbs(graph, starts, goals, max_nodes=improved.stats["nodes"])
@@ -137,3 +139,18 @@ def test_ecbs_plans_100_agents_within_its_bound(movingai_dir):
     assert plan.solved and validate(graph, plan.paths, starts, goals, plan.lengths) == []
     assert lower_bound(graph, starts, goals) <= plan.stats["lower_bound"]
     assert plan.sum_of_costs <= 1.2 * plan.stats["lower_bound"]
+
+
+def test_the_avoidance_table_picks_the_shortest_path_meeting_fewest_agents():
+    # Two shortest ways round an obstacle from (0, 1) to (2, 1); another agent rests on the
+    # upper one's middle cell (1, 0), so the lower one is taken with the table, and without it
+    # the search's own tie order, whichever it is, gives a path of the same length.
+    graph = grid_graph(np.array([[False] * 3, [False, True, False], [False] * 3]),
+                       connectivity=4)
+    field = hop_fields(graph, np.array([5]))[0]
+    table = Reservations.empty(graph.num_nodes)
+    resting = occupancy([np.array([1])], graph.num_nodes)
+    path, _, _ = search(graph, 3, 5, field, table, avoid=resting)
+    plain, _, _ = search(graph, 3, 5, field, table)
+    assert path.tolist() == [3, 6, 7, 8, 5] and len(plain) == len(path)
+    assert resting[0, 1] == 1 and resting.shape == (1, graph.num_nodes)

@@ -6,8 +6,9 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
 * :func:`prioritized` (:mod:`~jaxswarm.multiagent.prioritized`): space-time A* per agent around a
   reservation table, in a given, distance or seeded random order.
 * :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs;
-  ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements (``"icbs"`` in
-  ``PLANNERS``: both), with MDDs from :mod:`~jaxswarm.multiagent.mdd`.
+  ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements, ``avoid`` the
+  conflict avoidance table's tie-break (``"icbs"`` in ``PLANNERS``: all three), with MDDs from
+  :mod:`~jaxswarm.multiagent.mdd`.
 * :func:`ecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS, within a factor ``w`` of the
   optimum.
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
@@ -38,8 +39,9 @@ from jaxswarm.multiagent.report import report_scheme
 from jaxswarm.multiagent.validate import Violation, validate
 
 PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
-            "icbs": functools.partial(cbs, prioritize=True, bypass=True), "ecbs": ecbs,
-            "pibt": pibt, "lacam": lacam, "lacam_star": functools.partial(lacam, swap=True)}
+            "icbs": functools.partial(cbs, prioritize=True, bypass=True, avoid=True),
+            "ecbs": ecbs, "pibt": pibt, "lacam": lacam,
+            "lacam_star": functools.partial(lacam, swap=True)}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
 __all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",

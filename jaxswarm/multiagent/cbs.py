@@ -8,11 +8,13 @@ earliest collision (:func:`jaxswarm.multiagent.conflicts.pair_collisions`; the l
 equal steps) splits it into two children, each forbidding the collision to one of the two agents
 and re-planning only that agent. The first node without a collision is an optimal solution.
 
-Two improvements of Boyarski et al. (IJCAI 2015), each a switch: ``prioritize`` splits on a
-cardinal collision first, then a semi-cardinal one, then the earliest (from the agents' MDDs,
+Improvements, each a switch: ``prioritize`` splits on a cardinal collision first, then a
+semi-cardinal one, then the earliest (Boyarski et al., IJCAI 2015, from the agents' MDDs,
 :mod:`jaxswarm.multiagent.mdd`; a pair's first collision stands for the pair); ``bypass`` takes a
-child's path into its parent instead of splitting when the child costs no more and collides less.
-Both keep CBS optimal.
+child's path into its parent instead of splitting when the child costs no more and collides less
+(ibid.); ``avoid`` has the low level break ties between shortest paths toward the one meeting the
+fewest other agents (a conflict avoidance table, as CBS implementations do). All keep CBS
+optimal.
 
 CBS is for few agents: the number of nodes grows exponentially with the number of collisions
 that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
@@ -32,12 +34,13 @@ from jaxswarm.multiagent import mdd
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
-from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations, search
+from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations, occupancy, search
 from jaxswarm.world.graph import Graph
 
 
 def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,
-        max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False) -> Plan:
+        max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False,
+        avoid: bool = False) -> Plan:
     """Conflict-Based Search.
 
     Args:
@@ -48,6 +51,7 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       max_expansions: the limit on expanded space-time states per low-level search.
       prioritize: split on cardinal collisions first, then semi-cardinal (from MDDs).
       bypass: take a child's path instead of splitting where it costs no more, collides less.
+      avoid: of an agent's shortest paths, take the one meeting the fewest other agents.
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with both
@@ -65,16 +69,14 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     agents = len(start_nodes)
     instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
                          max_expansions=max_expansions, began=began,
-                         name=_name(prioritize, bypass))
+                         name=_name(prioritize, bypass, avoid), avoid=avoid)
     choose = instance.prioritized_collision if prioritize else _earliest_collision_of
     waiting = [np.array([s], np.int32) for s in start_nodes]
     unreachable = np.nonzero(instance.fields[np.arange(agents), start_nodes] == UNREACHABLE)[0]
     if unreachable.size:
         return instance.stop(waiting, False, *_cut_off(instance, int(unreachable[0])))
-    no_constraints = [(frozenset(), frozenset())] * agents
-    root = [instance.plan_agent(a, *no_constraints[a]) for a in range(agents)]
     tiebreak = itertools.count()
-    frontier = [_node(root, no_constraints, pair_collisions(pack(root)[0]), next(tiebreak))]
+    frontier = [_root(instance, agents, next(tiebreak))]
     last = None
     while frontier:
         node = heapq.heappop(frontier)
@@ -142,13 +144,18 @@ class _Instance:
         default_factory=lambda: {"expanded": 0, "nodes": 0, "bypasses": 0, "mdds": 0})
     mdds: dict = dataclasses.field(default_factory=dict)
     name: str = "cbs"
+    avoid: bool = False
 
-    def plan_agent(self, agent: int, vertex: frozenset, edge: frozenset):
-        """The agent's fewest-steps path (i32[T]) under its constraints, or None."""
+    def plan_agent(self, agent: int, vertex: frozenset, edge: frozenset, others: list = ()):
+        """The agent's fewest-steps path (i32[T]) under its constraints, or None; with
+        ``avoid``, the one meeting the fewest of ``others`` (the paths of the other agents,
+        or, at the root, of those planned so far; the agent's own entry is skipped)."""
+        table = (occupancy([path for a, path in enumerate(others) if a != agent],
+                           self.graph.num_nodes) if self.avoid else None)
         path, expanded, _ = search(self.graph, int(self.start_nodes[agent]),
                                    int(self.goal_nodes[agent]), self.fields[agent],
                                    _reservations(self.graph.num_nodes, vertex, edge),
-                                   max_expansions=self.max_expansions)
+                                   max_expansions=self.max_expansions, avoid=table)
         self.counts["expanded"] += expanded
         return path
 
@@ -198,11 +205,12 @@ def _cut_off(instance: _Instance, agent: int) -> tuple[str, int]:
             f"from {place(graph, instance.start_nodes[agent])}", agent)
 
 
-def _name(prioritize: bool, bypass: bool) -> str:
-    """The planner's name in a Plan: ``icbs`` with both improvements, ``cbs`` with none."""
-    if prioritize and bypass:
+def _name(prioritize: bool, bypass: bool, avoid: bool) -> str:
+    """The planner's name in a Plan: ``icbs`` with every improvement, ``cbs`` with none."""
+    if prioritize and bypass and avoid:
         return "icbs"
-    return "cbs" + ("+prioritize" if prioritize else "") + ("+bypass" if bypass else "")
+    return "cbs" + "".join(f"+{name}" for name, on in (
+        ("prioritize", prioritize), ("bypass", bypass), ("avoid", avoid)) if on)
 
 
 def _swap(padded: np.ndarray, a: int, b: int, step: int) -> bool:
@@ -245,10 +253,20 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
     children = []
     for agent, other in (pair, pair[::-1]):
         constraints = _forbid(node.constraints[agent], padded, agent, other, step)
-        path = instance.plan_agent(agent, *constraints)
+        path = instance.plan_agent(agent, *constraints, others=node.paths)
         if path is not None:
             children.append(_child(node, agent, path, constraints, next(tiebreak)))
     return children
+
+
+def _root(instance: _Instance, agents: int, order: int) -> _Node:
+    """The constraint tree's root: every agent's path without constraints (with ``avoid``,
+    meeting the fewest of those planned before it)."""
+    no_constraints = [(frozenset(), frozenset())] * agents
+    paths = []
+    for a in range(agents):
+        paths.append(instance.plan_agent(a, *no_constraints[a], others=paths))
+    return _node(paths, no_constraints, pair_collisions(pack(paths)[0]), order)
 
 
 def _bypassed(instance: _Instance, node: _Node, children: list[_Node], pair: tuple[int, int],

@@ -29,6 +29,7 @@ from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, pla
 from jaxswarm.multiagent.cbs import _earliest_collision, _forbid
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
+from jaxswarm.multiagent.spacetime import occupancy
 from jaxswarm.world.graph import Graph
 
 
@@ -156,7 +157,7 @@ class _Search:
         """``(path i32[T], lower bound on its cost)`` of the low-level focal search, or None."""
         vertex, edge = constraints
         others = [path for a, path in enumerate(paths) if a != agent]
-        occupied = _occupancy(others, self.graph.num_nodes)
+        occupied = occupancy(others, self.graph.num_nodes)
         horizon = max([t + 1 for t, _ in vertex] + [t + 1 for t, _, _ in edge]
                       + [len(occupied)])
         goal, field = int(self.goals[agent]), self.fields[agent]
@@ -169,17 +170,6 @@ class _Search:
         return Plan(*pack(paths, self.goals), solved=solved, planner="ecbs", reason=reason,
                     agent=agent,
                     stats={**self.counts, "seconds": time.perf_counter() - self.began})
-
-
-def _occupancy(paths: list, num_nodes: int) -> list[np.ndarray]:
-    """Per step, i32[N] how many of ``paths`` are on each node (each resting at its end after
-    it; the last entry stands for every later step)."""
-    steps = max((len(path) for path in paths), default=1)
-    counts = np.zeros((steps, num_nodes), np.int32)
-    for path in paths:
-        padded = np.concatenate([path, np.full(steps - len(path), path[-1])])
-        counts[np.arange(steps), padded] += 1
-    return list(counts)
 
 
 def _focal_search(moves, start, goal, field, vertex, edge, occupied, limit, keep_from, w,

@@ -18,7 +18,8 @@ on every instance, and finds the fewest steps to a goal that the agent can keep:
 accepted at step t only if no reservation touches it at t or later.
 
 The search is numba-compiled (as :mod:`jaxswarm.exact.kernels`): a heap of packed int64 keys
-``(f, -t, node)`` pops the lowest f, then the latest step, then the lowest node, so a solution is
+``(f, agents met, -t, node)`` pops the lowest f, then (with a conflict avoidance table) the
+path meeting the fewest other agents, then the latest step, then the lowest node, so a solution is
 a pure function of its input.
 """
 from __future__ import annotations
@@ -36,6 +37,8 @@ FREE, FORBIDDEN = -1, -2
 """``holder`` entries that are not agents."""
 FOUND, EXHAUSTED, LIMIT = 0, 1, 2
 """Search outcomes."""
+MET_CAP = 1023
+"""The most agents met a path's tie-break counts (more count as this many)."""
 
 
 @dataclasses.dataclass
@@ -84,7 +87,8 @@ def static_field(graph: Graph, goal: int, blocked: np.ndarray) -> np.ndarray:
 
 
 def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservations: Reservations,
-           *, max_expansions: int = 10_000_000) -> tuple[np.ndarray | None, int, int]:
+           *, max_expansions: int = 10_000_000,
+           avoid: np.ndarray | None = None) -> tuple[np.ndarray | None, int, int]:
     """Fewest-steps path of one agent from ``start`` to ``goal`` around the reservations.
 
     Args:
@@ -93,6 +97,9 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
       heuristic: i32[N] steps to ``goal`` ignoring the other agents (``hop_fields``).
       reservations: what the other agents hold.
       max_expansions: stop after expanding this many states.
+      avoid: optional i32[T, N] a conflict avoidance table (:func:`occupancy`): of the paths of
+        fewest steps, the one meeting the fewest agents on their nodes (step t >= T reads row
+        T - 1); None: ties as the module docstring orders them.
 
     Returns:
       ``(path i32[L] or None, expanded states, outcome)``, outcome FOUND, EXHAUSTED (no path
@@ -102,10 +109,23 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     parked = reservations.parked_from
     finish = static_field(graph, goal, (parked < UNREACHABLE) & (np.arange(len(parked)) != goal))
     keep_from = reservations.last_use(goal) + 1
+    avoid = np.zeros((0, graph.num_nodes), np.int32) if avoid is None else avoid
     path, expanded, outcome = _search(
         arrays.indptr, arrays.heads, np.ascontiguousarray(heuristic, np.int32), finish, start,
-        goal, reservations.holder, parked, reservations.banned, keep_from, max_expansions)
+        goal, reservations.holder, parked, reservations.banned, keep_from, max_expansions,
+        np.ascontiguousarray(avoid, np.int32))
     return (path if outcome == FOUND else None), int(expanded), int(outcome)
+
+
+def occupancy(paths: list, num_nodes: int) -> np.ndarray:
+    """i32[T, N]: per step, how many of ``paths`` (node lists) are on each node, each resting
+    at its end after it (the last row stands for every later step)."""
+    steps = max((len(path) for path in paths), default=1)
+    counts = np.zeros((steps, num_nodes), np.int32)
+    for path in paths:
+        padded = np.concatenate([path, np.full(steps - len(path), path[-1])])
+        counts[np.arange(steps), padded] += 1
+    return counts
 
 
 @inline
@@ -164,12 +184,24 @@ def _allowed(holder, banned, horizon, u, v, t):
     return True
 
 
+@inline
+def _met(avoid, v, t):
+    """Agents the avoidance table has on node v at step t (0 without a table)."""
+    if avoid.shape[0] == 0:
+        return 0
+    return avoid[min(t, avoid.shape[0] - 1), v]
+
+
 @jit
 def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banned, keep_from,
-            max_expansions):
+            max_expansions, avoid):
+    # A key packs (f, agents met, -t, node): the least f, then the fewest met, then the latest
+    # step. A state is closed when first popped; one reached again meeting fewer agents before
+    # that is pushed again (its older key is stale).
     horizon, n = holder.shape
     layers = horizon + 1
-    seen = np.zeros(layers * n, np.bool_)
+    met = np.full(layers * n, MET_CAP + 1, np.int32)
+    closed = np.zeros(layers * n, np.bool_)
     parent = np.empty(layers * n, np.int32)
     heap = np.empty(1024, np.int64)
     size = 0
@@ -179,13 +211,18 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
     f0 = heuristic[start] if horizon > 0 else finish[start]
     if f0 >= UNREACHABLE:
         return empty, 0, EXHAUSTED
-    seen[start] = True
-    heap, size = _push(heap, size, (np.int64(f0) * layers + horizon) * n + start)
+    met[start] = 0
+    heap, size = _push(heap, size, _key(f0, 0, layers, horizon, 0, n, start))
     expanded = 0
     while size > 0:
         key, size = _pop(heap, size)
         v = key % n
         t = horizon - (key // n) % layers
+        c = (key // (n * layers)) % (MET_CAP + 1)
+        state = t * n + v
+        if closed[state] or c != met[state]:
+            continue
+        closed[state] = True
         if t == horizon or (v == goal and t >= keep_from):
             return _unwind(indptr, heads, finish, parent, n, v, t, horizon), expanded, FOUND
         if expanded == max_expansions:
@@ -195,18 +232,25 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
         for e in range(indptr[v] - 1, indptr[v + 1]):
             w = v if e < indptr[v] else heads[e]  # a wait first, then the moves
             state = nt * n + w
-            if seen[state] or not _open(holder, parked, horizon, w, nt):
+            if closed[state] or not _open(holder, parked, horizon, w, nt):
                 continue
             if w != v and not _allowed(holder, banned, horizon, v, w, t):
                 continue
             remaining = finish[w] if nt == horizon else heuristic[w]
             if remaining >= UNREACHABLE:
                 continue
-            seen[state] = True
+            meets = min(c + _met(avoid, w, nt), MET_CAP)
+            if meets >= met[state]:
+                continue
+            met[state] = meets
             parent[state] = v
-            heap, size = _push(heap, size, (np.int64(nt + remaining) * layers + horizon - nt)
-                               * n + w)
+            heap, size = _push(heap, size, _key(nt + remaining, meets, layers, horizon, nt, n, w))
     return empty, expanded, EXHAUSTED
+
+
+@inline
+def _key(f, meets, layers, horizon, t, n, v):
+    return ((np.int64(f) * (MET_CAP + 1) + meets) * layers + horizon - t) * n + v
 
 
 @jit
