@@ -119,7 +119,7 @@ def animate_plan(graph: Graph, paths, path, *, goals=None, colors=None, fps: flo
     if agents > max_agents:
         drawn = np.unique(np.linspace(0, agents - 1, max_agents).round().astype(np.int64))
         paths, goals, colors = paths[drawn], goals[drawn], [colors[i] for i in drawn]
-        title = f"{title} ({len(drawn)} of {agents} agents drawn)"
+        title = f"{title}\n{len(drawn)} of {agents} agents drawn"
     times = _frame_times(paths.shape[1], substeps, max_frames)
     xy = np.asarray(graph.xy, np.float64)
     fig, ax = plt.subplots(figsize=(6, 6.3), layout="constrained")
@@ -204,7 +204,7 @@ def _moving_agents(ax: Axes, xy: np.ndarray, paths: np.ndarray, colors, size: fl
                 past = xy[paths[a, max(0, int(np.ceil(t)) - trail):int(t) + 1]]
                 line.set_data(*np.concatenate([past, now[a:a + 1]]).T)
         step = f"{t:.2f}" if substeps > 1 else str(int(t))
-        ax.set_title(title.format(step=step, steps=steps - 1))
+        ax.set_title(title.format(step=step, steps=steps - 1), fontsize="medium")
 
     return show, (dots, *trails)
 
