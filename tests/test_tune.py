@@ -187,6 +187,9 @@ def test_a_baseline_is_where_the_search_starts_and_what_the_best_is_judged_besid
     spec = tune_spec_from_dict(document(tune={"baseline": {"alpha": 2.0}, "budget": 30}))
     rho_n = float(make("iwd").default_params.rho_n)
     assert baseline_values(spec) == {"alpha": 2.0, "beta": 2.0, "rho_n": pytest.approx(rho_n)}
+    # A store records the baseline; a spec without one records itself as before the key.
+    assert spec.as_dict()["baseline"] == {"alpha": 2.0}
+    assert "baseline" not in tune_spec_from_dict(document()).as_dict()
     result = tune(spec, tmp_path / "tune", log=lambda _: None)
     first = result.held_out.iloc[0]
     assert first["label"] == "baseline" and first["alpha"] == first["beta"] == 2.0
