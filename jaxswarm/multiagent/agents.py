@@ -145,6 +145,24 @@ def _hop_fields(rev_indptr, rev_tails, goals, blocked):
     return out
 
 
+def cut_off(graph: Graph, fields: np.ndarray, start_nodes: np.ndarray,
+            goal_nodes: np.ndarray) -> tuple[int, str] | None:
+    """``(agent, reason)`` of the first agent whose goal cannot be reached from its start at
+    all, the reason naming it; None when every agent can reach its goal.
+
+    Args:
+      graph: the map.
+      fields: i32[A, N] the agents' hop fields (:func:`hop_fields`).
+      start_nodes, goal_nodes: i32[A] node indices.
+    """
+    unreachable = np.nonzero(fields[np.arange(len(start_nodes)), start_nodes] == UNREACHABLE)[0]
+    if not unreachable.size:
+        return None
+    a = int(unreachable[0])
+    return a, (f"agent {a} cannot reach its goal {place(graph, goal_nodes[a])} from "
+               f"{place(graph, start_nodes[a])}")
+
+
 def lower_bound(graph: Graph, starts, goals) -> int:
     """The sum of each agent's own shortest number of steps, a lower bound on the sum of costs
     (``UNREACHABLE`` if some agent cannot reach its goal).

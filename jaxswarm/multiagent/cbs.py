@@ -31,7 +31,7 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import mdd
-from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations, occupancy, search
@@ -72,9 +72,9 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
                          name=_name(prioritize, bypass, avoid), avoid=avoid)
     choose = instance.prioritized_collision if prioritize else _earliest_collision_of
     waiting = [np.array([s], np.int32) for s in start_nodes]
-    unreachable = np.nonzero(instance.fields[np.arange(agents), start_nodes] == UNREACHABLE)[0]
-    if unreachable.size:
-        return instance.stop(waiting, False, *_cut_off(instance, int(unreachable[0])))
+    blocked = cut_off(graph, instance.fields, start_nodes, goal_nodes)
+    if blocked is not None:
+        return instance.stop(waiting, False, blocked[1], blocked[0])
     tiebreak = itertools.count()
     frontier = [_root(instance, agents, next(tiebreak))]
     last = None
@@ -196,13 +196,6 @@ class _Instance:
         return Plan(*pack(paths, self.goal_nodes), solved=solved, planner=self.name, reason=reason,
                     agent=agent,
                     stats={**self.counts, "seconds": time.perf_counter() - self.began})
-
-
-def _cut_off(instance: _Instance, agent: int) -> tuple[str, int]:
-    """``(reason, agent)`` of an agent that cannot reach its goal at all."""
-    graph = instance.graph
-    return (f"agent {agent} cannot reach its goal {place(graph, instance.goal_nodes[agent])} "
-            f"from {place(graph, instance.start_nodes[agent])}", agent)
 
 
 def _name(prioritize: bool, bypass: bool, avoid: bool) -> str:

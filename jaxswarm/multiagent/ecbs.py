@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
-from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.cbs import _earliest_collision, _forbid
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
@@ -58,13 +58,9 @@ def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_00
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began)
-    unreachable = np.nonzero(search.fields[np.arange(len(start_nodes)), start_nodes]
-                             == UNREACHABLE)[0]
-    if unreachable.size:
-        a = int(unreachable[0])
-        return search.stop([np.array([s]) for s in start_nodes], False,
-                           f"agent {a} cannot reach its goal {place(graph, goal_nodes[a])} "
-                           f"from {place(graph, start_nodes[a])}", a)
+    blocked = cut_off(graph, search.fields, start_nodes, goal_nodes)
+    if blocked is not None:
+        return search.stop([np.array([s]) for s in start_nodes], False, blocked[1], blocked[0])
     return search.run(max_nodes, time_limit)
 
 

@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
@@ -99,21 +99,17 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     fields = hop_fields(graph, goal_nodes)
     stats = dict(field_seconds=time.perf_counter() - began)
-    agents = np.arange(len(start_nodes))
-    unreachable = np.nonzero(fields[agents, start_nodes] == UNREACHABLE)[0]
-    if unreachable.size:
-        a = int(unreachable[0])
-        return Plan(start_nodes[:, None], np.zeros(len(agents), np.int32), solved=False,
-                    planner=name, reason=f"agent {a} cannot reach its goal "
-                    f"{place(graph, goal_nodes[a])} from {place(graph, start_nodes[a])}",
-                    agent=a, stats=dict(stats, configurations=0, seconds=0.0))
+    waiting = (start_nodes[:, None], np.zeros(len(start_nodes), np.int32))
+    blocked = cut_off(graph, fields, start_nodes, goal_nodes)
+    if blocked is not None:
+        return Plan(*waiting, solved=False, planner=name, reason=blocked[1], agent=blocked[0],
+                    stats=dict(stats, configurations=0, seconds=0.0))
     search = _Search(Moves.build(graph, goal_nodes, fields), seed, swap)
     found, why = search.run(start_nodes, deadline=began + time_limit, refine=refine,
                             max_configurations=max_configurations)
     stats |= search.stats(refine > 0)
     if found is None:
-        return Plan(start_nodes[:, None], np.zeros(len(agents), np.int32), solved=False,
-                    planner=name, reason=why, stats=stats)
+        return Plan(*waiting, solved=False, planner=name, reason=why, stats=stats)
     paths = np.stack(found, axis=1)
     return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner=name,
                 stats=stats)

@@ -27,7 +27,7 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import inline, jit
-from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.plan import Plan, arrival_steps
 from jaxswarm.world.graph import Graph
 
@@ -382,13 +382,10 @@ def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -
     fields = hop_fields(graph, goal_nodes)
     field_seconds = time.perf_counter() - began
     stats = dict(field_seconds=field_seconds)
-    unreachable = np.nonzero(fields[np.arange(len(start_nodes)), start_nodes] == UNREACHABLE)[0]
-    if unreachable.size:
-        a = int(unreachable[0])
-        paths = start_nodes[:, None]
-        return Plan(paths, np.zeros(len(start_nodes), np.int32), solved=False, planner="pibt",
-                    reason=f"agent {a} cannot reach its goal {place(graph, goal_nodes[a])} "
-                           f"from {place(graph, start_nodes[a])}", agent=a,
+    blocked = cut_off(graph, fields, start_nodes, goal_nodes)
+    if blocked is not None:
+        return Plan(start_nodes[:, None], np.zeros(len(start_nodes), np.int32), solved=False,
+                    planner="pibt", reason=blocked[1], agent=blocked[0],
                     stats=dict(stats, steps=0, seconds=0.0))
     moves = Moves.build(graph, goal_nodes, fields)
     work = Workspace(moves, seed)
