@@ -42,14 +42,16 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # nine paper maps with 20 seeds (100 iterations, 256 drops or ants, 50 water drops); the path maps
 # 10x10, 20x20 and 40x25 with 10 runs of populations of 50 ants; the robot study on the three
 # path-map sizes and the nine paper maps with 20 seeds; the A* study on 1000 grids per size 10..100;
-# the MAPF study on five Moving AI maps with 5 to 100 agents, 5 random orders and CBS limited to 30
-# s an instance; every tune spec of tunes/ raced and judged on its held-out instances (the tunes'
-# run stores under out/calibration/stores, resumable), and racing against random search, the grid
-# and evolution strategies with 5 tuner seeds on the twins of tunes/compare/. Measured (jaxswarm
-# 0.4.0 and later, 2 cores AMD EPYC shared with other work, load 2-6): Table 1 9.4 min, RFD table
-# 5.2 min, path maps 0.7 min, dynamic tables 63 min, robot study 13-17 min, IWD 1 min, IWD_PG's
-# experiments about 25 min, the bees' tables 20 min (load 5-8) and inverse problem 10 min, A* study
-# about 5 min alone, MAPF study 9 min: about 155 minutes in all.
+# the MAPF study on every MAPF map and both scenario files with 10 to 1,000 agents, 3 random
+# orders and 30 s a planner and instance; every tune spec of tunes/ raced and judged on its
+# held-out instances (the tunes' run stores under out/calibration/stores, resumable), and racing
+# against random search, the grid and evolution strategies with 5 tuner seeds on the twins of
+# tunes/compare/. Measured (jaxswarm 0.4.0 and later, 2 cores AMD EPYC or Intel Xeon shared with
+# other work, load 2-6): Table 1 9.4-12 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
+# 63 min, robot study 13-17 min, IWD 1-5 min, IWD_PG's experiments 7-25 min, the bees' tables 20
+# min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, the calibrations from
+# their stores under a minute (from scratch: the four of 0.8.0 in 21 min); the MAPF study at this
+# size is not measured yet (estimated 1-2 hours: CBS, ECBS and pymapf at their time limits).
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256
@@ -83,7 +85,7 @@ CALIBRATION_QUICK := --specs tunes/quick/iwd.toml tunes/quick/aco_star.toml \
 	--stores $(QUICK_OUT)/calibration/stores --compare-specs tunes/quick/aco_star.toml \
 	--methods race,grid --tuner-seeds 1
 
-reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: about 155 min on 2 cores)
+reproduce: $(INSTALLED)  ## regenerate every file of results/ (full size: hours on 2 cores, see above)
 	$(BIN)/python sweeps/rfd_paper_static.py $(TABLE1_FULL) --out $(RESULTS)/rfd_paper_table1
 	$(BIN)/python sweeps/rfd_static.py $(RFD_FULL) --out $(RESULTS)/rfd_static
 	$(BIN)/python sweeps/aco_pathmaps.py $(PATHMAPS_FULL) --out $(RESULTS)/aco_pathmaps
