@@ -164,11 +164,11 @@ def _add_mapf_parser(subparsers) -> None:
     mapf.add_argument("--order", choices=ORDERS,
                       help="prioritized only: the priority order (default given)")
     mapf.add_argument("--seed", type=int,
-                      help="prioritized: seed of --order random; pibt, lacam: of the "
-                           "tie-breaks (default 0)")
+                      help="prioritized: seed of --order random; pibt, lacam, lacam_star: "
+                           "of the tie-breaks (default 0)")
     mapf.add_argument("--time-limit", type=float,
-                      help="cbs, icbs, ecbs, lacam: give up after this many seconds "
-                           "(default 60)")
+                      help="cbs, icbs, ecbs, lacam, lacam_star: give up after this many "
+                           "seconds (default 60)")
     mapf.add_argument("--w", type=float,
                       help="ecbs only: the suboptimality bound (default 1.2)")
     mapf.add_argument("--refine", type=float,

@@ -533,8 +533,8 @@ def plot_summary(summary: list[dict], path) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Command line entry point (see the module docstring); returns the exit status."""
-    args = _parser().parse_args(argv)
     parser = _parser()
+    args = parser.parse_args(argv)
     check_counts(parser, args, "seeds")
     if args.time_limit <= 0 or args.w < 1:
         parser.error("--time-limit must be positive and --w at least 1")
