@@ -45,8 +45,16 @@ its reason and ``error`` set; the study goes on, writes its files and exits with
 Per run (map, scenario, agents, planner, seed) ``runs.csv`` holds: solved, sum of costs, lower
 bound, their ratio, makespan (blank when not solved), time (s, wall time of the planner call,
 after a warm-up that leaves out numba's and JAX's one-off compilation), of which ``field_seconds``
-the agents' distance fields (PIBT and LaCAM report them apart), the reason when not solved, and
-the planner's counters (low-level expansions, CBS nodes, LaCAM configurations).
+the agents' distance fields (PIBT and LaCAM report them apart), the reason when not solved, the
+planner's counters (low-level expansions, CBS nodes, LaCAM configurations), and the commit the
+run came from.
+
+A study at the benchmark's scale takes hours, so it runs in parts: ``--planners`` picks the
+rows to run, ``runs.csv`` is rewritten after each map and scenario file, and ``--resume
+[FOLDER ...]`` keeps the runs of earlier parts (by default ``--out``'s own) and runs only the
+others, the files covering them all. Parts may run side by side into separate folders (say, half
+of the maps each) and be joined by a last one that resumes from both. ``table.md`` counts the
+runs of each commit.
 
 Outputs (in ``--out``, default ``out/mapf_study/``, each written atomically):
 
@@ -73,6 +81,7 @@ else ``../shared/benchdata/movingai/mapf`` beside the repository). Run from the 
 from __future__ import annotations
 
 import argparse
+import csv
 import functools
 import importlib.util
 import math
@@ -112,7 +121,12 @@ RANDOM = "prioritized (random)"
 """The row run once per seed."""
 RUN_COLUMNS = ("map", "scenario", "agents", "planner", "seed", "solved", "sum_of_costs",
                "lower_bound", "ratio", "makespan", "seconds", "field_seconds", "reason", "error",
-               "expanded", "nodes", "configurations", "repairs")
+               "expanded", "nodes", "configurations", "repairs", "commit")
+INTEGER_COLUMNS = ("agents", "sum_of_costs", "lower_bound", "makespan", "expanded", "nodes",
+                   "configurations", "repairs")
+FLOAT_COLUMNS = ("ratio", "seconds", "field_seconds")
+"""The typed columns of ``runs.csv`` (blank cells stay blank); ``solved`` and ``error`` are
+booleans, ``seed`` an integer or blank, the others text."""
 SUMMARY_COLUMNS = ("map", "agents", "planner", "runs", "solved", "success_rate", "mean_ratio",
                    "mean_makespan", "median_seconds", "errors")
 ALL_MAPS = "all"
@@ -185,6 +199,45 @@ def parse_scenarios(text: str) -> list[str]:
     return names
 
 
+def parse_planners(text: str) -> list[str]:
+    """A comma list of row names from :data:`PLANNERS` (``all``: every one)."""
+    if text.strip() == "all":
+        return list(PLANNERS)
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in PLANNERS]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"planners are {', '.join(PLANNERS)}; got {text!r}")
+    return names
+
+
+def read_runs(path: Path) -> list[dict]:
+    """The rows of a study's ``runs.csv``, typed as :func:`run_study` makes them.
+
+    Raises:
+      ValueError: the file's columns are not :data:`RUN_COLUMNS` (naming the file).
+    """
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.DictReader(f)
+        if tuple(reader.fieldnames or ()) != RUN_COLUMNS:
+            raise ValueError(f"{path}: columns {reader.fieldnames} are not this study's "
+                             f"{list(RUN_COLUMNS)}")
+        rows = list(reader)
+    for line, row in enumerate(rows, start=2):
+        try:
+            row.update({key: int(row[key]) for key in (*INTEGER_COLUMNS, "seed")
+                        if row[key] != ""})
+            row.update({key: float(row[key]) for key in FLOAT_COLUMNS if row[key] != ""})
+        except ValueError as exc:
+            raise ValueError(f"{path}, line {line}: {exc}") from None
+        row.update(solved=row["solved"] == "True", error=row["error"] == "True")
+    return rows
+
+
+def run_key(row: dict) -> tuple:
+    """What identifies a run: its map, scenario, agents, planner and seed."""
+    return row["map"], row["scenario"], row["agents"], row["planner"], row["seed"]
+
+
 def scenario_path(data: Path, map_name: str, scenario: str) -> Path:
     """The scenario file of ``map_name``."""
     return data / f"{map_name}-{scenario}-1.scen"
@@ -232,9 +285,10 @@ def pymapf_planner(solver: str, time_limit: float) -> Callable:
     return call
 
 
-def planner_calls(seeds: int, time_limit: float, w: float,
-                  with_pymapf: bool) -> list[tuple[str, int | None, Callable]]:
-    """``(planner, seed or None, call(graph, starts, goals) -> Plan)`` in the order they run."""
+def planner_calls(seeds: int, time_limit: float, w: float, with_pymapf: bool,
+                  planners=PLANNERS) -> list[tuple[str, int | None, Callable]]:
+    """``(planner, seed or None, call(graph, starts, goals) -> Plan)`` in the order they run,
+    for the rows of ``planners`` (pymapf's only ``with_pymapf``)."""
     ranked = functools.partial(prioritized, time_limit=time_limit)
     calls = [("report", None, report_scheme),
              ("prioritized (given)", None, functools.partial(ranked, order="given")),
@@ -251,7 +305,7 @@ def planner_calls(seeds: int, time_limit: float, w: float,
     if with_pymapf:
         calls += [(f"pymapf {solver}", None, pymapf_planner(solver, time_limit))
                   for solver in ("lacam", "cbs")]
-    return calls
+    return [call for call in calls if call[0] in planners]
 
 
 def warm_up(instance: Instance) -> None:
@@ -266,9 +320,12 @@ def warm_up(instance: Instance) -> None:
 
 
 def run_instance(instance: Instance, where: dict, calls: list, time_limit: float, *,
-                 skip: dict | None = None) -> list[dict]:
+                 skip: dict | None = None, earlier: list[dict] = (),
+                 commit: str = "") -> list[dict]:
     """Every planner of ``calls`` on one instance (``where``: its ``map``, ``scenario``,
-    ``agents``); one row per run. ``skip``: planner -> why it is not run here.
+    ``agents``); one row per run. ``skip``: planner -> why it is not run here; ``earlier``:
+    the instance's rows of an earlier run (an optimum there binds these runs too); ``commit``:
+    the source the rows come from.
 
     Raises:
       InvalidPlan: a solved plan fails ``validate``, is below the lower bound, beats an optimal
@@ -284,7 +341,7 @@ def run_instance(instance: Instance, where: dict, calls: list, time_limit: float
         row = dict(where, planner=planner, seed="" if seed is None else seed, solved=False,
                    sum_of_costs="", lower_bound=bound, ratio="", makespan="", seconds=0.0,
                    field_seconds="", reason="", error=False, expanded="", nodes="",
-                   configurations="", repairs="")
+                   configurations="", repairs="", commit=commit)
         if skip and planner in skip:
             rows.append(dict(row, reason=skip[planner], seconds=""))
             continue
@@ -305,7 +362,7 @@ def run_instance(instance: Instance, where: dict, calls: list, time_limit: float
         if row["solved"]:
             _check(instance, row, plan, bound, seed)
         rows.append(row)
-    check_optimal(rows, instance.name)
+    check_optimal([*earlier, *rows], instance.name)
     return rows
 
 
@@ -344,7 +401,9 @@ def check_optimal(rows: list[dict], name: str) -> None:
 
 
 def run_study(instances: list[tuple[str, str]], agent_counts, calls: list, time_limit: float,
-              data: Path, *, log: Callable[[str], None] | None = print) -> list[dict]:
+              data: Path, *, kept: list[dict] = (), commit: str = "",
+              save: Callable[[list[dict]], None] | None = None,
+              log: Callable[[str], None] | None = print) -> list[dict]:
     """Run every planner on every (map, scenario) at every count its file has rows for; the
     tidy rows. A planner not solving at a count is not run at larger ones on the same file.
 
@@ -354,32 +413,56 @@ def run_study(instances: list[tuple[str, str]], agent_counts, calls: list, time_
       calls: :func:`planner_calls`.
       time_limit: seconds an instance, per planner.
       data: the folder of the maps.
+      kept: rows of earlier runs (:func:`read_runs`): a run among them is not run again, and
+        its failures stop its planner at larger counts as new ones do. All of them are in the
+        result, those of this grid in its order (each instance's rows in planner order), the
+        others after.
+      commit: the source the new rows come from (their ``commit``).
+      save: called with the rows so far after each (map, scenario), so that an interrupted
+        study loses little (None: not called).
       log: called with one progress line per instance (None: silent).
     """
+    earlier: dict[tuple, list[dict]] = {}
+    for row in kept:
+        earlier.setdefault(run_key(row)[:3], []).append(row)
     rows = []
     began = time.perf_counter()
     for map_name, scenario in instances:
         scen = scenario_path(data, map_name, scenario)
         failed: dict[str, str] = {}
         for agents in [k for k in agent_counts if k <= scenario_rows(scen)]:
-            instance = load_instance(data / f"{map_name}.map", scen, agents)
             where = dict(map=map_name, scenario=scenario, agents=agents)
+            old = earlier.pop((map_name, scenario, agents), [])
+            done = {run_key(row) for row in old}
+            todo = [call for call in calls if (map_name, scenario, agents, call[0],
+                                               "" if call[1] is None else call[1]) not in done]
             instance_began = time.perf_counter()
-            new = run_instance(instance, where, calls, time_limit, skip=failed)
-            rows += new
-            for row in new:
+            new = [] if not todo else run_instance(
+                load_instance(data / f"{map_name}.map", scen, agents), where, todo, time_limit,
+                skip=failed, earlier=old, commit=commit)
+            ran = sorted(old + new, key=lambda row: (PLANNERS.index(row["planner"]),
+                                                     -1 if row["seed"] == "" else row["seed"]))
+            rows += ran
+            for row in ran:
                 if not row["solved"] and row["planner"] not in failed and row["planner"] != RANDOM:
                     failed[row["planner"]] = f"not run: not solved at {agents} agents"
-            if log is not None:
-                solved = {}
-                for row in new:
-                    done, runs = solved.get(row["planner"], (0, 0))
-                    solved[row["planner"]] = (done + row["solved"], runs + 1)
-                log(f"{map_name:>22} {scenario:>6} {agents:>4}: "
-                    f"{time.perf_counter() - instance_began:6.1f} s (elapsed "
-                    f"{time.perf_counter() - began:6.0f} s) | "
-                    + ", ".join(f"{LABELS[p]} {d}/{n}" for p, (d, n) in solved.items()))
-    return rows
+            if log is not None and new:
+                log(_progress(where, new, time.perf_counter() - instance_began,
+                              time.perf_counter() - began))
+        if save is not None:
+            save([*rows, *(row for group in earlier.values() for row in group)])
+    return [*rows, *(row for group in earlier.values() for row in group)]
+
+
+def _progress(where: dict, new: list[dict], seconds: float, elapsed: float) -> str:
+    """One log line: the instance, its time, and each planner's solved runs."""
+    solved = {}
+    for row in new:
+        done, runs = solved.get(row["planner"], (0, 0))
+        solved[row["planner"]] = (done + row["solved"], runs + 1)
+    return (f"{where['map']:>22} {where['scenario']:>6} {where['agents']:>4}: {seconds:6.1f} s "
+            f"(elapsed {elapsed:6.0f} s) | "
+            + ", ".join(f"{LABELS[p]} {d}/{n}" for p, (d, n) in solved.items()))
 
 
 def _group(rows: list[dict], key: tuple) -> dict:
@@ -457,8 +540,14 @@ def summary_markdown(summary: list[dict], rows: list[dict]) -> str:
         per_map.append(f"| {e['map']} | {e['agents']} | {LABELS[e['planner']]} | {cells(e)} | "
                        f"{reason} |")
     errors = sum(e["errors"] for e in summary if e["map"] == ALL_MAPS)
+    commits: dict[str, int] = {}
+    for row in rows:
+        commits[row["commit"]] = commits.get(row["commit"], 0) + 1
+    sources = ["| commit | runs |", "| --- | ---: |"] + [
+        f"| {commit or 'unknown'} | {runs} |" for commit, runs in commits.items()]
     sections = [("Published LaCAM figures beside ours", published_markdown(rows)),
-                ("Over all maps", overall), ("Per map", per_map)]
+                ("Over all maps", overall), ("Per map", per_map),
+                ("The source of the runs (a resumed study's parts)", sources)]
     if errors:
         sections.append(("Runs that raised", [
             f"{errors} runs raised an exception (recorded as not solved; the `error` column of "
@@ -546,14 +635,19 @@ def main(argv: list[str] | None = None) -> int:
         for path in (args.data / f"{name}.map", scenario_path(args.data, name, scenario)):
             if not path.is_file():
                 parser.error(f"no {path} (see --data)")
+    kept = resumed_rows(parser, [args.out] if args.resume == [] else args.resume or [])
     with_pymapf = pymapf_installed() and not args.no_pymapf
     record = provenance.begin(__file__, argv)
+    commit = (record.commit or "unknown")[:12] + ("+dirty" if record.dirty_files else "")
     print(f"MAPF study: {len(maps)} maps x {len(args.scenarios)} scenario files, agents "
           f"{args.agents}, {args.seeds} random orders, {args.time_limit:g} s a planner and "
-          f"instance, pymapf {'on' if with_pymapf else 'off'} -> {args.out}")
+          f"instance, pymapf {'on' if with_pymapf else 'off'}, {len(kept)} runs kept "
+          f"-> {args.out}")
     began = time.perf_counter()
-    calls = planner_calls(args.seeds, args.time_limit, args.w, with_pymapf)
-    rows = run_study(instances, args.agents, calls, args.time_limit, args.data)
+    calls = planner_calls(args.seeds, args.time_limit, args.w, with_pymapf, args.planners)
+    rows = run_study(instances, args.agents, calls, args.time_limit, args.data, kept=kept,
+                     commit=commit,
+                     save=lambda rows: write_csv(args.out / "runs.csv", rows, RUN_COLUMNS))
     summary = summarise(rows)
     record.finish(title=TITLE, about=ABOUT, arguments=vars(args), pymapf=with_pymapf)
     write_csv(args.out / "runs.csv", rows, RUN_COLUMNS)
@@ -561,8 +655,9 @@ def main(argv: list[str] | None = None) -> int:
     plot_summary(summary, args.out / "mapf_study.png")
     record.publish(args.out, summary_markdown(summary, rows))
     print("\n" + format_summary(summary))
-    print(f"\n{len(rows)} runs in {time.perf_counter() - began:.0f} s; every solved plan "
-          f"passed validate. Wrote {args.out / 'runs.csv'}, {args.out / 'summary.csv'}, "
+    print(f"\n{len(rows)} runs ({len(rows) - len(kept)} new) in "
+          f"{time.perf_counter() - began:.0f} s; every solved plan passed validate. Wrote "
+          f"{args.out / 'runs.csv'}, {args.out / 'summary.csv'}, "
           f"{args.out / 'mapf_study.png'}, {args.out / 'table.md'}")
     errors = sum(bool(row["error"]) for row in rows)
     if errors:  # a planner that raises is a bug: the files are written, the run fails
@@ -570,6 +665,27 @@ def main(argv: list[str] | None = None) -> int:
               "of runs.csv)", file=sys.stderr)
         return 1
     return 0
+
+
+def resumed_rows(parser: argparse.ArgumentParser, folders: list[Path]) -> list[dict]:
+    """The rows of every ``folder / runs.csv`` (:func:`read_runs`); the parser's error if one
+    is missing or unreadable, or if two hold the same run."""
+    rows, seen = [], {}
+    for folder in folders:
+        path = folder / "runs.csv"
+        if not path.is_file():
+            parser.error(f"--resume: no {path}")
+        try:
+            part = read_runs(path)
+        except (ValueError, KeyError) as exc:
+            parser.error(f"--resume: {exc}")
+        for row in part:
+            if run_key(row) in seen:
+                parser.error(f"--resume: run {run_key(row)} is in both {seen[run_key(row)]} "
+                             f"and {path}")
+            seen[run_key(row)] = path
+        rows += part
+    return rows
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -587,6 +703,11 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--time-limit", type=float, default=30.0,
                         help="seconds a planner has per instance (default 30)")
     parser.add_argument("--w", type=float, default=1.2, help="ECBS's bound (default 1.2)")
+    parser.add_argument("--planners", type=parse_planners, default=list(PLANNERS),
+                        help="comma list of the rows to run, or 'all' (default)")
+    parser.add_argument("--resume", type=Path, nargs="*", default=None, metavar="FOLDER",
+                        help="keep the runs of these folders' runs.csv (none named: --out's) "
+                             "and run only the others; the files cover them all")
     parser.add_argument("--no-pymapf", action="store_true",
                         help="leave out pymapf's solvers even where pymapf is installed")
     parser.add_argument("--data", type=Path, default=movingai_folder(),

@@ -161,6 +161,66 @@ def test_figure_is_a_readable_png_and_no_temporary_files_are_left(outputs):
         "mapf_study.png", "provenance.json", "runs.csv", "summary.csv", "table.md"]
 
 
+def test_a_study_in_parts_resumes_to_the_rows_of_one_run(outputs, tmp_path):
+    # Two parts side by side (a planner each on one map, then the rest on the other), joined
+    # by a third that resumes from both: every run once, the kept ones untouched.
+    one, two, joined = (tmp_path / name for name in ("one", "two", "joined"))
+    argv = ["--scenarios", "random", "--agents", str(AGENTS), "--seeds", "1", "--time-limit",
+            "5", "--no-pymapf"]
+    assert study.main([*argv, "--maps", MAPS[0], "--planners", "pibt", "--out", str(one)]) == 0
+    assert study.main([*argv, "--maps", MAPS[1], "--out", str(two)]) == 0
+    kept = study.read_runs(one / "runs.csv") + study.read_runs(two / "runs.csv")
+    assert study.main([*argv, "--maps", ",".join(MAPS), "--resume", str(one), str(two),
+                       "--out", str(joined)]) == 0
+    rows = study.read_runs(joined / "runs.csv")
+    keys = [study.run_key(row) for row in rows]
+    assert len(keys) == len(set(keys)) == 2 * (len(study.PLANNERS) - 2)
+    assert keys == [study.run_key(row) for row in study.read_runs(outputs["dir"] / "runs.csv")
+                    if not row["planner"].startswith("pymapf")]
+    by_key = {study.run_key(row): row for row in rows}
+    assert all(by_key[study.run_key(row)] == row for row in kept)  # kept, not run again
+    assert "runs (" in (joined / "table.md").read_text()
+    # Resuming a finished study runs nothing new and changes no row.
+    assert study.main([*argv, "--maps", ",".join(MAPS), "--resume", "--out", str(joined)]) == 0
+    assert study.read_runs(joined / "runs.csv") == rows
+
+
+def test_read_runs_types_the_rows_as_the_study_makes_them(outputs):
+    rows = study.read_runs(outputs["dir"] / "runs.csv")
+    assert [study.run_key(row) for row in rows] == [
+        (r["map"], r["scenario"], int(r["agents"]), r["planner"], int(r["seed"]) if r["seed"]
+         else "") for r in outputs["runs"]]
+    assert all(isinstance(row["solved"], bool) and isinstance(row["seconds"], float)
+               for row in rows)
+    # The summary of the rows read back is the one written from the rows made.
+    assert [{key: str(value) for key, value in entry.items()}
+            for entry in study.summarise(rows)] == outputs["summary"]
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda folder: None, "--resume: no "),
+    (lambda folder: (folder / "runs.csv").write_text("map,agents\nx,3\n"), "are not this "
+                                                                              "study's"),
+])
+def test_a_resume_from_a_missing_or_foreign_runs_csv_is_an_error(make, message, tmp_path,
+                                                                 capsys, movingai_dir):
+    folder = tmp_path / "earlier"
+    folder.mkdir()
+    make(folder)
+    with pytest.raises(SystemExit) as exit_info:
+        study.main(["--maps", "empty-32-32", "--resume", str(folder), "--out",
+                    str(tmp_path / "out")])
+    assert exit_info.value.code == 2 and message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_run_in_two_resumed_folders_is_an_error(outputs, tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        study.main(["--maps", MAPS[0], "--resume", str(outputs["dir"]), str(outputs["dir"]),
+                    "--out", str(tmp_path / "out")])
+    assert "is in both" in capsys.readouterr().err
+
+
 WHERE = dict(map="empty-32-32", scenario="random", agents=3)
 
 
@@ -244,6 +304,7 @@ def test_planners_are_capped_at_their_scale(instance, monkeypatch):
     (["--time-limit", "0"], "--time-limit must be positive"),
     (["--agents", "5,0"], "agent counts must be at least 1"),
     (["--maps", "no-such-map"], "no-such-map.map"),
+    (["--planners", "cbs,astar"], "planners are report,"),
 ])
 def test_bad_arguments_are_an_error(argv, message, tmp_path, capsys, movingai_dir):
     with pytest.raises(SystemExit) as exit_info:
