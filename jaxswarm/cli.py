@@ -157,8 +157,10 @@ def _add_mapf_parser(subparsers) -> None:
                       help="report: the A* report's two-robot scheme, pairwise; prioritized "
                            "(default): space-time A* in priority order; cbs: Conflict-Based "
                            "Search (optimal, few agents); icbs: CBS with prioritised "
-                           "collisions and bypassing (optimal); ecbs: Enhanced CBS (within "
-                           "--w of the optimum); pibt: PIBT steps (fast, incomplete); lacam: "
+                           "collisions and bypassing (optimal); cbsh: ICBS with the weighted "
+                           "dependency graph heuristic (optimal); cbsh_tc: CBSH with target "
+                           "and corridor reasoning (optimal); ecbs, eecbs: Enhanced and "
+                           "Explicit Estimation CBS (within --w of the optimum); pibt: PIBT steps (fast, incomplete); lacam: "
                            "LaCAM (complete, hundreds of agents); lacam_star: with LaCAM*'s "
                            "swap generator (--refine: its anytime refinement)")
     mapf.add_argument("--order", choices=ORDERS,
@@ -167,10 +169,10 @@ def _add_mapf_parser(subparsers) -> None:
                       help="prioritized: seed of --order random; pibt, lacam, lacam_star: "
                            "of the tie-breaks (default 0)")
     mapf.add_argument("--time-limit", type=float,
-                      help="cbs, icbs, ecbs, lacam, lacam_star: give up after this many "
+                      help="the CBS family, lacam, lacam_star: give up after this many "
                            "seconds (default 60)")
     mapf.add_argument("--w", type=float,
-                      help="ecbs only: the suboptimality bound (default 1.2)")
+                      help="ecbs, eecbs: the suboptimality bound (default 1.2)")
     mapf.add_argument("--refine", type=float,
                       help="lacam, lacam_star: lower the sum of costs for this many more "
                            "seconds after the first solution (LaCAM*'s refinement)")
@@ -437,8 +439,9 @@ def _planner_options(args: argparse.Namespace) -> dict:
     given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
              "refine": args.refine, "w": args.w}
     owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam", "lacam_star"),
-              "time_limit": ("cbs", "icbs", "ecbs", "lacam", "lacam_star"),
-              "refine": ("lacam", "lacam_star"), "w": ("ecbs",)}
+              "time_limit": ("cbs", "icbs", "cbsh", "cbsh_tc", "ecbs", "eecbs", "lacam",
+                             "lacam_star"),
+              "refine": ("lacam", "lacam_star"), "w": ("ecbs", "eecbs")}
     for option, value in given.items():
         if value is not None and args.planner not in owners[option]:
             raise ValueError(f"--{option.replace('_', '-')} applies to --planner "

@@ -15,8 +15,10 @@ scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-rando
   :func:`~jaxswarm.multiagent.prioritized` in the file's order, farthest first, and a random
   order once per seed 0 .. ``--seeds`` - 1;
 * ``cbs``: :func:`~jaxswarm.multiagent.cbs` (optimal sum of costs); ``icbs``: the same with
-  prioritised collisions and bypassing (optimal too); ``ecbs``: :func:`~jaxswarm.multiagent.ecbs`
-  with w = ``--w`` (1.2);
+  prioritised collisions and bypassing (optimal too); ``cbsh_tc``: ICBS with the weighted
+  dependency graph heuristic and target and corridor reasoning (optimal); ``ecbs`` and
+  ``eecbs``: :func:`~jaxswarm.multiagent.ecbs` and :func:`~jaxswarm.multiagent.eecbs` with w =
+  ``--w`` (1.2);
 * ``pibt``: :func:`~jaxswarm.multiagent.pibt` (1,000 steps at most); ``lacam``:
   :func:`~jaxswarm.multiagent.lacam` (its first solution); ``lacam_star``: the same with LaCAM*'s
   successor generator (PIBT with the swap operation), its first solution;
@@ -37,10 +39,11 @@ largest. The lower bound is the sum of each agent's own shortest 4-connected dis
 goal (:func:`~jaxswarm.multiagent.lower_bound`), ignoring the others; the ``.scen`` files' last
 column is an 8-connected optimum and is **not** used. Every solved plan is checked by
 :func:`~jaxswarm.multiagent.validate` (an invalid one raises :class:`InvalidPlan`: a planner bug),
-its sum of costs must be at least the lower bound, no planner may beat a solved optimal one (CBS
-or ICBS) on the same instance, and ECBS must stay within w of its proven bound (else
-:class:`InvalidPlan` too). A planner that raises is recorded as not solved, with the exception as
-its reason and ``error`` set; the study goes on, writes its files and exits with status 1.
+its sum of costs must be at least the lower bound, no planner may beat a solved optimal one (CBS,
+ICBS, CBSH-TC) on the same instance, and ECBS and EECBS must stay within w of their proven bound
+(else :class:`InvalidPlan` too). A planner that raises is recorded as not solved, with the
+exception as its reason and ``error`` set; the study goes on, writes its files and exits with
+status 1.
 
 Per run (map, scenario, agents, planner, seed) ``runs.csv`` holds: solved, sum of costs, lower
 bound, their ratio, makespan (blank when not solved), time (s, wall time of the planner call,
@@ -94,8 +97,8 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.multiagent import (Instance, Plan, cbs, ecbs, lacam, load_instance, lower_bound,
-                                 pack, pibt, prioritized, report_scheme, validate)
+from jaxswarm.multiagent import (Instance, Plan, cbs, ecbs, eecbs, lacam, load_instance,
+                                 lower_bound, pack, pibt, prioritized, report_scheme, validate)
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
@@ -108,15 +111,20 @@ SCENARIOS = ("random", "even")
 AGENTS = (10, 20, 50, 100, 200, 400, 700, 1000)
 """The default agent counts (each map runs those its scenario files have rows for)."""
 PLANNERS = ("report", "prioritized (given)", "prioritized (distance)", "prioritized (random)",
-            "cbs", "icbs", "ecbs", "pibt", "lacam", "lacam_star", "pymapf lacam", "pymapf cbs")
+            "cbs", "icbs", "cbsh_tc", "ecbs", "eecbs", "pibt", "lacam", "lacam_star",
+            "pymapf lacam", "pymapf cbs")
 """The rows, in the order they run on every instance."""
 PYMAPF = ("pymapf lacam", "pymapf cbs")
 """The rows of pymapf's solvers (left out when pymapf is not installed)."""
-MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "ecbs": 400, "pymapf lacam": 200,
-              "pymapf cbs": 50}
+MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "cbsh_tc": 100, "ecbs": 400, "eecbs": 400,
+              "pymapf lacam": 200, "pymapf cbs": 50}
 """The most agents a planner is run with (the others: every count)."""
-OPTIMAL = ("cbs", "icbs")
+OPTIMAL = ("cbs", "icbs", "cbsh_tc")
 """The rows whose solved plans have the least sum of costs."""
+BOUNDED = ("ecbs", "eecbs")
+"""The rows whose solved plans are within w of the bound they prove."""
+MARKERS, STYLES = "osD^vP*Xhd<>pH8", ("-", "-", "--", ":") * 4
+"""The figure's marker and line style of each row of :data:`PLANNERS`, in order."""
 RANDOM = "prioritized (random)"
 """The row run once per seed."""
 RUN_COLUMNS = ("map", "scenario", "agents", "planner", "seed", "solved", "sum_of_costs",
@@ -138,8 +146,11 @@ ABOUT = (
     "robots is jaxswarm's choice), prioritised planning with space-time A* (Silver 2005; "
     "`prioritized`) in the scenario's order, farthest-first and seeded random orders, "
     "Conflict-Based Search (Sharon et al. 2015; `cbs`, optimal), CBS with prioritised "
-    "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), Enhanced CBS (Barer et "
-    "al. 2014; `ecbs`, within w of the optimum), PIBT (Okumura et al. 2022), LaCAM (Okumura, "
+    "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), ICBS with the weighted "
+    "dependency graph heuristic (Li et al. 2019) and target and corridor reasoning (Li et al. "
+    "2020; `cbsh_tc`, optimal), Enhanced CBS (Barer et al. 2014; `ecbs`) and Explicit "
+    "Estimation CBS (Li et al. 2021, without the CBS improvements of its paper; `eecbs`), both "
+    "within w of the optimum, PIBT (Okumura et al. 2022), LaCAM (Okumura, "
     "AAAI 2023; its first solution) and with LaCAM*'s successor generator (Okumura, IJCAI "
     "2023: PIBT with the swap operation; its first solution), and pymapf's LaCAM and CBS where "
     "pymapf is installed. "
@@ -154,6 +165,7 @@ ABOUT = (
 LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (given)",
           "prioritized (distance)": "prioritized (distance)",
           "prioritized (random)": "prioritized (random)", "cbs": "CBS", "icbs": "ICBS",
+          "cbsh_tc": "CBSH-TC", "eecbs": "EECBS",
           "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "lacam_star": "LaCAM* (swap)",
           "pymapf lacam": "pymapf LaCAM",
           "pymapf cbs": "pymapf CBS"}
@@ -298,7 +310,11 @@ def planner_calls(seeds: int, time_limit: float, w: float, with_pymapf: bool,
     calls += [("cbs", None, functools.partial(cbs, time_limit=time_limit)),
               ("icbs", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
                                                bypass=True, avoid=True)),
+              ("cbsh_tc", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
+                                                  bypass=True, avoid=True, wdg=True,
+                                                  target=True, corridor=True)),
               ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
+              ("eecbs", None, functools.partial(eecbs, w=w, time_limit=time_limit)),
               ("pibt", None, pibt),
               ("lacam", None, functools.partial(lacam, time_limit=time_limit)),
               ("lacam_star", None, functools.partial(lacam, time_limit=time_limit, swap=True))]
@@ -378,7 +394,7 @@ def _check(instance: Instance, row: dict, plan: Plan, bound: int, seed) -> None:
         raise InvalidPlan(f"{where}: sum of costs {plan.sum_of_costs} below the lower bound "
                           f"{bound}")
     proven = plan.stats.get("lower_bound")
-    if row["planner"] == "ecbs" and plan.sum_of_costs > plan.stats["w"] * proven:
+    if row["planner"] in BOUNDED and plan.sum_of_costs > plan.stats["w"] * proven:
         raise InvalidPlan(f"{where}: sum of costs {plan.sum_of_costs} above w times its "
                           f"bound {proven}")
     row.update(sum_of_costs=plan.sum_of_costs, makespan=plan.makespan,
@@ -387,10 +403,11 @@ def _check(instance: Instance, row: dict, plan: Plan, bound: int, seed) -> None:
 
 def check_optimal(rows: list[dict], name: str) -> None:
     """Raise :class:`InvalidPlan` if a solved run of one instance has a smaller sum of costs
-    than a solved optimal one (CBS's and ICBS's are the least), or if those two differ."""
+    than a solved optimal one (those of :data:`OPTIMAL` are the least), or if two of those
+    differ."""
     optima = {row["sum_of_costs"] for row in rows if row["planner"] in OPTIMAL and row["solved"]}
     if len(optima) > 1:
-        raise InvalidPlan(f"CBS and ICBS on {name}: different optima {sorted(optima)}")
+        raise InvalidPlan(f"the optimal planners on {name}: different optima {sorted(optima)}")
     if not optima:
         return
     optimum = optima.pop()
@@ -596,7 +613,7 @@ def plot_summary(summary: list[dict], path) -> None:
     fig = Figure(figsize=(15, 4.5), layout="constrained")
     axes = fig.subplots(1, len(panels))
     for ax, (metric, title) in zip(axes, panels):
-        for planner, marker, style in zip(PLANNERS, "osD^vP*Xhd<", ("-", "-", "--", ":") * 3):
+        for planner, marker, style in zip(PLANNERS, MARKERS, STYLES):
             entries = sorted((e for e in overall if e["planner"] == planner),
                              key=lambda e: e["agents"])
             if entries:  # markers and dashes tell apart the lines that coincide

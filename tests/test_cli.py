@@ -152,7 +152,9 @@ def _mapf_row(text: str, planner: str) -> dict:
                                               ("prioritized", ["--order", "distance"]),
                                               ("cbs", ["--time-limit", "30"]),
                                               ("icbs", ["--time-limit", "30"]),
+                                              ("cbsh", []), ("cbsh_tc", []),
                                               ("ecbs", ["--w", "1.1"]),
+                                              ("eecbs", ["--w", "1.1"]),
                                               ("pibt", ["--seed", "2"]),
                                               ("lacam", ["--refine", "0.5"]),
                                               ("lacam_star", ["--seed", "1"])])
@@ -167,7 +169,7 @@ def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner,
     cost, bound = int(row["sum of costs"]), int(row["lower bound"])
     assert bound == 114 and cost >= bound  # the sum of the scenario's optimal lengths
     assert float(row["ratio"]) == pytest.approx(cost / bound, abs=1e-3)
-    if planner in ("cbs", "icbs", "ecbs"):
+    if planner in ("cbs", "icbs", "cbsh", "cbsh_tc", "ecbs", "eecbs"):
         assert cost == bound  # optimal (ECBS: within 1.1), and here no agent has to give way
     # The longest path is the makespan: at least the mean, at most the sum of the paths.
     assert cost / 5 <= int(row["makespan"]) <= cost
@@ -229,7 +231,7 @@ def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
      "--refine must be at least 0, got -1.0"),
     (["{map}", "{scen}", "--planner", "ecbs", "--w", "0.5"], "--w must be at least 1, got 0.5"),
     (["{map}", "{scen}", "--planner", "cbs", "--w", "1.5"],
-     "--w applies to --planner ecbs, not cbs"),
+     "--w applies to --planner ecbs or eecbs, not cbs"),
     (["{map}", "{scen}", "--gif", "a.gif", "--no-gif"], "--no-gif: not allowed with argument"),
 ])
 def test_mapf_rejects_bad_input_in_a_line_with_exit_status_2(movingai_dir, capsys, arguments,

@@ -9,7 +9,8 @@ import pytest
 
 import oracle
 from jaxswarm.exact._host import edge_arrays
-from jaxswarm.multiagent import cbs, ecbs, hop_fields, load_instance, lower_bound, validate
+from jaxswarm.multiagent import (PLANNERS, cbs, ecbs, eecbs, hop_fields, load_instance,
+                                 lower_bound, validate)
 from jaxswarm.multiagent import mdd
 from jaxswarm.multiagent.spacetime import Reservations, occupancy, search
 from jaxswarm.world.graph import grid_graph
@@ -85,21 +86,24 @@ TINY = [  # (obstacle rows, starts, goals), as test_multiagent's joint-state che
 
 
 @pytest.mark.parametrize("rows, starts, goals", TINY)
-def test_the_switches_keep_cbs_optimal_and_ecbs_within_its_bound(rows, starts, goals):
+def test_the_switches_keep_cbs_optimal_and_ecbs_and_eecbs_within_their_bound(rows, starts, goals):
     blocked = np.array([[c == "#" for c in row] for row in rows])
     graph = grid_graph(blocked, connectivity=4)
     optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                   starts, goals)
-    for prioritize, bypass, avoid in itertools.product((False, True), repeat=3):
-        plan = cbs(graph, starts, goals, prioritize=prioritize, bypass=bypass, avoid=avoid)
-        assert plan.solved and plan.sum_of_costs == optimum, (prioritize, bypass, avoid)
+    names = ("prioritize", "bypass", "avoid", "wdg", "target", "corridor")
+    for switches in itertools.product((False, True), repeat=len(names)):
+        plan = cbs(graph, starts, goals, **dict(zip(names, switches)))
+        assert plan.solved and plan.sum_of_costs == optimum == plan.stats["lower_bound"], \
+            plan.planner
         assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
-    for w in (1.0, 1.5, 3.0):
-        plan = ecbs(graph, starts, goals, w=w)
+    for bounded, w in itertools.product((ecbs, eecbs), (1.0, 1.5, 3.0)):
+        plan = bounded(graph, starts, goals, w=w)
         assert plan.solved and validate(graph, plan.paths, starts, goals, plan.lengths) == []
         assert plan.stats["lower_bound"] <= optimum <= plan.sum_of_costs <= w * optimum
         assert plan.sum_of_costs <= w * plan.stats["lower_bound"]
-    assert ecbs(graph, starts, goals, w=1.0).sum_of_costs == optimum
+        if w == 1.0:
+            assert plan.sum_of_costs == optimum
 
 
 def test_planner_names_and_bad_bounds():
@@ -107,9 +111,14 @@ def test_planner_names_and_bad_bounds():
     starts, goals = [(0, 0), (2, 0)], [(2, 0), (0, 0)]
     assert cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True).planner == "icbs"
     assert cbs(graph, starts, goals, bypass=True, avoid=True).planner == "cbs+bypass+avoid"
+    assert PLANNERS["cbsh"](graph, starts, goals).planner == "cbsh"
+    assert PLANNERS["cbsh_tc"](graph, starts, goals).planner == "cbsh_tc"
+    assert cbs(graph, starts, goals, wdg=True, corridor=True).planner == "cbs+wdg+corridor"
     assert ecbs(graph, starts, goals).planner == "ecbs"
-    with pytest.raises(ValueError, match="w must be at least 1, got 0.9"):
-        ecbs(graph, starts, goals, w=0.9)
+    assert eecbs(graph, starts, goals).planner == "eecbs"
+    for bounded in (ecbs, eecbs):
+        with pytest.raises(ValueError, match="w must be at least 1, got 0.9"):
+            bounded(graph, starts, goals, w=0.9)
 
 
 @pytest.mark.parametrize("name", ["random-32-32-20", "room-32-32-4"])
@@ -130,12 +139,13 @@ def test_prioritized_collisions_solve_what_plain_cbs_cannot_in_the_time(movingai
         1.2 * improved.sum_of_costs)
 
 
-def test_ecbs_plans_100_agents_within_its_bound(movingai_dir):
+@pytest.mark.parametrize("bounded", [ecbs, eecbs])
+def test_ecbs_and_eecbs_plan_100_agents_within_their_bound(movingai_dir, bounded):
     mapf = movingai_dir / "mapf"
     instance = load_instance(mapf / "random-32-32-10.map",
                              mapf / "random-32-32-10-random-1.scen", 100)
     graph, starts, goals = instance.graph, instance.starts, instance.goals
-    plan = ecbs(graph, starts, goals, w=1.2, time_limit=60)
+    plan = bounded(graph, starts, goals, w=1.2, time_limit=60)
     assert plan.solved and validate(graph, plan.paths, starts, goals, plan.lengths) == []
     assert lower_bound(graph, starts, goals) <= plan.stats["lower_bound"]
     assert plan.sum_of_costs <= 1.2 * plan.stats["lower_bound"]

@@ -8,9 +8,12 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
 * :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs;
   ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements, ``avoid`` the
   conflict avoidance table's tie-break (``"icbs"`` in ``PLANNERS``: all three), with MDDs from
-  :mod:`~jaxswarm.multiagent.mdd`.
-* :func:`ecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS, within a factor ``w`` of the
-  optimum.
+  :mod:`~jaxswarm.multiagent.mdd`; ``wdg`` the weighted dependency graph heuristic
+  (:mod:`~jaxswarm.multiagent.dependency`; ``"cbsh"``: all four), ``target`` and ``corridor``
+  the symmetry reasoning of :mod:`~jaxswarm.multiagent.constraints` and
+  :mod:`~jaxswarm.multiagent.corridor` (``"cbsh_tc"``: all six).
+* :func:`ecbs` and :func:`eecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS and Explicit
+  Estimation CBS, within a factor ``w`` of the optimum.
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
   step for all agents at a time; fast, incomplete.
 * :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
@@ -30,7 +33,7 @@ from jaxswarm.multiagent.agents import (UNREACHABLE, Instance, agent_nodes, hop_
                                         load_instance, lower_bound)
 from jaxswarm.multiagent.cbs import cbs
 from jaxswarm.multiagent.conflicts import Conflicts, find_conflicts
-from jaxswarm.multiagent.ecbs import ecbs
+from jaxswarm.multiagent.ecbs import ecbs, eecbs
 from jaxswarm.multiagent.lacam import lacam
 from jaxswarm.multiagent.pibt import pibt
 from jaxswarm.multiagent.plan import Plan, arrival_steps, pack
@@ -40,11 +43,14 @@ from jaxswarm.multiagent.validate import Violation, validate
 
 PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
             "icbs": functools.partial(cbs, prioritize=True, bypass=True, avoid=True),
-            "ecbs": ecbs, "pibt": pibt, "lacam": lacam,
+            "cbsh": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True),
+            "cbsh_tc": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True,
+                                         target=True, corridor=True),
+            "ecbs": ecbs, "eecbs": eecbs, "pibt": pibt, "lacam": lacam,
             "lacam_star": functools.partial(lacam, swap=True)}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
 __all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",
-           "agent_nodes", "arrival_steps", "cbs", "ecbs", "find_conflicts", "hop_fields", "lacam",
-           "load_instance", "lower_bound", "pack", "pibt", "prioritized", "report_scheme",
-           "validate"]
+           "agent_nodes", "arrival_steps", "cbs", "ecbs", "eecbs", "find_conflicts", "hop_fields",
+           "lacam", "load_instance", "lower_bound", "pack", "pibt", "prioritized",
+           "report_scheme", "validate"]

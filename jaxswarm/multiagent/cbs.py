@@ -13,8 +13,13 @@ semi-cardinal one, then the earliest (Boyarski et al., IJCAI 2015, from the agen
 :mod:`jaxswarm.multiagent.mdd`; a pair's first collision stands for the pair); ``bypass`` takes a
 child's path into its parent instead of splitting when the child costs no more and collides less
 (ibid.); ``avoid`` has the low level break ties between shortest paths toward the one meeting the
-fewest other agents (a conflict avoidance table, as CBS implementations do). All keep CBS
-optimal.
+fewest other agents (a conflict avoidance table, as CBS implementations do); ``wdg`` orders the
+high level by the sum of costs plus the weighted dependency graph heuristic (Li et al., IJCAI
+2019; :mod:`jaxswarm.multiagent.dependency`), with pathmax: CBSH-WDG with all four;
+``target`` splits a collision on the goal of an agent resting there by when it finishes (target
+reasoning, Li et al., ICAPS 2020; :mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits
+two agents meeting head-on in a corridor by which crosses first (corridor reasoning, ibid.;
+:mod:`jaxswarm.multiagent.corridor`). All keep CBS optimal.
 
 CBS is for few agents: the number of nodes grows exponentially with the number of collisions
 that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
@@ -30,17 +35,21 @@ from typing import NamedTuple
 import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
-from jaxswarm.multiagent import mdd
+from jaxswarm.multiagent import dependency, mdd
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
+from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, forbid,
+                                             reservations)
+from jaxswarm.multiagent.corridor import Corridors
 from jaxswarm.multiagent.plan import Plan, pack
-from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations, occupancy, search
+from jaxswarm.multiagent.spacetime import occupancy, search
 from jaxswarm.world.graph import Graph
 
 
 def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,
         max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False,
-        avoid: bool = False) -> Plan:
+        avoid: bool = False, wdg: bool = False, target: bool = False,
+        corridor: bool = False) -> Plan:
     """Conflict-Based Search.
 
     Args:
@@ -52,14 +61,21 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       prioritize: split on cardinal collisions first, then semi-cardinal (from MDDs).
       bypass: take a child's path instead of splitting where it costs no more, collides less.
       avoid: of an agent's shortest paths, take the one meeting the fewest other agents.
+      wdg: expand the node of the least sum of costs plus its weighted dependency graph's
+        vertex cover first.
+      target: split a collision on a resting agent's goal by when that agent finishes.
+      corridor: split a head-on collision in a corridor by which agent crosses first.
 
     Returns:
-      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with both
-      improvements, ``cbs+prioritize`` or ``cbs+bypass`` with one) with the least sum of
-      costs; not solved when an agent's goal cannot be reached (naming it), when no solution exists
-      (the tree runs out), or at a limit (naming the agents of the collision it was resolving).
-      ``stats``: ``expanded`` space-time states, ``nodes`` split, ``bypasses``, ``mdds`` built,
-      ``seconds``.
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with
+      ``prioritize``, ``bypass`` and ``avoid``, ``cbsh`` with ``wdg`` too, and ``cbsh_t``,
+      ``cbsh_c`` or ``cbsh_tc`` with ``target``, ``corridor`` or both on top, else ``cbs`` and
+      ``+name`` per switch) with the least sum of costs; not solved when an agent's goal
+      cannot be reached (naming it), when no solution exists (the tree runs out), or at a limit
+      (naming the agents of the collision it was resolving). ``stats``: ``expanded``
+      space-time states, ``nodes`` split, ``bypasses``, ``mdds`` built, ``pairs`` two-agent
+      problems solved for the heuristic, ``corridors`` corridor splits, ``lower_bound`` the
+      least sum of costs plus heuristic left (the optimum when solved), ``seconds``.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
@@ -69,17 +85,27 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     agents = len(start_nodes)
     instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
                          max_expansions=max_expansions, began=began,
-                         name=_name(prioritize, bypass, avoid), avoid=avoid)
-    choose = instance.prioritized_collision if prioritize else _earliest_collision_of
-    waiting = [np.array([s], np.int32) for s in start_nodes]
+                         name=_name(prioritize, bypass, avoid, wdg, target, corridor),
+                         avoid=avoid, wdg=wdg, target=target,
+                         corridors=Corridors(graph) if corridor else None)
     blocked = cut_off(graph, instance.fields, start_nodes, goal_nodes)
     if blocked is not None:
-        return instance.stop(waiting, False, blocked[1], blocked[0])
+        return instance.stop([np.array([s], np.int32) for s in start_nodes], False, blocked[1],
+                             blocked[0])
+    return _search(instance, agents, max_nodes, time_limit, prioritize, bypass)
+
+
+def _search(instance: "_Instance", agents: int, max_nodes: int, time_limit: float,
+            prioritize: bool, bypass: bool) -> Plan:
+    """The high-level best-first search of :func:`cbs` from the root."""
+    choose = (instance.prioritized_collision if prioritize
+              else lambda node: earliest_collision(node.collisions))
     tiebreak = itertools.count()
-    frontier = [_root(instance, agents, next(tiebreak))]
+    frontier = [instance.bounded(_root(instance, agents, next(tiebreak)))]
     last = None
     while frontier:
         node = heapq.heappop(frontier)
+        instance.counts["lower_bound"] = node.bound
         collision = choose(node)
         if collision is None:
             return instance.stop(node.paths, True)
@@ -94,7 +120,8 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
         if bypass:
             children = _bypassed(instance, node, children, last, tiebreak)
         for child in children:
-            heapq.heappush(frontier, child)
+            heapq.heappush(frontier, instance.bounded(child, node.bound))
+    waiting = [np.array([s], np.int32) for s in instance.start_nodes]
     return instance.stop(waiting, False, "no solution exists: every way of resolving the "
                                          f"collisions of agents {last[0]} and {last[1]} "
                                          "failed", last[1] if last else None)
@@ -104,18 +131,20 @@ class _Node(NamedTuple):
     """A constraint-tree node, as a heap entry ordered by its first three fields.
 
     Attributes:
-      cost: the sum of costs of its paths.
+      bound: a lower bound of the sum of costs below it: ``cost``, or with ``wdg`` the
+        heuristic added.
       colliding_pairs: how many pairs of agents collide.
-      order: its creation number, the oldest first at equal cost and pairs.
+      order: its creation number, the oldest first at equal bound and pairs.
+      cost: the sum of costs of its paths.
       paths: per agent, its node list i32[T_a].
-      constraints: per agent, ``(vertex, edge)``: frozensets of ``(t, v)`` (not on ``v`` at
-        step ``t``) and of ``(t, u, v)`` (not along ``u -> v`` from step ``t``).
+      constraints: per agent, its :class:`~jaxswarm.multiagent.constraints.Constraints`.
       collisions: i32[A, A] as :func:`pair_collisions` gives them for ``paths``.
     """
 
-    cost: int
+    bound: int
     colliding_pairs: int
     order: int
+    cost: int
     paths: list
     constraints: list
     collisions: np.ndarray
@@ -141,33 +170,40 @@ class _Instance:
     max_expansions: int
     began: float
     counts: dict = dataclasses.field(
-        default_factory=lambda: {"expanded": 0, "nodes": 0, "bypasses": 0, "mdds": 0})
+        default_factory=lambda: {"expanded": 0, "nodes": 0, "bypasses": 0, "mdds": 0,
+                                 "pairs": 0, "corridors": 0, "lower_bound": 0})
     mdds: dict = dataclasses.field(default_factory=dict)
     name: str = "cbs"
     avoid: bool = False
+    wdg: bool = False
+    target: bool = False
+    corridors: Corridors | None = None
+    weights: dict = dataclasses.field(default_factory=dict)
 
-    def plan_agent(self, agent: int, vertex: frozenset, edge: frozenset, others: list = ()):
-        """The agent's fewest-steps path (i32[T]) under its constraints, or None; with
-        ``avoid``, the one meeting the fewest of ``others`` (the paths of the other agents,
-        or, at the root, of those planned so far; the agent's own entry is skipped)."""
+    def plan_agent(self, agent: int, constraints: Constraints, others=None):
+        """The agent's fewest-steps path (i32[T]) under its ``constraints``, or None; with
+        ``avoid`` and ``others`` (the paths of the other agents, or, at the root, of those
+        planned so far; the agent's own entry is skipped), the one meeting the fewest of
+        them."""
         table = (occupancy([path for a, path in enumerate(others) if a != agent],
-                           self.graph.num_nodes) if self.avoid else None)
+                           self.graph.num_nodes) if self.avoid and others is not None else None)
         path, expanded, _ = search(self.graph, int(self.start_nodes[agent]),
                                    int(self.goal_nodes[agent]), self.fields[agent],
-                                   _reservations(self.graph.num_nodes, vertex, edge),
+                                   reservations(self.graph.num_nodes, constraints),
                                    max_expansions=self.max_expansions, avoid=table)
         self.counts["expanded"] += expanded
         return path
 
-    def agent_mdd(self, agent: int, path, constraints: tuple) -> list[frozenset]:
+    def agent_mdd(self, agent: int, path, constraints: Constraints) -> list[frozenset]:
         """The agent's MDD at its path's cost under its constraints (cached)."""
-        key = (agent, len(path) - 1, *constraints)
+        key = (agent, len(path) - 1, constraints)
         levels = self.mdds.get(key)
         if levels is None:
             arrays = edge_arrays(self.graph)
             levels = self.mdds[key] = mdd.mdd(
                 arrays.indptr, arrays.heads, int(self.start_nodes[agent]),
-                int(self.goal_nodes[agent]), len(path) - 1, self.fields[agent], *constraints)
+                int(self.goal_nodes[agent]), len(path) - 1, self.fields[agent],
+                constraints.vertex, constraints.edge, constraints.parked)
             self.counts["mdds"] += 1
         return levels
 
@@ -190,6 +226,44 @@ class _Instance:
             best = key if best is None or key < best else best
         return (best[2], best[3]), best[1]
 
+    def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
+        """The two children's constraints for the collision of two agents (their
+        ``constraints`` and node lists ``paths``) arriving at ``step``: a corridor split if
+        ``corridor`` is on and it applies, else one constraint each
+        (:func:`~jaxswarm.multiagent.constraints.forbid`, with target reasoning if on)."""
+        padded = pack(list(paths))[0]
+        if self.corridors is not None:
+            both = self.corridors.split(constraints, paths, step, padded)
+            if both is not None:
+                self.counts["corridors"] += 1
+                return both
+        resting_from = np.array([len(path) - 1 for path in paths]) if self.target else None
+        return tuple(forbid(constraints[i], padded, i, 1 - i, step, resting_from)
+                     for i in (0, 1))
+
+    def bounded(self, node: "_Node", parent_bound: int = 0) -> "_Node":
+        """``node`` with its bound: its cost, or with ``wdg`` its cost plus the vertex cover
+        of its colliding pairs' dependency weights, and at least ``parent_bound``."""
+        if not self.wdg:
+            return node
+        weights = {}
+        for a, b in np.argwhere(np.triu(node.collisions >= 0, 1)).tolist():
+            weights[a, b] = self.pair_weight(node, a, b)
+        return node._replace(bound=max(parent_bound,
+                                       node.cost + dependency.vertex_cover(weights)))
+
+    def pair_weight(self, node: "_Node", a: int, b: int) -> int:
+        """The dependency weight of agents ``a`` and ``b`` under ``node``'s constraints
+        (cached by the constraints)."""
+        key = (a, b, node.constraints[a], node.constraints[b])
+        if key not in self.weights:
+            self.counts["pairs"] += 1
+            self.weights[key] = dependency.pair_extra_cost(
+                (node.paths[a], node.paths[b]), (node.constraints[a], node.constraints[b]),
+                lambda i, constraints: self.plan_agent((a, b)[i], constraints),
+                self.split)
+        return self.weights[key]
+
     def stop(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
         """The search's :class:`~jaxswarm.multiagent.plan.Plan` of ``paths`` (one node list
         per agent)."""
@@ -198,33 +272,25 @@ class _Instance:
                     stats={**self.counts, "seconds": time.perf_counter() - self.began})
 
 
-def _name(prioritize: bool, bypass: bool, avoid: bool) -> str:
-    """The planner's name in a Plan: ``icbs`` with every improvement, ``cbs`` with none."""
-    if prioritize and bypass and avoid:
+def _name(prioritize: bool, bypass: bool, avoid: bool, wdg: bool, target: bool,
+          corridor: bool) -> str:
+    """The planner's name in a Plan: ``icbs`` with the first three switches, ``cbsh`` with
+    ``wdg`` too, then ``_t``, ``_c`` or ``_tc`` for the symmetry reasoning on top (as Li et al.
+    name the variants of CBSH2), ``cbs`` and ``+name`` per switch otherwise."""
+    if prioritize and bypass and avoid and not (target or corridor) and not wdg:
         return "icbs"
+    if prioritize and bypass and avoid and wdg:
+        reasoning = "t" * target + "c" * corridor
+        return "cbsh" + (f"_{reasoning}" if reasoning else "")
     return "cbs" + "".join(f"+{name}" for name, on in (
-        ("prioritize", prioritize), ("bypass", bypass), ("avoid", avoid)) if on)
+        ("prioritize", prioritize), ("bypass", bypass), ("avoid", avoid), ("wdg", wdg),
+        ("target", target), ("corridor", corridor)) if on)
 
 
 def _swap(padded: np.ndarray, a: int, b: int, step: int) -> bool:
     """Whether agents ``a`` and ``b`` of ``padded`` (i32[A, T]) collide at ``step`` by
     swapping rather than on one node."""
     return bool(padded[a, step] != padded[b, step])
-
-
-def _earliest_collision_of(node: "_Node") -> tuple[tuple[int, int], int] | None:
-    """CBS's choice: the earliest collision of the node (:func:`_earliest_collision`)."""
-    return _earliest_collision(node.collisions)
-
-
-def _earliest_collision(collisions: np.ndarray) -> tuple[tuple[int, int], int] | None:
-    """``((a, b), step)``: the first step at which two agents collide and the lowest such
-    pair (``a < b``), from ``collisions`` i32[A, A] (:func:`pair_collisions`); None when no
-    pair collides."""
-    if not (collisions >= 0).any():
-        return None
-    pair = np.argwhere(collisions == collisions[collisions >= 0].min())[0]
-    return (int(pair[0]), int(pair[1])), int(collisions[pair[0], pair[1]])
 
 
 def _reached_limit(instance: _Instance, max_nodes: int, time_limit: float) -> str | None:
@@ -242,11 +308,11 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
     """Expand ``node`` at the collision of ``pair`` arriving at ``step``: one child per agent
     of the pair, forbidding the collision to that agent and re-planning it, none for an agent
     that then has no path. ``tiebreak`` numbers the children in the order they are made."""
-    padded = pack(node.paths)[0]
     children = []
-    for agent, other in (pair, pair[::-1]):
-        constraints = _forbid(node.constraints[agent], padded, agent, other, step)
-        path = instance.plan_agent(agent, *constraints, others=node.paths)
+    both = instance.split(tuple(node.constraints[a] for a in pair),
+                          tuple(node.paths[a] for a in pair), step)
+    for agent, constraints in zip(pair, both):
+        path = instance.plan_agent(agent, constraints, others=node.paths)
         if path is not None:
             children.append(_child(node, agent, path, constraints, next(tiebreak)))
     return children
@@ -255,10 +321,10 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
 def _root(instance: _Instance, agents: int, order: int) -> _Node:
     """The constraint tree's root: every agent's path without constraints (with ``avoid``,
     meeting the fewest of those planned before it)."""
-    no_constraints = [(frozenset(), frozenset())] * agents
+    no_constraints = [Constraints()] * agents
     paths = []
     for a in range(agents):
-        paths.append(instance.plan_agent(a, *no_constraints[a], others=paths))
+        paths.append(instance.plan_agent(a, no_constraints[a], others=paths))
     return _node(paths, no_constraints, pair_collisions(pack(paths)[0]), order)
 
 
@@ -276,19 +342,7 @@ def _bypassed(instance: _Instance, node: _Node, children: list[_Node], pair: tup
     return [_child(node, agent, taken.paths[agent], node.constraints[agent], next(tiebreak))]
 
 
-def _forbid(constraints: tuple, padded: np.ndarray, agent: int, other: int,
-            step: int) -> tuple[frozenset, frozenset]:
-    """``agent``'s ``(vertex, edge)`` constraints, plus one against its collision with
-    ``other`` arriving at ``step`` (``padded``: i32[A, T] the node's paths): the node they
-    share at ``step``, or, where they swap, ``agent``'s move into its node at ``step``."""
-    vertex, edge = constraints
-    here = int(padded[agent, step])
-    if here == padded[other, step]:
-        return vertex | {(step, here)}, edge
-    return vertex, edge | {(step - 1, int(padded[agent, step - 1]), here)}
-
-
-def _child(node: _Node, agent: int, path, constraints: tuple, order: int) -> _Node:
+def _child(node: _Node, agent: int, path, constraints: Constraints, order: int) -> _Node:
     """``node`` with ``agent`` on ``path`` (i32[T]) under its new ``constraints``."""
     paths = list(node.paths)
     paths[agent] = path
@@ -306,16 +360,5 @@ def _node(paths, constraints, collisions: np.ndarray, order: int) -> _Node:
     """The node of ``paths`` (node lists), ``constraints`` and their ``collisions`` i32[A, A]
     (as :func:`pair_collisions` gives them), made ``order``-th."""
     cost = sum(len(path) - 1 for path in paths)
-    return _Node(cost, int((collisions >= 0).sum()) // 2, order, paths, constraints, collisions)
-
-
-def _reservations(num_nodes: int, vertex: frozenset, edge: frozenset) -> Reservations:
-    """The low-level table of one agent's constraints: FORBIDDEN (t, v) entries and banned
-    moves, over enough steps that the world is static after them."""
-    steps = max([t + 1 for t, _ in vertex] + [t + 1 for t, _, _ in edge] + [0])
-    table = Reservations.empty(num_nodes, steps)
-    for t, v in vertex:
-        table.holder[t, v] = FORBIDDEN
-    if edge:
-        table.banned = np.array(sorted(edge), np.int32)
-    return table
+    return _Node(cost, int((collisions >= 0).sum()) // 2, order, cost, paths, constraints,
+                 collisions)

@@ -12,8 +12,17 @@ cost) on its earliest collision, as CBS does. The first node without collisions 
 whose sum of costs is at most w times the least LB, itself at most the optimum: the bound it
 proves is ``stats["lower_bound"]``.
 
-EECBS (Li, Ruml and Koenig, AAAI 2021) replaces the high level's focal list by an explicit
-estimation search and adds CBS's improvements; it is not implemented here.
+Explicit Estimation CBS (:func:`eecbs`; Li, Ruml and Koenig, AAAI 2021) keeps the low level and
+replaces the high level's focal list by explicit estimation search (Thayer and Ruml, IJCAI
+2011). A node's cost to go is estimated from its colliding pairs d: d-hat = d / (1 - e_d)
+collisions left to resolve, each raising the sum of costs by e_h, so f-hat = cost + e_h d-hat;
+e_h and e_d are learnt online, the mean one-step errors of the expansions so far (the cost and
+the collisions a node's best child adds, the latter beyond the one it resolves). Of the open
+nodes it splits the one with the least d-hat among those within w of the least f-hat, if its
+cost is within w of the least LB; else the one of least f-hat, if within w of that; else the
+one of least LB, which raises the bound. Solutions keep ECBS's guarantee. The paper's EECBS
+also adds CBS's improvements (bypassing, prioritised collisions, the WDG heuristic, symmetry
+reasoning); this one has none of them (its admissible heuristic is 0).
 """
 from __future__ import annotations
 
@@ -26,8 +35,8 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
-from jaxswarm.multiagent.cbs import _earliest_collision, _forbid
 from jaxswarm.multiagent.conflicts import pair_collisions
+from jaxswarm.multiagent.constraints import Constraints, earliest_collision, forbid
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import occupancy
 from jaxswarm.world.graph import Graph
@@ -35,7 +44,14 @@ from jaxswarm.world.graph import Graph
 
 def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_000,
          time_limit: float = 60.0) -> Plan:
-    """Enhanced CBS with suboptimality bound ``w``.
+    """Enhanced CBS with suboptimality bound ``w`` (the arguments and result of
+    :func:`eecbs`, ``planner="ecbs"``)."""
+    return _bounded(graph, starts, goals, w, max_nodes, time_limit, explicit=False)
+
+
+def eecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_000,
+          time_limit: float = 60.0) -> Plan:
+    """Explicit Estimation CBS with suboptimality bound ``w``.
 
     Args:
       graph: the map; its valid edges are the moves, one step each.
@@ -45,19 +61,26 @@ def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_00
       time_limit: give up after this many seconds.
 
     Returns:
-      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="ecbs"``); not solved when an
+      A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="eecbs"``); not solved when an
       agent's goal cannot be reached (naming it) or at a limit. ``stats``: ``lower_bound`` (the
       least LB open when it stopped: no solution costs less), ``w``, ``nodes``, ``expanded``,
-      ``seconds``.
+      ``cost_error`` and ``collision_error`` (e_h and e_d as learnt), ``seconds``.
 
     Raises:
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or w < 1.
     """
+    return _bounded(graph, starts, goals, w, max_nodes, time_limit, explicit=True)
+
+
+def _bounded(graph: Graph, starts, goals, w: float, max_nodes: int, time_limit: float, *,
+             explicit: bool) -> Plan:
+    """ECBS, or with ``explicit`` EECBS (see :func:`eecbs`)."""
     if not w >= 1.0:
         raise ValueError(f"w must be at least 1, got {w}")
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
-    search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began)
+    search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began,
+                     explicit)
     blocked = cut_off(graph, search.fields, start_nodes, goal_nodes)
     if blocked is not None:
         return search.stop([np.array([s]) for s in start_nodes], False, blocked[1], blocked[0])
@@ -88,19 +111,24 @@ class _Node:
 
 
 class _Search:
-    """One ECBS search (see the module docstring)."""
+    """One ECBS or EECBS search (see the module docstring)."""
 
-    def __init__(self, graph, start_nodes, goal_nodes, fields, w: float, began: float):
+    def __init__(self, graph, start_nodes, goal_nodes, fields, w: float, began: float,
+                 explicit: bool):
         arrays = edge_arrays(graph)
         self.moves = [arrays.heads[arrays.indptr[u]:arrays.indptr[u + 1]].tolist() + [u]
                       for u in range(graph.num_nodes)]
         self.graph, self.starts, self.goals = graph, start_nodes, goal_nodes
         self.fields, self.w, self.began = fields, w, began
         self.counts = {"expanded": 0, "nodes": 0, "lower_bound": 0, "w": w}
+        self.explicit = explicit
+        if explicit:
+            self.counts.update(cost_error=0.0, collision_error=0.0)
+        self.errors = [0.0, 0.0, 0]  # the one-step errors' sums (cost, collisions), expansions
 
     def run(self, max_nodes: int, time_limit: float) -> Plan:
         agents = len(self.starts)
-        constraints = [(frozenset(), frozenset())] * agents
+        constraints = [Constraints()] * agents
         paths, bounds = [], []
         for a in range(agents):
             path, bound = self.plan_agent(a, constraints[a], paths)
@@ -110,11 +138,8 @@ class _Search:
         open_ = [root]
         last = None
         while open_:
-            least = min(node.lower_bound for node in open_)
-            self.counts["lower_bound"] = least
-            node = min((n for n in open_ if n.cost <= self.w * least),
-                       key=lambda n: (n.colliding_pairs, n.cost))
-            collision = _earliest_collision(node.collisions)
+            node = self.choose(open_)
+            collision = earliest_collision(node.collisions)
             if collision is None:
                 return self.stop(node.paths, True)
             last, step = collision
@@ -125,9 +150,42 @@ class _Search:
                                  f"collision of agents {last[0]} and {last[1]}", last[1])
             open_.remove(node)
             self.counts["nodes"] += 1
-            open_ += self.children(node, last, step)
+            children = self.children(node, last, step)
+            if self.explicit and children:
+                self.learn(node, children)
+            open_ += children
         return self.stop(root.paths, False, "no solution exists: every way of resolving the "
                          f"collisions of agents {last[0]} and {last[1]} failed", last[1])
+
+    def choose(self, open_: list[_Node]) -> _Node:
+        """The node to split next (ECBS's focal choice, or EECBS's, see the module docstring);
+        records the least LB open."""
+        least = min(node.lower_bound for node in open_)
+        self.counts["lower_bound"] = least
+        if not self.explicit:
+            return min((n for n in open_ if n.cost <= self.w * least),
+                       key=lambda n: (n.colliding_pairs, n.cost))
+        cost_error, collision_error = self.counts["cost_error"], self.counts["collision_error"]
+        left = {id(n): n.colliding_pairs / (1.0 - collision_error) for n in open_}
+        estimate = {id(n): n.cost + cost_error * left[id(n)] for n in open_}
+        best = min(open_, key=lambda n: (estimate[id(n)], left[id(n)]))
+        focal = min((n for n in open_ if estimate[id(n)] <= self.w * estimate[id(best)]),
+                    key=lambda n: (left[id(n)], estimate[id(n)]))
+        for candidate in (focal, best):
+            if candidate.cost <= self.w * least:
+                return candidate
+        return min(open_, key=lambda n: (n.lower_bound, n.cost))
+
+    def learn(self, node: _Node, children: list[_Node]) -> None:
+        """Add the one-step errors of an expansion, from its child with the fewest colliding
+        pairs: the cost it adds, and the pairs beyond one fewer; update e_h and e_d, their
+        means (e_h at least 0, e_d in [0, 0.99])."""
+        child = min(children, key=lambda n: (n.colliding_pairs, n.cost))
+        self.errors[0] += child.cost - node.cost
+        self.errors[1] += child.colliding_pairs - (node.colliding_pairs - 1)
+        self.errors[2] += 1
+        self.counts["cost_error"] = max(0.0, self.errors[0] / self.errors[2])
+        self.counts["collision_error"] = min(0.99, max(0.0, self.errors[1] / self.errors[2]))
 
     def children(self, node: _Node, pair: tuple[int, int], step: int) -> list[_Node]:
         """One child per agent of the colliding ``pair``: the collision forbidden to it, the
@@ -135,7 +193,7 @@ class _Search:
         padded = pack(node.paths)[0]
         out = []
         for agent, other in (pair, pair[::-1]):
-            constraints = _forbid(node.constraints[agent], padded, agent, other, step)
+            constraints = forbid(node.constraints[agent], padded, agent, other, step)
             found = self.plan_agent(agent, constraints, node.paths)
             if found is None:
                 continue
@@ -149,9 +207,9 @@ class _Search:
             out.append(_Node(paths, bounds, all_constraints, collisions))
         return out
 
-    def plan_agent(self, agent: int, constraints: tuple, paths: list):
+    def plan_agent(self, agent: int, constraints: Constraints, paths: list):
         """``(path i32[T], lower bound on its cost)`` of the low-level focal search, or None."""
-        vertex, edge = constraints
+        vertex, edge = constraints.vertex, constraints.edge
         others = [path for a, path in enumerate(paths) if a != agent]
         occupied = occupancy(others, self.graph.num_nodes)
         horizon = max([t + 1 for t, _ in vertex] + [t + 1 for t, _, _ in edge]
@@ -163,7 +221,8 @@ class _Search:
                              self.counts)
 
     def stop(self, paths, solved: bool, reason: str = "", agent=None) -> Plan:
-        return Plan(*pack(paths, self.goals), solved=solved, planner="ecbs", reason=reason,
+        return Plan(*pack(paths, self.goals), solved=solved,
+                    planner="eecbs" if self.explicit else "ecbs", reason=reason,
                     agent=agent,
                     stats={**self.counts, "seconds": time.perf_counter() - self.began})
 

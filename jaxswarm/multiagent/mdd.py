@@ -3,7 +3,8 @@
 An agent's MDD of cost c under its constraints holds, for every step t = 0..c, the nodes it can
 be on at t on some path that reaches its goal at step c, moving or waiting one step at a time and
 keeping its constraints (no ``(t, v)`` vertex, no ``(t, u, v)`` move). After step c it rests at
-its goal, so its level there is the goal alone.
+its goal, so its level there is the goal alone. A parked constraint ``(t, v)`` keeps it off
+``v`` from step t on (target reasoning's, on another agent's goal).
 
 A collision of two agents is *cardinal* for an agent when every path of its cost passes it (its
 level at the collision is the colliding node alone; for a swap, both ends of the move): then
@@ -20,8 +21,8 @@ CARDINAL, SEMI_CARDINAL, NON_CARDINAL = 0, 1, 2
 
 
 def mdd(indptr: np.ndarray, heads: np.ndarray, start: int, goal: int, cost: int,
-        field: np.ndarray, vertex: frozenset = frozenset(),
-        edge: frozenset = frozenset()) -> list[frozenset]:
+        field: np.ndarray, vertex: frozenset = frozenset(), edge: frozenset = frozenset(),
+        parked: frozenset = frozenset()) -> list[frozenset]:
     """The agent's MDD of ``cost``: its levels 0..cost (empty when no path of that cost keeps
     the constraints).
 
@@ -33,14 +34,18 @@ def mdd(indptr: np.ndarray, heads: np.ndarray, start: int, goal: int, cost: int,
         than are left is on no such path).
       vertex: ``(t, v)``: not on ``v`` at step ``t``.
       edge: ``(t, u, v)``: not along ``u -> v`` from step ``t``.
+      parked: ``(t, v)``: not on ``v`` at step ``t`` or later.
     """
-    forward = [{start} if (0, start) not in vertex else set()]
+    parked_from = {}
+    for t, v in parked:
+        parked_from[v] = min(t, parked_from.get(v, t))
+    forward = [{start} if (0, start) not in vertex and parked_from.get(start, 1) > 0 else set()]
     for t in range(1, cost + 1):
         level = set()
         for u in forward[-1]:
             for v in heads[indptr[u]:indptr[u + 1]].tolist() + [u]:
                 if (field[v] <= cost - t and (t, v) not in vertex
-                        and (t - 1, u, v) not in edge):
+                        and (t - 1, u, v) not in edge and parked_from.get(v, t + 1) > t):
                     level.add(v)
         forward.append(level)
     levels = [frozenset()] * (cost + 1)

@@ -10,6 +10,8 @@ one. What the other agents hold is a :class:`Reservations` table:
 * ``parked_from`` i32[N]: the step from which an agent stays on the node for good.
 * ``banned`` i32[M, 3]: single moves ``(t, u, v)`` forbidden from step t (CBS's edge
   constraints).
+* ``earliest_finish``: the agent may not stay at its goal for good before this step (CBS's
+  length constraint of target reasoning).
 
 From step ``H`` on nothing moves any more, so the world is static: a state reaching step H is
 finished by the static shortest path that avoids the parked nodes (a breadth-first field from the
@@ -49,11 +51,13 @@ class Reservations:
       holder: i32[H, N] agent (or FREE, FORBIDDEN) per step and node.
       parked_from: i32[N] the step from which a node is held for good (UNREACHABLE: never).
       banned: i32[M, 3] forbidden moves ``(t, u, v)``, each with t < H.
+      earliest_finish: the first step from which the agent may stay at its goal (at most H).
     """
 
     holder: np.ndarray
     parked_from: np.ndarray
     banned: np.ndarray
+    earliest_finish: int = 0
 
     @classmethod
     def empty(cls, num_nodes: int, steps: int = 0) -> "Reservations":
@@ -108,7 +112,7 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     arrays = edge_arrays(graph)
     parked = reservations.parked_from
     finish = static_field(graph, goal, (parked < UNREACHABLE) & (np.arange(len(parked)) != goal))
-    keep_from = reservations.last_use(goal) + 1
+    keep_from = max(reservations.last_use(goal) + 1, reservations.earliest_finish)
     avoid = np.zeros((0, graph.num_nodes), np.int32) if avoid is None else avoid
     path, expanded, outcome = _search(
         arrays.indptr, arrays.heads, np.ascontiguousarray(heuristic, np.int32), finish, start,
