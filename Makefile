@@ -50,8 +50,10 @@ performance: $(INSTALLED)  ## run every benchmark and write docs/performance.md 
 # other work, load 2-6): Table 1 9.4-12 min, RFD table 5.2 min, path maps 0.7 min, dynamic tables
 # 63 min, robot study 13-17 min, IWD 1-5 min, IWD_PG's experiments 7-25 min, the bees' tables 20
 # min (load 5-8) and inverse problem 10 min, A* study about 5 min alone, the calibrations from
-# their stores under a minute (from scratch: the four of 0.8.0 in 21 min); the MAPF study at this
-# size is not measured yet (estimated 1-2 hours: CBS, ECBS and pymapf at their time limits).
+# their stores under a minute (from scratch: the four of 0.8.0 in 21 min); the MAPF study about
+# 3.0 hours of one process (0.9.0: run as six parts, two or three side by side, in 1.5 hours; most
+# of it planners at their 30 s limit, and the report's scheme, which has none, on 256 x 256 maps;
+# sweeps/mapf_study.py --resume joins parts).
 RESULTS := results
 QUICK_OUT := out/reproduce-quick
 TABLE1_FULL := --maps all --seeds 20 --iterations 100 --agents 256

@@ -349,11 +349,11 @@ def run_instance(instance: Instance, where: dict, calls: list, time_limit: float
     """
     graph, starts, goals = instance.graph, instance.starts, instance.goals
     bound = lower_bound(graph, starts, goals)
-    warm_up(instance)
+    calls = within_caps(calls, where["agents"])
+    if any(planner not in (skip or {}) for planner, _, _ in calls):
+        warm_up(instance)
     rows = []
     for planner, seed, call in calls:
-        if (where["agents"] > MAX_AGENTS.get(planner, where["agents"])):
-            continue
         row = dict(where, planner=planner, seed="" if seed is None else seed, solved=False,
                    sum_of_costs="", lower_bound=bound, ratio="", makespan="", seconds=0.0,
                    field_seconds="", reason="", error=False, expanded="", nodes="",
@@ -380,6 +380,11 @@ def run_instance(instance: Instance, where: dict, calls: list, time_limit: float
         rows.append(row)
     check_optimal([*earlier, *rows], instance.name)
     return rows
+
+
+def within_caps(calls: list, agents: int) -> list:
+    """The planner calls whose :data:`MAX_AGENTS` allows ``agents`` (the others have no row)."""
+    return [call for call in calls if agents <= MAX_AGENTS.get(call[0], agents)]
 
 
 def _check(instance: Instance, row: dict, plan: Plan, bound: int, seed) -> None:
@@ -451,8 +456,9 @@ def run_study(instances: list[tuple[str, str]], agent_counts, calls: list, time_
             where = dict(map=map_name, scenario=scenario, agents=agents)
             old = earlier.pop((map_name, scenario, agents), [])
             done = {run_key(row) for row in old}
-            todo = [call for call in calls if (map_name, scenario, agents, call[0],
-                                               "" if call[1] is None else call[1]) not in done]
+            todo = [call for call in within_caps(calls, agents) if (
+                map_name, scenario, agents, call[0], "" if call[1] is None else call[1])
+                not in done]
             instance_began = time.perf_counter()
             new = [] if not todo else run_instance(
                 load_instance(data / f"{map_name}.map", scen, agents), where, todo, time_limit,
@@ -610,7 +616,7 @@ def plot_summary(summary: list[dict], path) -> None:
               ("median_seconds", "median time (s)"))
     overall = [e for e in summary if e["map"] == ALL_MAPS]
     counts = sorted({e["agents"] for e in overall})
-    fig = Figure(figsize=(15, 4.5), layout="constrained")
+    fig = Figure(figsize=(17, 4.5), layout="constrained")
     axes = fig.subplots(1, len(panels))
     for ax, (metric, title) in zip(axes, panels):
         for planner, marker, style in zip(PLANNERS, MARKERS, STYLES):
@@ -621,14 +627,14 @@ def plot_summary(summary: list[dict], path) -> None:
                         marker=marker, markersize=5, linestyle=style, label=LABELS[planner],
                         alpha=0.85)
         ax.set_xscale("log")
-        ax.set_xticks(counts, [str(c) for c in counts])
+        ax.set_xticks(counts, [str(c) for c in counts], rotation=45)
         ax.minorticks_off()
         ax.set_title(title)
         ax.set_xlabel("agents")
         ax.grid(True, alpha=0.3)
     axes[0].set_ylim(-0.05, 1.05)
     axes[2].set_yscale("log")
-    axes[0].legend()
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="outside right center")
     sets = [e["map"] for e in summary if e["map"] != ALL_MAPS]
     maps = sorted({name.split(" (")[0] for name in sets})
     fig.suptitle(f"MAPF planners on {len(maps)} Moving AI map{'s' * (len(maps) > 1)}, "

@@ -188,6 +188,18 @@ def test_a_study_in_parts_resumes_to_the_rows_of_one_run(outputs, tmp_path):
     assert study.read_runs(joined / "runs.csv") == rows
 
 
+def test_resuming_loads_no_instance_whose_runs_are_all_kept_or_capped(outputs, tmp_path,
+                                                                        monkeypatch):
+    # The rows above a planner's cap do not exist; they must not make a resume load the map and
+    # warm up (minutes for the report's distance fields on a 256 x 256 map).
+    monkeypatch.setitem(study.MAX_AGENTS, "lacam", AGENTS - 1)
+    argv = [*ARGV, "--no-pymapf", "--out", str(tmp_path)]
+    assert study.main([*argv, "--planners", "pibt,lacam"]) == 0
+    monkeypatch.setattr(study, "load_instance", None)  # any load would raise
+    assert study.main([*argv, "--planners", "pibt,lacam", "--resume"]) == 0
+    assert {row["planner"] for row in study.read_runs(tmp_path / "runs.csv")} == {"pibt"}
+
+
 def test_read_runs_types_the_rows_as_the_study_makes_them(outputs):
     rows = study.read_runs(outputs["dir"] / "runs.csv")
     assert [study.run_key(row) for row in rows] == [
