@@ -102,7 +102,7 @@ from jaxswarm.multiagent import (Instance, Plan, cbs, ecbs, eecbs, lacam, load_i
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
-from jaxswarm.studies.arguments import add_out_argument, check_counts
+from jaxswarm.studies.arguments import add_out_argument, check_counts, names_argument
 from jaxswarm.studies.problems import movingai_folder
 
 
@@ -208,17 +208,6 @@ def parse_scenarios(text: str) -> list[str]:
     unknown = [name for name in names if name not in SCENARIOS]
     if not names or unknown:
         raise argparse.ArgumentTypeError(f"scenarios are {', '.join(SCENARIOS)}; got {text!r}")
-    return names
-
-
-def parse_planners(text: str) -> list[str]:
-    """A comma list of row names from :data:`PLANNERS` (``all``: every one)."""
-    if text.strip() == "all":
-        return list(PLANNERS)
-    names = [name.strip() for name in text.split(",") if name.strip()]
-    unknown = [name for name in names if name not in PLANNERS]
-    if not names or unknown:
-        raise argparse.ArgumentTypeError(f"planners are {', '.join(PLANNERS)}; got {text!r}")
     return names
 
 
@@ -345,7 +334,7 @@ def run_instance(instance: Instance, where: dict, calls: list, time_limit: float
 
     Raises:
       InvalidPlan: a solved plan fails ``validate``, is below the lower bound, beats an optimal
-        planner, or ECBS's is above its bound.
+        planner, or ECBS's or EECBS's is above its bound.
     """
     graph, starts, goals = instance.graph, instance.starts, instance.goals
     bound = lower_bound(graph, starts, goals)
@@ -726,7 +715,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--time-limit", type=float, default=30.0,
                         help="seconds a planner has per instance (default 30)")
     parser.add_argument("--w", type=float, default=1.2, help="ECBS's bound (default 1.2)")
-    parser.add_argument("--planners", type=parse_planners, default=list(PLANNERS),
+    parser.add_argument("--planners", type=names_argument(PLANNERS), default=PLANNERS,
                         help="comma list of the rows to run, or 'all' (default)")
     parser.add_argument("--resume", type=Path, nargs="*", default=None, metavar="FOLDER",
                         help="keep the runs of these folders' runs.csv (none named: --out's) "
