@@ -159,8 +159,10 @@ def _add_mapf_parser(subparsers) -> None:
                            "Search (optimal, few agents); icbs: CBS with prioritised "
                            "collisions and bypassing (optimal); cbsh: ICBS with the weighted "
                            "dependency graph heuristic (optimal); cbsh_tc: CBSH with target "
-                           "and corridor reasoning (optimal); ecbs, eecbs: Enhanced and "
-                           "Explicit Estimation CBS (within --w of the optimum); pibt: PIBT steps (fast, incomplete); lacam: "
+                           "and corridor reasoning (optimal); cbsh_rtc: with rectangle "
+                           "reasoning too (optimal); ecbs, eecbs: Enhanced and Explicit "
+                           "Estimation CBS (within --w of the optimum); pibt: PIBT steps "
+                           "(fast, incomplete); lacam: "
                            "LaCAM (complete, hundreds of agents); lacam_star: with LaCAM*'s "
                            "swap generator (--refine: its anytime refinement)")
     mapf.add_argument("--order", choices=ORDERS,
@@ -439,8 +441,8 @@ def _planner_options(args: argparse.Namespace) -> dict:
     given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
              "refine": args.refine, "w": args.w}
     owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam", "lacam_star"),
-              "time_limit": ("cbs", "icbs", "cbsh", "cbsh_tc", "ecbs", "eecbs", "lacam",
-                             "lacam_star"),
+              "time_limit": ("cbs", "icbs", "cbsh", "cbsh_tc", "cbsh_rtc", "ecbs", "eecbs",
+                             "lacam", "lacam_star"),
               "refine": ("lacam", "lacam_star"), "w": ("ecbs", "eecbs")}
     for option, value in given.items():
         if value is not None and args.planner not in owners[option]:

@@ -16,7 +16,8 @@ scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-rando
   order once per seed 0 .. ``--seeds`` - 1;
 * ``cbs``: :func:`~jaxswarm.multiagent.cbs` (optimal sum of costs); ``icbs``: the same with
   prioritised collisions and bypassing (optimal too); ``cbsh_tc``: ICBS with the weighted
-  dependency graph heuristic and target and corridor reasoning (optimal); ``ecbs`` and
+  dependency graph heuristic and target and corridor reasoning (optimal); ``cbsh_rtc``: with
+  rectangle reasoning too (optimal); ``ecbs`` and
   ``eecbs``: :func:`~jaxswarm.multiagent.ecbs` and :func:`~jaxswarm.multiagent.eecbs` with w =
   ``--w`` (1.2);
 * ``pibt``: :func:`~jaxswarm.multiagent.pibt` (1,000 steps at most); ``lacam``:
@@ -111,15 +112,15 @@ SCENARIOS = ("random", "even")
 AGENTS = (10, 20, 50, 100, 200, 400, 700, 1000)
 """The default agent counts (each map runs those its scenario files have rows for)."""
 PLANNERS = ("report", "prioritized (given)", "prioritized (distance)", "prioritized (random)",
-            "cbs", "icbs", "cbsh_tc", "ecbs", "eecbs", "pibt", "lacam", "lacam_star",
+            "cbs", "icbs", "cbsh_tc", "cbsh_rtc", "ecbs", "eecbs", "pibt", "lacam", "lacam_star",
             "pymapf lacam", "pymapf cbs")
 """The rows, in the order they run on every instance."""
 PYMAPF = ("pymapf lacam", "pymapf cbs")
 """The rows of pymapf's solvers (left out when pymapf is not installed)."""
-MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "cbsh_tc": 100, "ecbs": 400, "eecbs": 400,
-              "pymapf lacam": 200, "pymapf cbs": 50}
+MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "cbsh_tc": 100, "cbsh_rtc": 100,
+              "ecbs": 400, "eecbs": 400, "pymapf lacam": 200, "pymapf cbs": 50}
 """The most agents a planner is run with (the others: every count)."""
-OPTIMAL = ("cbs", "icbs", "cbsh_tc")
+OPTIMAL = ("cbs", "icbs", "cbsh_tc", "cbsh_rtc")
 """The rows whose solved plans have the least sum of costs."""
 BOUNDED = ("ecbs", "eecbs")
 """The rows whose solved plans are within w of the bound they prove."""
@@ -148,7 +149,8 @@ ABOUT = (
     "Conflict-Based Search (Sharon et al. 2015; `cbs`, optimal), CBS with prioritised "
     "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), ICBS with the weighted "
     "dependency graph heuristic (Li et al. 2019) and target and corridor reasoning (Li et al. "
-    "2020; `cbsh_tc`, optimal), Enhanced CBS (Barer et al. 2014; `ecbs`) and Explicit "
+    "2020; `cbsh_tc`, optimal) and with rectangle reasoning too (Li et al. 2019, its barriers "
+    "timed by static distances; `cbsh_rtc`, optimal), Enhanced CBS (Barer et al. 2014; `ecbs`) and Explicit "
     "Estimation CBS (Li et al. 2021, without the CBS improvements of its paper; `eecbs`), both "
     "within w of the optimum, PIBT (Okumura et al. 2022), LaCAM (Okumura, "
     "AAAI 2023; its first solution) and with LaCAM*'s successor generator (Okumura, IJCAI "
@@ -165,7 +167,7 @@ ABOUT = (
 LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (given)",
           "prioritized (distance)": "prioritized (distance)",
           "prioritized (random)": "prioritized (random)", "cbs": "CBS", "icbs": "ICBS",
-          "cbsh_tc": "CBSH-TC", "eecbs": "EECBS",
+          "cbsh_tc": "CBSH-TC", "cbsh_rtc": "CBSH-RTC", "eecbs": "EECBS",
           "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "lacam_star": "LaCAM* (swap)",
           "pymapf lacam": "pymapf LaCAM",
           "pymapf cbs": "pymapf CBS"}
@@ -302,6 +304,10 @@ def planner_calls(seeds: int, time_limit: float, w: float, with_pymapf: bool,
               ("cbsh_tc", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
                                                   bypass=True, avoid=True, wdg=True,
                                                   target=True, corridor=True)),
+              ("cbsh_rtc", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
+                                                   bypass=True, avoid=True, wdg=True,
+                                                   target=True, corridor=True,
+                                                   rectangle=True)),
               ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
               ("eecbs", None, functools.partial(eecbs, w=w, time_limit=time_limit)),
               ("pibt", None, pibt),

@@ -153,6 +153,7 @@ def _mapf_row(text: str, planner: str) -> dict:
                                               ("cbs", ["--time-limit", "30"]),
                                               ("icbs", ["--time-limit", "30"]),
                                               ("cbsh", []), ("cbsh_tc", []),
+                                              ("cbsh_rtc", ["--time-limit", "30"]),
                                               ("ecbs", ["--w", "1.1"]),
                                               ("eecbs", ["--w", "1.1"]),
                                               ("pibt", ["--seed", "2"]),
@@ -169,7 +170,7 @@ def test_mapf_plans_five_agents_with_each_planner(movingai_dir, capsys, planner,
     cost, bound = int(row["sum of costs"]), int(row["lower bound"])
     assert bound == 114 and cost >= bound  # the sum of the scenario's optimal lengths
     assert float(row["ratio"]) == pytest.approx(cost / bound, abs=1e-3)
-    if planner in ("cbs", "icbs", "cbsh", "cbsh_tc", "ecbs", "eecbs"):
+    if planner in ("cbs", "icbs", "cbsh", "cbsh_tc", "cbsh_rtc", "ecbs", "eecbs"):
         assert cost == bound  # optimal (ECBS: within 1.1), and here no agent has to give way
     # The longest path is the makespan: at least the mean, at most the sum of the paths.
     assert cost / 5 <= int(row["makespan"]) <= cost

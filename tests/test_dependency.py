@@ -130,12 +130,12 @@ def test_symmetry_reasoning_and_the_heuristic_are_optimal_on_random_tiny_instanc
     graph = grid_graph(blocked, connectivity=4)
     optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                   starts, goals)
-    for wdg, target, corridor in itertools.product((False, True), repeat=3):
-        plan = cbs(graph, starts, goals, prioritize=True, bypass=True, wdg=wdg, target=target,
-                   corridor=corridor)
-        assert plan.solved == (optimum is not None), (wdg, target, corridor)
+    for switches in itertools.product((False, True), repeat=4):
+        plan = cbs(graph, starts, goals, prioritize=True, bypass=True,
+                   **dict(zip(("wdg", "target", "corridor", "rectangle"), switches)))
+        assert plan.solved == (optimum is not None), switches
         if optimum is not None:
-            assert plan.sum_of_costs == optimum, (wdg, target, corridor)
+            assert plan.sum_of_costs == optimum, switches
             assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
 
 

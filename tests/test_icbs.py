@@ -91,7 +91,7 @@ def test_the_switches_keep_cbs_optimal_and_ecbs_and_eecbs_within_their_bound(row
     graph = grid_graph(blocked, connectivity=4)
     optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                   starts, goals)
-    names = ("prioritize", "bypass", "avoid", "wdg", "target", "corridor")
+    names = ("prioritize", "bypass", "avoid", "wdg", "target", "corridor", "rectangle")
     for switches in itertools.product((False, True), repeat=len(names)):
         plan = cbs(graph, starts, goals, **dict(zip(names, switches)))
         assert plan.solved and plan.sum_of_costs == optimum == plan.stats["lower_bound"], \
@@ -113,6 +113,9 @@ def test_planner_names_and_bad_bounds():
     assert cbs(graph, starts, goals, bypass=True, avoid=True).planner == "cbs+bypass+avoid"
     assert PLANNERS["cbsh"](graph, starts, goals).planner == "cbsh"
     assert PLANNERS["cbsh_tc"](graph, starts, goals).planner == "cbsh_tc"
+    assert PLANNERS["cbsh_rtc"](graph, starts, goals).planner == "cbsh_rtc"
+    assert cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True, wdg=True,
+               rectangle=True).planner == "cbsh_r"
     assert cbs(graph, starts, goals, wdg=True, corridor=True).planner == "cbs+wdg+corridor"
     assert ecbs(graph, starts, goals).planner == "ecbs"
     assert eecbs(graph, starts, goals).planner == "eecbs"

@@ -220,8 +220,8 @@ def test_many_agents(notebook_env):
     result = json.loads(stdout(checks[0]).strip().splitlines()[-1])
     assert result["agents"] == 20, "JAXSWARM_NOTEBOOK_SMALL ignored"
     planners = result["planners"]
-    assert set(planners) == {"report", "prioritized", "cbs", "icbs", "cbsh", "cbsh_tc", "ecbs",
-                             "eecbs", "pibt", "lacam", "lacam_star"}
+    assert set(planners) == {"report", "prioritized", "cbs", "icbs", "cbsh", "cbsh_tc",
+                             "cbsh_rtc", "ecbs", "eecbs", "pibt", "lacam", "lacam_star"}
     bound = result["lower_bound"]
     for name, plan in planners.items():
         assert plan["solved"], f"{name}: {plan['reason']}"

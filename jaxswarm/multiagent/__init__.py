@@ -9,9 +9,10 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
   ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements, ``avoid`` the
   conflict avoidance table's tie-break (``"icbs"`` in ``PLANNERS``: all three), with MDDs from
   :mod:`~jaxswarm.multiagent.mdd`; ``wdg`` the weighted dependency graph heuristic
-  (:mod:`~jaxswarm.multiagent.dependency`; ``"cbsh"``: all four), ``target`` and ``corridor``
-  the symmetry reasoning of :mod:`~jaxswarm.multiagent.constraints` and
-  :mod:`~jaxswarm.multiagent.corridor` (``"cbsh_tc"``: all six).
+  (:mod:`~jaxswarm.multiagent.dependency`; ``"cbsh"``: all four), ``target``, ``corridor`` and
+  ``rectangle`` the symmetry reasoning of :mod:`~jaxswarm.multiagent.constraints`,
+  :mod:`~jaxswarm.multiagent.corridor` and :mod:`~jaxswarm.multiagent.rectangle`
+  (``"cbsh_tc"``: the first six, ``"cbsh_rtc"``: all seven).
 * :func:`ecbs` and :func:`eecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS and Explicit
   Estimation CBS, within a factor ``w`` of the optimum.
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
@@ -46,6 +47,8 @@ PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
             "cbsh": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True),
             "cbsh_tc": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True,
                                          target=True, corridor=True),
+            "cbsh_rtc": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True,
+                                          target=True, corridor=True, rectangle=True),
             "ecbs": ecbs, "eecbs": eecbs, "pibt": pibt, "lacam": lacam,
             "lacam_star": functools.partial(lacam, swap=True)}
 """The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""

@@ -19,7 +19,9 @@ high level by the sum of costs plus the weighted dependency graph heuristic (Li 
 ``target`` splits a collision on the goal of an agent resting there by when it finishes (target
 reasoning, Li et al., ICAPS 2020; :mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits
 two agents meeting head-on in a corridor by which crosses first (corridor reasoning, ibid.;
-:mod:`jaxswarm.multiagent.corridor`). All keep CBS optimal.
+:mod:`jaxswarm.multiagent.corridor`); ``rectangle`` splits two agents crossing a rectangle of a
+grid on shortest paths by a barrier on each one's way out (rectangle reasoning, Li et al., AAAI
+2019; :mod:`jaxswarm.multiagent.rectangle`). All keep CBS optimal.
 
 CBS is for few agents: the number of nodes grows exponentially with the number of collisions
 that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
@@ -42,6 +44,7 @@ from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, fo
                                              reservations)
 from jaxswarm.multiagent.corridor import Corridors
 from jaxswarm.multiagent.plan import Plan, pack
+from jaxswarm.multiagent.rectangle import Rectangles
 from jaxswarm.multiagent.spacetime import occupancy, search
 from jaxswarm.world.graph import Graph
 
@@ -49,7 +52,7 @@ from jaxswarm.world.graph import Graph
 def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,
         max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False,
         avoid: bool = False, wdg: bool = False, target: bool = False,
-        corridor: bool = False) -> Plan:
+        corridor: bool = False, rectangle: bool = False) -> Plan:
     """Conflict-Based Search.
 
     Args:
@@ -65,16 +68,18 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
         vertex cover first.
       target: split a collision on a resting agent's goal by when that agent finishes.
       corridor: split a head-on collision in a corridor by which agent crosses first.
+      rectangle: split a collision of two agents crossing a rectangle by barriers.
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with
-      ``prioritize``, ``bypass`` and ``avoid``, ``cbsh`` with ``wdg`` too, and ``cbsh_t``,
-      ``cbsh_c`` or ``cbsh_tc`` with ``target``, ``corridor`` or both on top, else ``cbs`` and
-      ``+name`` per switch) with the least sum of costs; not solved when an agent's goal
-      cannot be reached (naming it), when no solution exists (the tree runs out), or at a limit
-      (naming the agents of the collision it was resolving). ``stats``: ``expanded``
-      space-time states, ``nodes`` split, ``bypasses``, ``mdds`` built, ``pairs`` two-agent
-      problems solved for the heuristic, ``corridors`` corridor splits, ``lower_bound`` the
+      ``prioritize``, ``bypass`` and ``avoid``, ``cbsh`` with ``wdg`` too, and ``cbsh_`` with
+      ``r``, ``t`` and ``c`` for ``rectangle``, ``target`` and ``corridor`` on top, as in
+      ``cbsh_rtc``, else ``cbs`` and ``+name`` per switch) with the least sum of costs; not
+      solved when an agent's goal cannot be reached (naming it), when no solution exists (the
+      tree runs out), or at a limit (naming the agents of the collision it was resolving).
+      ``stats``: ``expanded`` space-time states, ``nodes`` split, ``bypasses``, ``mdds``
+      built, ``pairs`` two-agent problems solved for the heuristic, ``corridors`` corridor
+      splits, ``rectangles`` rectangle splits, ``lower_bound`` the
       least sum of costs plus heuristic left (the optimum when solved), ``seconds``.
 
     Raises:
@@ -85,9 +90,11 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
     agents = len(start_nodes)
     instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
                          max_expansions=max_expansions, began=began,
-                         name=_name(prioritize, bypass, avoid, wdg, target, corridor),
+                         name=_name(prioritize, bypass, avoid, wdg, target, corridor,
+                                    rectangle),
                          avoid=avoid, wdg=wdg, target=target,
-                         corridors=Corridors(graph) if corridor else None)
+                         corridors=Corridors(graph) if corridor else None,
+                         rectangles=Rectangles(graph) if rectangle else None)
     blocked = cut_off(graph, instance.fields, start_nodes, goal_nodes)
     if blocked is not None:
         return instance.stop([np.array([s], np.int32) for s in start_nodes], False, blocked[1],
@@ -171,13 +178,15 @@ class _Instance:
     began: float
     counts: dict = dataclasses.field(
         default_factory=lambda: {"expanded": 0, "nodes": 0, "bypasses": 0, "mdds": 0,
-                                 "pairs": 0, "corridors": 0, "lower_bound": 0})
+                                 "pairs": 0, "corridors": 0, "rectangles": 0,
+                                 "lower_bound": 0})
     mdds: dict = dataclasses.field(default_factory=dict)
     name: str = "cbs"
     avoid: bool = False
     wdg: bool = False
     target: bool = False
     corridors: Corridors | None = None
+    rectangles: Rectangles | None = None
     weights: dict = dataclasses.field(default_factory=dict)
 
     def plan_agent(self, agent: int, constraints: Constraints, others=None):
@@ -228,14 +237,14 @@ class _Instance:
 
     def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
         """The two children's constraints for the collision of two agents (their
-        ``constraints`` and node lists ``paths``) arriving at ``step``: a corridor split if
-        ``corridor`` is on and it applies, else one constraint each
+        ``constraints`` and node lists ``paths``) arriving at ``step``: a corridor split, else
+        a rectangle split, where they are on and apply, else one constraint each
         (:func:`~jaxswarm.multiagent.constraints.forbid`, with target reasoning if on)."""
         padded = pack(list(paths))[0]
-        if self.corridors is not None:
-            both = self.corridors.split(constraints, paths, step, padded)
+        for reasoning, count in ((self.corridors, "corridors"), (self.rectangles, "rectangles")):
+            both = reasoning.split(constraints, paths, step, padded) if reasoning else None
             if both is not None:
-                self.counts["corridors"] += 1
+                self.counts[count] += 1
                 return both
         resting_from = np.array([len(path) - 1 for path in paths]) if self.target else None
         return tuple(forbid(constraints[i], padded, i, 1 - i, step, resting_from)
@@ -273,18 +282,19 @@ class _Instance:
 
 
 def _name(prioritize: bool, bypass: bool, avoid: bool, wdg: bool, target: bool,
-          corridor: bool) -> str:
+          corridor: bool, rectangle: bool) -> str:
     """The planner's name in a Plan: ``icbs`` with the first three switches, ``cbsh`` with
-    ``wdg`` too, then ``_t``, ``_c`` or ``_tc`` for the symmetry reasoning on top (as Li et al.
-    name the variants of CBSH2), ``cbs`` and ``+name`` per switch otherwise."""
-    if prioritize and bypass and avoid and not (target or corridor) and not wdg:
+    ``wdg`` too, then ``_`` and ``r``, ``t``, ``c`` for the symmetry reasoning on top (as Li et
+    al. name the variants of CBSH2: ``cbsh_rtc``), ``cbs`` and ``+name`` per switch
+    otherwise."""
+    if prioritize and bypass and avoid and not (target or corridor or rectangle or wdg):
         return "icbs"
     if prioritize and bypass and avoid and wdg:
-        reasoning = "t" * target + "c" * corridor
+        reasoning = "r" * rectangle + "t" * target + "c" * corridor
         return "cbsh" + (f"_{reasoning}" if reasoning else "")
     return "cbs" + "".join(f"+{name}" for name, on in (
         ("prioritize", prioritize), ("bypass", bypass), ("avoid", avoid), ("wdg", wdg),
-        ("target", target), ("corridor", corridor)) if on)
+        ("target", target), ("corridor", corridor), ("rectangle", rectangle)) if on)
 
 
 def _swap(padded: np.ndarray, a: int, b: int, step: int) -> bool:
