@@ -1,6 +1,7 @@
 """Rectangle reasoning for CBS (jaxswarm.multiagent.rectangle, cbs's ``rectangle``): the barriers
-by hand, where the split does not apply, optimality against the joint-state search, and 50 agents
-on an empty map that CBSH-TC does not solve in many more nodes."""
+by hand, where the split does not apply, optimality against the joint-state search, every pair of
+walks breaking both barriers colliding (brute force), and 50 agents on an empty map that CBSH-TC
+does not solve in many more nodes."""
 from __future__ import annotations
 
 import itertools
@@ -54,19 +55,26 @@ def test_no_rectangle_for_a_swap_a_head_on_meeting_or_moves_that_are_not_four_wa
     assert not Rectangles(grid_graph(np.zeros((3, 5), bool), connectivity=8)).usable
 
 
-# Random small grids (as drawn below) whose CBS search takes a rectangle split.
+# Random small grids (as :func:`_small_instance` draws them) whose CBS search takes a rectangle
+# split.
 SPLIT_SEEDS = [9, 23, 31, 62, 70, 88, 114, 118, 175, 196]
 
 
-@pytest.mark.parametrize("seed", SPLIT_SEEDS)
-def test_rectangle_reasoning_is_optimal_on_small_grids_where_it_splits(seed):
+def _small_instance(seed: int):
+    """``(blocked, starts, goals)``: a random grid of 3 to 6 x 3 to 5 cells with 2 or 3
+    agents."""
     rng = np.random.default_rng(seed)
     width, height = int(rng.integers(3, 7)), int(rng.integers(3, 6))
     blocked = rng.random((height, width)) < 0.08
     free = [(x, y) for y in range(height) for x in range(width) if not blocked[y, x]]
     agents = int(rng.integers(2, 4))
     picks = rng.choice(len(free), size=2 * agents, replace=False)
-    starts, goals = [free[i] for i in picks[:agents]], [free[i] for i in picks[agents:]]
+    return blocked, [free[i] for i in picks[:agents]], [free[i] for i in picks[agents:]]
+
+
+@pytest.mark.parametrize("seed", SPLIT_SEEDS)
+def test_rectangle_reasoning_is_optimal_on_small_grids_where_it_splits(seed):
+    blocked, starts, goals = _small_instance(seed)
     graph = grid_graph(blocked, connectivity=4)
     optimum = oracle.mapf_optimum(oracle.grid_adjacency(blocked.tolist(), connectivity=4),
                                   starts, goals)
@@ -78,6 +86,74 @@ def test_rectangle_reasoning_is_optimal_on_small_grids_where_it_splits(seed):
         assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
         split |= plan.stats["rectangles"] > 0
     assert split
+
+
+def _every_walk(blocked: np.ndarray, start: tuple[int, int], steps: int) -> np.ndarray:
+    """i64[P, steps + 1] the node (y * width + x) of every walk of ``steps`` moves or waits from
+    ``start`` on the free cells of ``blocked``."""
+    height, width = blocked.shape
+    moves = np.array([(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)])
+    choice = np.array(list(itertools.product(range(5), repeat=steps))).reshape(-1, steps)
+    cells = np.concatenate([np.broadcast_to(start, (len(choice), 1, 2)),
+                            start + np.cumsum(moves[choice], axis=1)], axis=1)
+    x, y = cells[..., 0], cells[..., 1]
+    inside = ((x >= 0) & (x < width) & (y >= 0) & (y < height)).all(axis=1)
+    x, y = x[inside], y[inside]
+    free = ~blocked[y, x].any(axis=1)
+    return (y * width + x)[free]
+
+
+def _breaks(walks: np.ndarray, barrier: frozenset) -> np.ndarray:
+    """bool[P]: the walks (i64[P, T]) on a barrier's node at its step."""
+    return np.any([walks[:, t] == v for t, v in barrier], axis=0)
+
+
+def _cluttered_instance(seed: int):
+    """``(blocked, starts, goals)``: a random grid of 4 to 6 x 4 or 5 cells, a quarter of them
+    blocked, with 2 agents."""
+    rng = np.random.default_rng(seed)
+    width, height = int(rng.integers(4, 7)), int(rng.integers(4, 6))
+    blocked = rng.random((height, width)) < 0.25
+    free = [(x, y) for y in range(height) for x in range(width) if not blocked[y, x]]
+    picks = rng.choice(len(free), size=4, replace=False)
+    return blocked, [free[i] for i in picks[:2]], [free[i] for i in picks[2:]]
+
+
+# The cluttered seeds are grids where barriers without the shortest-path conditions (every
+# cell of the side at its Manhattan step from the entry) let two walks break both and not
+# collide.
+@pytest.mark.parametrize("instance", [_small_instance(seed) for seed in SPLIT_SEEDS]
+                         + [_cluttered_instance(seed) for seed in (143, 916)],
+                         ids=[f"small-{seed}" for seed in SPLIT_SEEDS]
+                         + [f"cluttered-{seed}" for seed in (143, 916)])
+def test_two_walks_that_both_break_their_barriers_collide(instance, monkeypatch):
+    # Every rectangle split the search makes, checked against every pair of walks of the two
+    # agents up to the barriers' last step: none that breaks both barriers is collision-free,
+    # so every solution keeps one child's constraints.
+    blocked, starts, goals = instance
+    graph = grid_graph(blocked, connectivity=4)
+    splits, split = [], Rectangles.split
+
+    def recorded(self, constraints, paths, step, padded):
+        both = split(self, constraints, paths, step, padded)
+        if both is not None:
+            splits.append(([int(path[0]) for path in paths],
+                           [both[i].vertex - constraints[i].vertex for i in (0, 1)]))
+        return both
+
+    monkeypatch.setattr(Rectangles, "split", recorded)
+    assert cbs(graph, starts, goals, prioritize=True, bypass=True, rectangle=True).solved
+    assert splits
+    width = blocked.shape[1]
+    for start_nodes, barriers in splits:
+        steps = max(t for barrier in barriers for t, _ in barrier)
+        walks = [_every_walk(blocked, (s % width, s // width), steps) for s in start_nodes]
+        first, second = (walks[i][_breaks(walks[i], barriers[i])] for i in (0, 1))
+        assert len(first) and len(second)
+        on_one_node = (first[:, None, :] == second[None, :, :]).any(axis=2)
+        swapping = ((first[:, None, :-1] == second[None, :, 1:])
+                    & (first[:, None, 1:] == second[None, :, :-1])).any(axis=2)
+        assert (on_one_node | swapping).all()
 
 
 def test_rectangles_solve_fifty_agents_on_an_empty_map_in_few_nodes(movingai_dir):
