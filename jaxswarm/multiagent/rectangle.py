@@ -42,21 +42,21 @@ class Rectangles:
     """Rectangle reasoning on a grid and the distances it needs (cached).
 
     Attributes:
-      cells: i64[N, 2] each node's ``(x, y)`` cell.
-      usable: whether every move is one cell up, down, left or right (otherwise no split
-        applies).
+      shape: the grid's ``(H, W)`` (None for a graph that is not a grid).
+      cells: i64[N, 2] each node's ``(x, y)`` cell (node ``y * W + x``) on a grid.
+      usable: whether the map is a grid where every move is one cell up, down, left or right
+        (otherwise no split applies).
     """
 
     def __init__(self, graph: Graph):
         self.arrays = edge_arrays(graph)
-        self.cells = np.rint(np.asarray(graph.xy)).astype(np.int64)
-        tails = np.repeat(np.arange(graph.num_nodes), np.diff(self.arrays.indptr))
-        steps = np.abs(self.cells[self.arrays.heads] - self.cells[tails]).sum(axis=1)
-        self.usable = bool(graph.is_grid and np.all(steps == 1))
-        width = int(self.cells[:, 0].max(initial=0)) + 1
-        self.node_at = np.full((int(self.cells[:, 1].max(initial=0)) + 1, width), -1, np.int64)
-        self.node_at[self.cells[:, 1], self.cells[:, 0]] = np.arange(graph.num_nodes)
-        self._fields = {}
+        self.shape, self.usable, self._fields = graph.shape, graph.is_grid, {}
+        if self.usable:
+            nodes = np.arange(graph.num_nodes)
+            self.cells = np.stack([nodes % self.shape[1], nodes // self.shape[1]], axis=1)
+            tails = np.repeat(nodes, np.diff(self.arrays.indptr))
+            steps = np.abs(self.cells[self.arrays.heads] - self.cells[tails]).sum(axis=1)
+            self.usable = bool(np.all(steps == 1))
 
     def distances(self, start: int, avoiding: int = -1) -> np.ndarray:
         """i32[N] the fewest steps from ``start`` to every node, avoiding node ``avoiding``
@@ -133,19 +133,18 @@ class Rectangles:
 
     def _barrier(self, side, sign: np.ndarray, entry: int, entry_step: int, start: int,
                  field: np.ndarray) -> frozenset:
-        """The vertex constraints ``(t, v)`` of one agent's barrier: the free cells of ``side``
-        (mirrored ``(x, y)`` cells) it reaches from its ``entry`` node, visited at
+        """The vertex constraints ``(t, v)`` of one agent's barrier: the cells of ``side``
+        (mirrored ``(x, y)`` cells; a blocked one is never reached) it reaches from its ``entry`` node, visited at
         ``entry_step``, on a shortest path, at the step it would, where every shortest path
         from its ``start`` passes ``entry``."""
         around = self.distances(start, avoiding=entry) if entry != start else None
+        height, width = self.shape
         barrier = set()
         for cell in side:
             x, y = np.asarray(cell) * sign
-            if not (0 <= y < self.node_at.shape[0] and 0 <= x < self.node_at.shape[1]):
+            if not (0 <= y < height and 0 <= x < width):
                 continue
-            node = int(self.node_at[y, x])
-            if node < 0:
-                continue
+            node = int(y * width + x)
             at = entry_step + int(np.abs(self.cells[node] - self.cells[entry]).sum())
             if field[node] == at and (around is None or around[node] > at):
                 barrier.add((at, node))
