@@ -41,10 +41,10 @@ goal (:func:`~jaxswarm.multiagent.lower_bound`), ignoring the others; the ``.sce
 column is an 8-connected optimum and is **not** used. Every solved plan is checked by
 :func:`~jaxswarm.multiagent.validate` (an invalid one raises :class:`InvalidPlan`: a planner bug),
 its sum of costs must be at least the lower bound, no planner may beat a solved optimal one (CBS,
-ICBS, CBSH-TC) on the same instance, and ECBS and EECBS must stay within w of their proven bound
-(else :class:`InvalidPlan` too). A planner that raises is recorded as not solved, with the
-exception as its reason and ``error`` set; the study goes on, writes its files and exits with
-status 1.
+ICBS, CBSH-TC, CBSH-RTC) on the same instance, and ECBS and EECBS must stay within w of their
+proven bound (else :class:`InvalidPlan` too). A planner that raises is recorded as not solved,
+with the exception as its reason and ``error`` set; the study goes on, writes its files and exits
+with status 1.
 
 Per run (map, scenario, agents, planner, seed) ``runs.csv`` holds: solved, sum of costs, lower
 bound, their ratio, makespan (blank when not solved), time (s, wall time of the planner call,
@@ -98,8 +98,9 @@ from typing import Callable
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.multiagent import (Instance, Plan, cbs, ecbs, eecbs, lacam, load_instance,
-                                 lower_bound, pack, pibt, prioritized, report_scheme, validate)
+from jaxswarm.multiagent import PLANNERS as NAMED
+from jaxswarm.multiagent import (Instance, Plan, cbs, lacam, load_instance, lower_bound, pack,
+                                 pibt, prioritized, report_scheme, validate)
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
@@ -150,8 +151,9 @@ ABOUT = (
     "collisions and bypassing (Boyarski et al. 2015; `icbs`, optimal), ICBS with the weighted "
     "dependency graph heuristic (Li et al. 2019) and target and corridor reasoning (Li et al. "
     "2020; `cbsh_tc`, optimal) and with rectangle reasoning too (Li et al. 2019, its barriers "
-    "timed by static distances; `cbsh_rtc`, optimal), Enhanced CBS (Barer et al. 2014; `ecbs`) and Explicit "
-    "Estimation CBS (Li et al. 2021, without the CBS improvements of its paper; `eecbs`), both "
+    "timed by static distances; `cbsh_rtc`, optimal), Enhanced CBS (Barer et al. 2014; "
+    "`ecbs`) and Explicit Estimation CBS (Li et al. 2021, without the CBS improvements of its "
+    "paper; `eecbs`), both "
     "within w of the optimum, PIBT (Okumura et al. 2022), LaCAM (Okumura, "
     "AAAI 2023; its first solution) and with LaCAM*'s successor generator (Okumura, IJCAI "
     "2023: PIBT with the swap operation; its first solution), and pymapf's LaCAM and CBS where "
@@ -298,21 +300,13 @@ def planner_calls(seeds: int, time_limit: float, w: float, with_pymapf: bool,
              ("prioritized (distance)", None, functools.partial(ranked, order="distance"))]
     calls += [(RANDOM, seed, functools.partial(ranked, order="random", seed=seed))
               for seed in range(seeds)]
-    calls += [("cbs", None, functools.partial(cbs, time_limit=time_limit)),
-              ("icbs", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
-                                               bypass=True, avoid=True)),
-              ("cbsh_tc", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
-                                                  bypass=True, avoid=True, wdg=True,
-                                                  target=True, corridor=True)),
-              ("cbsh_rtc", None, functools.partial(cbs, time_limit=time_limit, prioritize=True,
-                                                   bypass=True, avoid=True, wdg=True,
-                                                   target=True, corridor=True,
-                                                   rectangle=True)),
-              ("ecbs", None, functools.partial(ecbs, w=w, time_limit=time_limit)),
-              ("eecbs", None, functools.partial(eecbs, w=w, time_limit=time_limit)),
-              ("pibt", None, pibt),
-              ("lacam", None, functools.partial(lacam, time_limit=time_limit)),
-              ("lacam_star", None, functools.partial(lacam, time_limit=time_limit, swap=True))]
+    calls += [(name, None, functools.partial(NAMED[name], time_limit=time_limit))
+              for name in OPTIMAL]
+    calls += [(name, None, functools.partial(NAMED[name], w=w, time_limit=time_limit))
+              for name in BOUNDED]
+    calls += [("pibt", None, pibt)]
+    calls += [(name, None, functools.partial(NAMED[name], time_limit=time_limit))
+              for name in ("lacam", "lacam_star")]
     if with_pymapf:
         calls += [(f"pymapf {solver}", None, pymapf_planner(solver, time_limit))
                   for solver in ("lacam", "cbs")]

@@ -22,11 +22,11 @@ right column and top row are where the two agents' straight runs end, the vertic
 leaving through the top row and the horizontal one through the right column. So such a path of
 the vertical agent joins the bottom row to the top row inside the rectangle's columns, and one
 of the horizontal agent joins the left column to the right column inside its rows: the two
-share a cell ``w``. Both reach it at the step their entries and ``w`` give, which is the same step when
-``D_V(S_V) - S_V.x - S_V.y = D_H(S_H) - S_H.x - S_H.y``. So two paths that both break their
-barriers collide, every solution keeps one of the two barriers, and the split keeps CBS complete
-and optimal. It is taken only where both agents' current paths break their barriers (so both
-children differ from the node); otherwise CBS splits as usual.
+share a cell ``w``. Both reach it at the step their entries and ``w`` give, which is the same
+step when ``D_V(S_V) - S_V.x - S_V.y = D_H(S_H) - S_H.x - S_H.y``. So two paths that both
+break their barriers collide, every solution keeps one of the two barriers, and the split keeps
+CBS complete and optimal. It is taken only where both agents' current paths break their barriers
+(so both children differ from the node); otherwise CBS splits as usual.
 """
 from __future__ import annotations
 
@@ -134,9 +134,9 @@ class Rectangles:
     def _barrier(self, side, sign: np.ndarray, entry: int, entry_step: int, start: int,
                  field: np.ndarray) -> frozenset:
         """The vertex constraints ``(t, v)`` of one agent's barrier: the cells of ``side``
-        (mirrored ``(x, y)`` cells; a blocked one is never reached) it reaches from its ``entry`` node, visited at
-        ``entry_step``, on a shortest path, at the step it would, where every shortest path
-        from its ``start`` passes ``entry``."""
+        (mirrored ``(x, y)`` cells; a blocked one is never reached) it reaches from its
+        ``entry`` node, visited at ``entry_step``, on a shortest path, at the step it would,
+        where every shortest path from its ``start`` passes ``entry``."""
         around = self.distances(start, avoiding=entry) if entry != start else None
         height, width = self.shape
         barrier = set()
