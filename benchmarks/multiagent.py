@@ -1,6 +1,6 @@
 """Multi-agent planning: prioritised planning on a MAPF benchmark instance, the batched JAX
-conflict check beside a pure-Python one on the same solutions, PIBT's step and LaCAM's solve
-times.
+conflict check beside a pure-Python one on the same solutions, PIBT's step, LaCAM's solve
+times and CBSH-RTC's constraint-tree nodes per second.
 
 What is measured
 ----------------
@@ -70,12 +70,21 @@ What is measured
    ``total s`` the call as users make it; the goal is the total within 10 s on one core.
    ``configurations`` counts LaCAM's high-level nodes, the useful work.
 
+4. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
+   ``--cbs`` (default ``room-32-32-4-even-1`` and ``maze-32-32-2-even-1``, two of the 32 x 32
+   files the issue's check names), stopped after ``--cbs-nodes`` constraint-tree nodes (default
+   2,000): one warm-up call on 3 agents, then ``--cbs-repeats`` calls (default 3). The search
+   is deterministic, so every call must split as many nodes and expand as many space-time
+   states (the useful work; the script exits 1 otherwise); ``median s`` is the median call,
+   ``nodes/s`` the nodes over it, ``k states/s`` the low-level states over it, ``pairs`` the
+   two-agent problems its heuristic solved.
+
 XLA:CPU runs on ``--threads`` intra-op threads (default 1, as in ``benchmarks/rfd.py``: the
 Python check runs on one core too; see :mod:`jaxswarm.runtime.cpu`).
 
 How to run
 ----------
-From the repository root (defaults take about 15 s on 2 cores)::
+From the repository root (defaults take about 30 s on 2 cores)::
 
     python benchmarks/multiagent.py
     python benchmarks/multiagent.py --quick
@@ -99,8 +108,8 @@ import numba
 import numpy as np
 
 from jaxswarm.maps.movingai import read_map
-from jaxswarm.multiagent import (ORDERS, find_conflicts, hop_fields, lacam, load_instance,
-                                 lower_bound, prioritized, validate)
+from jaxswarm.multiagent import (ORDERS, PLANNERS, find_conflicts, hop_fields, lacam,
+                                 load_instance, lower_bound, prioritized, validate)
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
@@ -115,6 +124,8 @@ PIBT_MAP = "random-32-32-20"
 LACAM_INSTANCES = "random-32-32-20:400,random-64-64-10:400,room-64-64-8:400"
 GOAL_STEP_MS = 1.0
 GOAL_LACAM_S = 10.0
+CBS_FILES = "room-32-32-4-even-1,maze-32-32-2-even-1"
+CBS_AGENTS = 20
 
 
 def machine() -> str:
@@ -347,6 +358,30 @@ def _lacam_row(name: str, agents: int, plan, valid: bool, total: float, bound: i
             "met" if valid and total <= GOAL_LACAM_S else "NOT met")
 
 
+def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[list[tuple],
+                                                                              bool]:
+    """Part 4: (table rows, whether every call of a file did the same work)."""
+    rows, same = [], True
+    for scenario in files:
+        name = scenario.rsplit("-", 2)[0]  # the map's name: without "-even-1" or "-random-1"
+        instance = load_instance(mapf / f"{name}.map", mapf / f"{scenario}.scen", CBS_AGENTS)
+        graph, starts, goals = instance.graph, instance.starts, instance.goals
+        PLANNERS["cbsh_rtc"](graph, starts[:3], goals[:3])  # load the kernels
+        times, work = [], set()
+        for _ in range(repeats):
+            began = time.perf_counter()
+            plan = PLANNERS["cbsh_rtc"](graph, starts, goals, max_nodes=nodes, time_limit=600)
+            times.append(time.perf_counter() - began)
+            work.add((plan.stats["nodes"], plan.stats["expanded"], plan.stats["pairs"]))
+        same &= len(work) == 1
+        split, states, pairs = work.pop()
+        median = statistics.median(times)
+        rows.append((scenario, CBS_AGENTS, f"{split:,}", f"{median:.2f}", f"{split / median:,.0f}",
+                     f"{states / median / 1e3:,.0f}", f"{pairs:,}",
+                     "yes" if plan.solved else f"no ({plan.stats['lower_bound']} bound)"))
+    return rows, same
+
+
 def main(argv: list[str] | None = None) -> int:
     """Parse the options, run both parts, print the tables; 1 if a result is wrong."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -367,6 +402,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--pibt-steps", type=int, default=200, help="PIBT steps timed")
     parser.add_argument("--lacam", default=LACAM_INSTANCES,
                         help="LaCAM's instances, MAP:AGENTS comma-separated (random-1 scenarios)")
+    parser.add_argument("--cbs", default=CBS_FILES,
+                        help="CBSH-RTC's scenario files, comma-separated (first 20 rows each)")
+    parser.add_argument("--cbs-nodes", type=int, default=2000,
+                        help="constraint-tree nodes after which each CBSH-RTC call stops")
+    parser.add_argument("--cbs-repeats", type=int, default=3, help="timed CBSH-RTC calls")
     parser.add_argument("--threads", type=int, default=1,
                         help="XLA:CPU intra-op threads (jaxswarm.runtime.cpu.configure)")
     parser.add_argument("--data", type=Path, default=REPO.parent / "shared",
@@ -379,8 +419,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.quick:
         args.repeats, args.check_repeats, args.check_agents, args.check_steps = 2, 2, 200, 200
         args.pibt_steps, args.lacam = 20, "random-32-32-20:100"
+        args.cbs_nodes, args.cbs_repeats = 200, 2
     for name in ("agents", "repeats", "check_agents", "check_repeats", "threads", "pibt_agents",
-                 "pibt_steps"):
+                 "pibt_steps", "cbs_nodes", "cbs_repeats"):
         if getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
     if args.check_steps < 2:
@@ -441,6 +482,12 @@ def main(argv: list[str] | None = None) -> int:
                     "configurations", "SoC/bound", f"{GOAL_LACAM_S:g} s goal"), rows,
                    "lrllrrrrrl"))
     plans_ok &= lacam_ok
+    rows, cbs_ok = bench_cbs(mapf, args.cbs.split(","), args.cbs_nodes, args.cbs_repeats)
+    print(f"\nCBSH-RTC, stopped after {args.cbs_nodes:,} nodes: median of {args.cbs_repeats} "
+          f"calls after a warm-up on 3 agents\n")
+    print(markdown(("scenario", "agents", "nodes", "median s", "nodes/s", "k states/s", "pairs",
+                    "solved"), rows, "lrrrrrrl"))
+    plans_ok &= cbs_ok
     verdict = "every plan valid" if plans_ok else "A PLAN IS INVALID OR DIFFERS (see above)"
     print(f"plans: {verdict} | benchmark took {time.perf_counter() - began:.0f} s")
     return 0 if plans_ok else 1

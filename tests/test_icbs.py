@@ -162,7 +162,7 @@ def test_the_avoidance_table_picks_the_shortest_path_meeting_fewest_agents():
                        connectivity=4)
     field = hop_fields(graph, np.array([5]))[0]
     table = Reservations.empty(graph.num_nodes)
-    resting = occupancy([np.array([1])], graph.num_nodes)
+    resting = occupancy(np.array([[1]], np.int32), graph.num_nodes)
     path, _, _ = search(graph, 3, 5, field, table, avoid=resting)
     plain, _, _ = search(graph, 3, 5, field, table)
     assert path.tolist() == [3, 6, 7, 8, 5] and len(plain) == len(path)

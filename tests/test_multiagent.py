@@ -4,6 +4,7 @@ optimum and each other."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import jax.numpy as jnp
 import numpy as np
@@ -147,6 +148,33 @@ def test_batched_conflicts_match_all_pairs(monkeypatch, table_entries):
     """Random walks with many collisions on a 6 x 6 grid; 64 table entries force one step per
     chunk and a padded last chunk."""
     monkeypatch.setattr(conflicts_module, "TABLE_ENTRIES", table_entries)
+    graph, walks = _colliding_walks()
+    found = find_conflicts(walks, graph.num_nodes)
+    vertex, swap = oracle.pairwise_conflicts(walks.tolist())
+    assert {(int(t), int(a)) for t, a in zip(*np.nonzero(found.vertex))} == vertex
+    assert vertex and swap, "the walks should collide"
+    # A swap partner is reported unless the partner shares its node with a third agent.
+    reported = {(int(t), int(a), int(found.swap[t, a])) for t, a in zip(*np.nonzero(
+        found.swap >= 0))}
+    assert reported <= swap
+    assert {s for s in swap if (s[0], s[2]) not in vertex} <= reported
+
+
+def test_pair_collisions_are_each_pairs_first_vertex_or_swap_step():
+    _, walks = _colliding_walks()
+    first = conflicts_module.pair_collisions(walks)
+    for a, b in itertools.permutations(range(len(walks)), 2):
+        here, there = walks[a], walks[b]
+        steps = [t for t in range(walks.shape[1]) if here[t] == there[t]
+                 or (t > 0 and here[t - 1] == there[t] and here[t] == there[t - 1]
+                     and here[t] != here[t - 1])]
+        assert first[a, b] == (steps[0] if steps else -1), (a, b)
+    assert (first >= 0).sum() > 20 and (first[~np.eye(len(walks), dtype=bool)] < 0).any()
+    assert (conflicts_module.pair_collisions(walks, [7, 3]) == first[[7, 3]]).all()
+
+
+def _colliding_walks():
+    """A 6 x 6 grid and 12 random walks of 23 steps on it (i64[12, 23]), colliding often."""
     rng = np.random.default_rng(3)
     graph = grid_graph(np.zeros((6, 6), bool), connectivity=4)
     nbr = np.asarray(graph.nbr)
@@ -157,15 +185,7 @@ def test_batched_conflicts_match_all_pairs(monkeypatch, table_entries):
         pick = rng.integers(0, 5, size=12)
         step = options[np.arange(12), pick]
         walks[:, t] = np.where(step >= 0, step, walks[:, t - 1])
-    found = find_conflicts(walks, graph.num_nodes)
-    vertex, swap = oracle.pairwise_conflicts(walks.tolist())
-    assert {(int(t), int(a)) for t, a in zip(*np.nonzero(found.vertex))} == vertex
-    assert vertex and swap, "the walks should collide"
-    # A swap partner is reported unless the partner shares its node with a third agent.
-    reported = {(int(t), int(a), int(found.swap[t, a])) for t, a in zip(*np.nonzero(
-        found.swap >= 0))}
-    assert reported <= swap
-    assert {s for s in swap if (s[0], s[2]) not in vertex} <= reported
+    return graph, walks
 
 
 # --- the planners ---------------------------------------------------------------------------

@@ -15,7 +15,8 @@ child's path into its parent instead of splitting when the child costs no more a
 (ibid.); ``avoid`` has the low level break ties between shortest paths toward the one meeting the
 fewest other agents (a conflict avoidance table, as CBS implementations do); ``wdg`` orders the
 high level by the sum of costs plus the weighted dependency graph heuristic (Li et al., IJCAI
-2019; :mod:`jaxswarm.multiagent.dependency`), with pathmax: CBSH-WDG with all four;
+2019; :mod:`jaxswarm.multiagent.dependency`), with pathmax, computed when a node first reaches
+the top of the frontier (most never do): CBSH-WDG with all four;
 ``target`` splits a collision on the goal of an agent resting there by when it finishes (target
 reasoning, Li et al., ICAPS 2020; :mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits
 two agents meeting head-on in a corridor by which crosses first (corridor reasoning, ibid.;
@@ -108,10 +109,18 @@ def _search(instance: "_Instance", agents: int, max_nodes: int, time_limit: floa
     choose = (instance.prioritized_collision if prioritize
               else lambda node: earliest_collision(node.collisions))
     tiebreak = itertools.count()
-    frontier = [instance.bounded(_root(instance, agents, next(tiebreak)))]
+    frontier = [_root(instance, agents, next(tiebreak))]
     last = None
     while frontier:
         node = heapq.heappop(frontier)
+        if not node.informed:
+            # The heuristic is computed for the nodes that reach the top of the frontier
+            # only: most generated nodes never do. One it raises goes back to wait its turn.
+            informed = instance.bounded(node)
+            if informed.bound > node.bound:
+                heapq.heappush(frontier, informed)
+                continue
+            node = informed
         instance.counts["lower_bound"] = node.bound
         collision = choose(node)
         if collision is None:
@@ -127,7 +136,7 @@ def _search(instance: "_Instance", agents: int, max_nodes: int, time_limit: floa
         if bypass:
             children = _bypassed(instance, node, children, last, tiebreak)
         for child in children:
-            heapq.heappush(frontier, instance.bounded(child, node.bound))
+            heapq.heappush(frontier, child._replace(bound=max(node.bound, child.cost)))
     waiting = [np.array([s], np.int32) for s in instance.start_nodes]
     return instance.stop(waiting, False, "no solution exists: every way of resolving the "
                                          f"collisions of agents {last[0]} and {last[1]} "
@@ -138,14 +147,20 @@ class _Node(NamedTuple):
     """A constraint-tree node, as a heap entry ordered by its first three fields.
 
     Attributes:
-      bound: a lower bound of the sum of costs below it: ``cost``, or with ``wdg`` the
-        heuristic added.
+      bound: a lower bound of the sum of costs below it: at least its parent's bound and
+        ``cost``, and, once ``informed``, with ``wdg`` at least ``cost`` plus the heuristic.
       colliding_pairs: how many pairs of agents collide.
       order: its creation number, the oldest first at equal bound and pairs.
       cost: the sum of costs of its paths.
       paths: per agent, its node list i32[T_a].
       constraints: per agent, its :class:`~jaxswarm.multiagent.constraints.Constraints`.
       collisions: i32[A, A] as :func:`pair_collisions` gives them for ``paths``.
+      padded: i32[A, T] ``paths`` padded (each resting at its goal after its end).
+      classes: ``(a, b)``: the class of the first collision of agents a < b
+        (:func:`mdd.classify`), filled as ``prioritize`` needs them; a child keeps those of
+        the pairs without its re-planned agent.
+      informed: whether ``bound`` holds the heuristic (with ``wdg``; computed when the node
+        first reaches the top of the frontier).
     """
 
     bound: int
@@ -155,6 +170,9 @@ class _Node(NamedTuple):
     paths: list
     constraints: list
     collisions: np.ndarray
+    padded: np.ndarray
+    classes: dict
+    informed: bool = False
 
 
 @dataclasses.dataclass
@@ -191,11 +209,10 @@ class _Instance:
 
     def plan_agent(self, agent: int, constraints: Constraints, others=None):
         """The agent's fewest-steps path (i32[T]) under its ``constraints``, or None; with
-        ``avoid`` and ``others`` (the paths of the other agents, or, at the root, of those
-        planned so far; the agent's own entry is skipped), the one meeting the fewest of
-        them."""
-        table = (occupancy([path for a, path in enumerate(others) if a != agent],
-                           self.graph.num_nodes) if self.avoid and others is not None else None)
+        ``avoid`` and ``others`` (i32[B, T] the padded paths of the other agents, or, at the
+        root, of those planned so far), the one meeting the fewest of them."""
+        table = (occupancy(others, self.graph.num_nodes)
+                 if self.avoid and others is not None else None)
         path, expanded, _ = search(self.graph, int(self.start_nodes[agent]),
                                    int(self.goal_nodes[agent]), self.fields[agent],
                                    reservations(self.graph.num_nodes, constraints),
@@ -222,17 +239,18 @@ class _Instance:
         pairs = np.argwhere(np.triu(node.collisions >= 0, 1))
         if not pairs.size:
             return None
-        padded = pack(node.paths)[0]
-        best = None
+        padded = node.padded
         for a, b in pairs.tolist():
-            step = int(node.collisions[a, b])
-            sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
-                                      int(self.goal_nodes[x]), step, int(padded[x, step]),
-                                      int(padded[x, step - 1]) if _swap(padded, a, b, step)
-                                      else int(padded[x, step]))
-                     for x in (a, b)]
-            key = (mdd.classify(*sides), step, a, b)
-            best = key if best is None or key < best else best
+            if (a, b) not in node.classes:
+                step = int(node.collisions[a, b])
+                sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
+                                          int(self.goal_nodes[x]), step, int(padded[x, step]),
+                                          int(padded[x, step - 1]) if _swap(padded, a, b, step)
+                                          else int(padded[x, step]))
+                         for x in (a, b)]
+                node.classes[a, b] = mdd.classify(*sides)
+        best = min((node.classes[a, b], int(node.collisions[a, b]), a, b)
+                   for a, b in pairs.tolist())
         return (best[2], best[3]), best[1]
 
     def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
@@ -250,16 +268,16 @@ class _Instance:
         return tuple(forbid(constraints[i], padded, i, 1 - i, step, resting_from)
                      for i in (0, 1))
 
-    def bounded(self, node: "_Node", parent_bound: int = 0) -> "_Node":
-        """``node`` with its bound: its cost, or with ``wdg`` its cost plus the vertex cover
-        of its colliding pairs' dependency weights, and at least ``parent_bound``."""
+    def bounded(self, node: "_Node") -> "_Node":
+        """``node`` informed: with ``wdg``, its bound raised to its cost plus the vertex cover
+        of its colliding pairs' dependency weights where that is larger."""
         if not self.wdg:
-            return node
+            return node._replace(informed=True)
         weights = {}
         for a, b in np.argwhere(np.triu(node.collisions >= 0, 1)).tolist():
             weights[a, b] = self.pair_weight(node, a, b)
-        return node._replace(bound=max(parent_bound,
-                                       node.cost + dependency.vertex_cover(weights)))
+        return node._replace(bound=max(node.bound, node.cost + dependency.vertex_cover(weights)),
+                             informed=True)
 
     def pair_weight(self, node: "_Node", a: int, b: int) -> int:
         """The dependency weight of agents ``a`` and ``b`` under ``node``'s constraints
@@ -322,7 +340,8 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
     both = instance.split(tuple(node.constraints[a] for a in pair),
                           tuple(node.paths[a] for a in pair), step)
     for agent, constraints in zip(pair, both):
-        path = instance.plan_agent(agent, constraints, others=node.paths)
+        path = instance.plan_agent(agent, constraints,
+                                   others=np.delete(node.padded, agent, axis=0))
         if path is not None:
             children.append(_child(node, agent, path, constraints, next(tiebreak)))
     return children
@@ -334,8 +353,10 @@ def _root(instance: _Instance, agents: int, order: int) -> _Node:
     no_constraints = [Constraints()] * agents
     paths = []
     for a in range(agents):
-        paths.append(instance.plan_agent(a, no_constraints[a], others=paths))
-    return _node(paths, no_constraints, pair_collisions(pack(paths)[0]), order)
+        paths.append(instance.plan_agent(a, no_constraints[a],
+                                         others=pack(paths)[0] if paths else None))
+    padded = pack(paths)[0]
+    return _node(paths, no_constraints, pair_collisions(padded), padded, {}, order)
 
 
 def _bypassed(instance: _Instance, node: _Node, children: list[_Node], pair: tuple[int, int],
@@ -358,17 +379,26 @@ def _child(node: _Node, agent: int, path, constraints: Constraints, order: int) 
     paths[agent] = path
     all_constraints = list(node.constraints)
     all_constraints[agent] = constraints
+    steps = node.padded.shape[1]
+    padded = np.empty((len(paths), max(steps, len(path))), np.int32)
+    padded[:, :steps] = node.padded
+    padded[:, steps:] = node.padded[:, -1:]
+    padded[agent, :len(path)] = path
+    padded[agent, len(path):] = path[-1]
     # Only the re-planned agent's collisions change.
     collisions = node.collisions.copy()
-    changed = pair_collisions(pack(paths)[0], [agent])[0]
+    changed = pair_collisions(padded, [agent])[0]
     collisions[agent, :] = changed
     collisions[:, agent] = changed
-    return _node(paths, all_constraints, collisions, order)
+    classes = {pair: kind for pair, kind in node.classes.items() if agent not in pair}
+    return _node(paths, all_constraints, collisions, padded, classes, order)
 
 
-def _node(paths, constraints, collisions: np.ndarray, order: int) -> _Node:
-    """The node of ``paths`` (node lists), ``constraints`` and their ``collisions`` i32[A, A]
-    (as :func:`pair_collisions` gives them), made ``order``-th."""
+def _node(paths, constraints, collisions: np.ndarray, padded: np.ndarray, classes: dict,
+          order: int) -> _Node:
+    """The node of ``paths`` (node lists; ``padded`` i32[A, T]), ``constraints``, their
+    ``collisions`` i32[A, A] (as :func:`pair_collisions` gives them) and the ``classes`` of
+    those already known, made ``order``-th."""
     cost = sum(len(path) - 1 for path in paths)
     return _Node(cost, int((collisions >= 0).sum()) // 2, order, cost, paths, constraints,
-                 collisions)
+                 collisions, padded, classes)

@@ -21,6 +21,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxswarm.exact.kernels import jit
+
 TABLE_ENTRIES = 1 << 16
 """Occupancy-table entries per chunk of time steps (chunk = this // nodes, at least 1 step)."""
 
@@ -105,19 +107,33 @@ def pair_collisions(paths, agents=None) -> np.ndarray:
     """i32[B, A]: the first step at which each of ``agents`` (default all, B = A) collides with
     each agent, -1 if never.
 
-    A collision at step t is a vertex conflict at t or a swap arriving at t. Host numpy over all
-    pairs (O(B A T) memory): for the planners' decisions on few agents, not for validation.
+    A collision at step t is a vertex conflict at t or a swap arriving at t. A compiled loop
+    over the pairs (O(B A T) time, stopping at each pair's first collision): for the planners'
+    decisions on few agents, not for validation.
 
     Args:
       paths: i32[A, T] padded paths.
       agents: optional i32[B] rows to compute.
     """
-    paths = np.asarray(paths)
-    rows = np.arange(len(paths)) if agents is None else np.asarray(agents).reshape(-1)
-    here = paths[rows][:, None, :]
-    there = paths[None, :, :]
-    hit = here == there
-    hit[:, :, 1:] |= ((here[:, :, :-1] == there[:, :, 1:]) & (here[:, :, 1:] == there[:, :, :-1])
-                      & (here[:, :, 1:] != here[:, :, :-1]))
-    hit[np.arange(len(rows)), rows] = False
-    return np.where(hit.any(axis=2), np.argmax(hit, axis=2), -1).astype(np.int32)
+    paths = np.ascontiguousarray(paths, np.int32)
+    rows = (np.arange(len(paths), dtype=np.int32) if agents is None
+            else np.asarray(agents, np.int32).reshape(-1))
+    return _first_collisions(paths, rows)
+
+
+@jit
+def _first_collisions(paths, rows):
+    agents, steps = paths.shape
+    first = np.full((len(rows), agents), -1, np.int32)
+    for i in range(len(rows)):
+        a = rows[i]
+        for b in range(agents):
+            if b == a:
+                continue
+            for t in range(steps):
+                here, there = paths[a, t], paths[b, t]
+                if here == there or (t > 0 and paths[a, t - 1] == there
+                                     and here == paths[b, t - 1] and here != paths[a, t - 1]):
+                    first[i, b] = t
+                    break
+    return first

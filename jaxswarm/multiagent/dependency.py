@@ -18,6 +18,7 @@ cover.
 """
 from __future__ import annotations
 
+import functools
 import heapq
 import itertools
 from typing import Callable
@@ -92,9 +93,22 @@ def vertex_cover(weights: dict[tuple[int, int], int]) -> int:
             continue
         component = _component(neighbours, vertex)
         seen |= component
-        total += (_exact_cover(component, neighbours) if len(component) <= EXACT_VERTICES
-                  else _matching(component, neighbours))
+        total += _component_cover(tuple(sorted((a, b, w) for a in component
+                                               for b, w in neighbours[a].items() if a < b)))
     return total
+
+
+@functools.lru_cache(maxsize=1 << 16)
+def _component_cover(edges: tuple[tuple[int, int, int], ...]) -> int:
+    """The cover of one connected component, given as its sorted edges ``(a, b, w)`` (cached:
+    a constraint-tree node's children share most of its components)."""
+    neighbours: dict[int, dict[int, int]] = {}
+    for a, b, weight in edges:
+        neighbours.setdefault(a, {})[b] = weight
+        neighbours.setdefault(b, {})[a] = weight
+    component = set(neighbours)
+    return (_exact_cover(component, neighbours) if len(component) <= EXACT_VERTICES
+            else _matching(component, neighbours))
 
 
 def _component(neighbours: dict, vertex: int) -> set[int]:

@@ -211,7 +211,8 @@ class _Search:
         """``(path i32[T], lower bound on its cost)`` of the low-level focal search, or None."""
         vertex, edge = constraints.vertex, constraints.edge
         others = [path for a, path in enumerate(paths) if a != agent]
-        occupied = occupancy(others, self.graph.num_nodes)
+        occupied = occupancy(pack(others)[0] if others else np.zeros((0, 1), np.int32),
+                             self.graph.num_nodes)
         horizon = max([t + 1 for t, _ in vertex] + [t + 1 for t, _, _ in edge]
                       + [len(occupied)])
         goal, field = int(self.goals[agent]), self.fields[agent]

@@ -62,8 +62,10 @@ def pack(paths: Sequence[Sequence[int]], goals=None) -> tuple[np.ndarray, np.nda
     if any(row.size == 0 for row in rows):
         raise ValueError("every agent's path needs at least its start")
     steps = max(row.size for row in rows)
-    padded = np.stack([np.concatenate([row, np.full(steps - row.size, row[-1], np.int32)])
-                       for row in rows])
+    padded = np.empty((len(rows), steps), np.int32)
+    for agent, row in enumerate(rows):
+        padded[agent, :row.size] = row
+        padded[agent, row.size:] = row[-1]
     if goals is None:
         return padded, np.array([row.size - 1 for row in rows], np.int32)
     return padded, arrival_steps(padded, goals)

@@ -86,6 +86,8 @@ class Rectangles:
             return None
         starts = [int(path[0]) for path in paths]
         fields = [self.distances(s) for s in starts]
+        if any(fields[i][padded[i, step]] != step for i in (0, 1)):
+            return None  # an agent is not on a shortest path there
         runs = [_straight_run(self.cells[padded[i]], fields[i][padded[i]], step)
                 for i in (0, 1)]
         if None in runs:
@@ -156,26 +158,27 @@ def _straight_run(cells: np.ndarray, arrival: np.ndarray, step: int) -> tuple[in
     (its cells i64[T, 2], ``arrival`` i32[T] the fewest steps from its start to each) is at
     each cell at the fewest steps and moves without turning back on either axis; None when the
     path is not at its cell at ``step`` on a shortest path."""
-    on_time = arrival == np.arange(len(arrival))
+    on_time = (arrival == np.arange(len(arrival))).tolist()
     if not on_time[step]:
         return None
+    moves = np.sign(np.diff(cells, axis=0)).tolist()
     first, last = step, step
-    signs = np.zeros(2, np.int64)
-    while first > 0 and on_time[first - 1] and _keeps(signs, cells[first] - cells[first - 1]):
+    signs = [0, 0]
+    while first > 0 and on_time[first - 1] and _keeps(signs, moves[first - 1]):
         first -= 1
-    while last + 1 < len(cells) and on_time[last + 1] and _keeps(signs,
-                                                                 cells[last + 1] - cells[last]):
+    while last + 1 < len(cells) and on_time[last + 1] and _keeps(signs, moves[last]):
         last += 1
     return first, last
 
 
-def _keeps(signs: np.ndarray, move: np.ndarray) -> bool:
-    """Whether ``move`` (i64[2]) goes the way of ``signs`` (i64[2], 0 where not yet known) on
-    both axes; records its signs in ``signs`` if so."""
-    moved = np.sign(move)
-    if np.any(moved * signs < 0):
+def _keeps(signs: list[int], move: list[int]) -> bool:
+    """Whether a move (its signs per axis, -1, 0 or 1) goes the way of ``signs`` (0 on an axis
+    not yet known) on both axes; records its signs in ``signs`` if so."""
+    if move[0] * signs[0] < 0 or move[1] * signs[1] < 0:
         return False
-    signs[moved != 0] = moved[moved != 0]
+    for axis in (0, 1):
+        if move[axis]:
+            signs[axis] = move[axis]
     return True
 
 

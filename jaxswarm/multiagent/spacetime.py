@@ -98,7 +98,9 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     Args:
       graph: the map (its valid edges are the moves).
       start, goal: node indices.
-      heuristic: i32[N] steps to ``goal`` ignoring the other agents (``hop_fields``).
+      heuristic: i32[N] the fewest steps from every node to ``goal`` on the map, ignoring the
+        other agents (``hop_fields``; exact: with no node parked it is also the static way to
+        the goal once nothing moves).
       reservations: what the other agents hold.
       max_expansions: stop after expanding this many states.
       avoid: optional i32[T, N] a conflict avoidance table (:func:`occupancy`): of the paths of
@@ -111,7 +113,9 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     """
     arrays = edge_arrays(graph)
     parked = reservations.parked_from
-    finish = static_field(graph, goal, (parked < UNREACHABLE) & (np.arange(len(parked)) != goal))
+    blocked = (parked < UNREACHABLE) & (np.arange(len(parked)) != goal)
+    # Without parked nodes the static way to the goal is the heuristic's own field.
+    finish = static_field(graph, goal, blocked) if blocked.any() else heuristic
     keep_from = max(reservations.last_use(goal) + 1, reservations.earliest_finish)
     avoid = np.zeros((0, graph.num_nodes), np.int32) if avoid is None else avoid
     path, expanded, outcome = _search(
@@ -121,15 +125,13 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     return (path if outcome == FOUND else None), int(expanded), int(outcome)
 
 
-def occupancy(paths: list, num_nodes: int) -> np.ndarray:
-    """i32[T, N]: per step, how many of ``paths`` (node lists) are on each node, each resting
-    at its end after it (the last row stands for every later step)."""
-    steps = max((len(path) for path in paths), default=1)
-    counts = np.zeros((steps, num_nodes), np.int32)
-    for path in paths:
-        padded = np.concatenate([path, np.full(steps - len(path), path[-1])])
-        counts[np.arange(steps), padded] += 1
-    return counts
+def occupancy(padded: np.ndarray, num_nodes: int) -> np.ndarray:
+    """i32[T, N]: per step, how many of the paths ``padded`` (i32[B, T], each resting at its
+    end after it; B may be 0) are on each node (the last row stands for every later step)."""
+    steps = padded.shape[1]
+    cells = (np.arange(steps, dtype=np.int64) * num_nodes + padded).ravel()
+    return np.bincount(cells, minlength=steps * num_nodes).reshape(steps, num_nodes).astype(
+        np.int32)
 
 
 @inline
