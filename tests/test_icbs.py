@@ -167,3 +167,17 @@ def test_the_avoidance_table_picks_the_shortest_path_meeting_fewest_agents():
     plain, _, _ = search(graph, 3, 5, field, table)
     assert path.tolist() == [3, 6, 7, 8, 5] and len(plain) == len(path)
     assert resting[0, 1] == 1 and resting.shape == (1, graph.num_nodes)
+
+
+@pytest.mark.parametrize("finish", [1, 12, 40])
+def test_a_forced_late_finish_runs_down_one_path(finish):
+    # On an open 8 x 8 grid the goal is next to the start; the agent may stay there only from
+    # step ``finish`` on. The fewest steps are then exactly ``finish``, and the search runs deep
+    # down one path: about a state per step, not the thousands that could reach the goal before.
+    graph = grid_graph(np.zeros((8, 8), bool), connectivity=4)
+    field = hop_fields(graph, np.array([1]))[0]
+    table = Reservations.empty(graph.num_nodes, steps=finish)
+    table.earliest_finish = finish
+    path, expanded, _ = search(graph, 0, 1, field, table)
+    assert len(path) - 1 == finish and path[-1] == 1 and path[0] == 0
+    assert expanded <= 2 * finish + 2

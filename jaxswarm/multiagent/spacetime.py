@@ -202,7 +202,9 @@ def _met(avoid, v, t):
 def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banned, keep_from,
             max_expansions, avoid):
     # A key packs (f, agents met, -t, node): the least f, then the fewest met, then the latest
-    # step. A state is closed when first popped; one reached again meeting fewer agents before
+    # step. f is at least keep_from, the earliest step the agent may end at its goal: with a
+    # late finish forced, the search runs deep down one path instead of through every state
+    # that could still reach the goal before then. A state is closed when first popped; one reached again meeting fewer agents before
     # that is pushed again (its older key is stale).
     horizon, n = holder.shape
     layers = horizon + 1
@@ -218,7 +220,7 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
     if f0 >= UNREACHABLE:
         return empty, 0, EXHAUSTED
     met[start] = 0
-    heap, size = _push(heap, size, _key(f0, 0, layers, horizon, 0, n, start))
+    heap, size = _push(heap, size, _key(max(f0, keep_from), 0, layers, horizon, 0, n, start))
     expanded = 0
     while size > 0:
         key, size = _pop(heap, size)
@@ -250,7 +252,8 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
                 continue
             met[state] = meets
             parent[state] = v
-            heap, size = _push(heap, size, _key(nt + remaining, meets, layers, horizon, nt, n, w))
+            f = max(nt + remaining, keep_from)
+            heap, size = _push(heap, size, _key(f, meets, layers, horizon, nt, n, w))
     return empty, expanded, EXHAUSTED
 
 
