@@ -112,6 +112,7 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
       exists) or LIMIT.
     """
     arrays = edge_arrays(graph)
+    heuristic = np.ascontiguousarray(heuristic, np.int32)
     parked = reservations.parked_from
     blocked = (parked < UNREACHABLE) & (np.arange(len(parked)) != goal)
     # Without parked nodes the static way to the goal is the heuristic's own field.
@@ -119,9 +120,8 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     keep_from = max(reservations.last_use(goal) + 1, reservations.earliest_finish)
     avoid = np.zeros((0, graph.num_nodes), np.int32) if avoid is None else avoid
     path, expanded, outcome = _search(
-        arrays.indptr, arrays.heads, np.ascontiguousarray(heuristic, np.int32), finish, start,
-        goal, reservations.holder, parked, reservations.banned, keep_from, max_expansions,
-        np.ascontiguousarray(avoid, np.int32))
+        arrays.indptr, arrays.heads, heuristic, finish, start, goal, reservations.holder, parked,
+        reservations.banned, keep_from, max_expansions, np.ascontiguousarray(avoid, np.int32))
     return (path if outcome == FOUND else None), int(expanded), int(outcome)
 
 
