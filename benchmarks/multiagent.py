@@ -72,10 +72,11 @@ What is measured
 
 4. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
    ``--cbs`` (default ``room-32-32-4-even-1`` and ``maze-32-32-2-even-1``, two of the 32 x 32
-   files the issue's check names), stopped after ``--cbs-nodes`` constraint-tree nodes (default
+   files hardest for CBS), stopped after ``--cbs-nodes`` constraint-tree nodes (default
    2,000): one warm-up call on 3 agents, then ``--cbs-repeats`` calls (default 3). The search
    is deterministic, so every call must split as many nodes and expand as many space-time
-   states (the useful work; the script exits 1 otherwise); ``median s`` is the median call,
+   states (the useful work), and a plan it solves must pass ``validate`` (the script exits 1
+   otherwise); ``median s`` is the median call,
    ``nodes/s`` the nodes over it, ``k states/s`` the low-level states over it, ``pairs`` the
    two-agent problems its heuristic solved.
 
@@ -360,7 +361,8 @@ def _lacam_row(name: str, agents: int, plan, valid: bool, total: float, bound: i
 
 def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[list[tuple],
                                                                               bool]:
-    """Part 4: (table rows, whether every call of a file did the same work)."""
+    """Part 4: (table rows, whether every call of a file did the same work and every solved
+    plan is valid)."""
     rows, same = [], True
     for scenario in files:
         name = scenario.rsplit("-", 2)[0]  # the map's name: without "-even-1" or "-random-1"
@@ -373,7 +375,8 @@ def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[l
             plan = PLANNERS["cbsh_rtc"](graph, starts, goals, max_nodes=nodes, time_limit=600)
             times.append(time.perf_counter() - began)
             work.add((plan.stats["nodes"], plan.stats["expanded"], plan.stats["pairs"]))
-        same &= len(work) == 1
+        same &= len(work) == 1 and (not plan.solved or not validate(graph, plan.paths, starts,
+                                                                    goals, plan.lengths))
         split, states, pairs = work.pop()
         median = statistics.median(times)
         rows.append((scenario, CBS_AGENTS, f"{split:,}", f"{median:.2f}", f"{split / median:,.0f}",
@@ -434,6 +437,11 @@ def main(argv: list[str] | None = None) -> int:
     check_map = mapf / f"{args.check_map}.map"
     if not check_map.is_file():
         parser.error(f"no {check_map} (use --data or --check-map)")
+    for scenario in args.cbs.split(","):
+        for path in (mapf / f"{scenario.rsplit('-', 2)[0]}.map", mapf / f"{scenario}.scen"):
+            if not path.is_file():
+                parser.error(f"--cbs: no {path} (a scenario file's name, as "
+                             f"room-32-32-4-even-1)")
     configure(threads=args.threads)  # before JAX's first computation
 
     began = time.perf_counter()
