@@ -236,11 +236,11 @@ class _Instance:
     def prioritized_collision(self, node: "_Node") -> tuple[tuple[int, int], int] | None:
         """``((a, b), step)``: of every colliding pair's first collision, a cardinal one first,
         then a semi-cardinal one, then the earliest (then the lowest pair); None when none."""
-        pairs = np.argwhere(np.triu(node.collisions >= 0, 1))
-        if not pairs.size:
+        pairs = _colliding_pairs(node.collisions)
+        if not pairs:
             return None
         padded = node.padded
-        for a, b in pairs.tolist():
+        for a, b in pairs:
             if (a, b) not in node.classes:
                 step = int(node.collisions[a, b])
                 sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
@@ -249,8 +249,7 @@ class _Instance:
                                           else int(padded[x, step]))
                          for x in (a, b)]
                 node.classes[a, b] = mdd.classify(*sides)
-        best = min((node.classes[a, b], int(node.collisions[a, b]), a, b)
-                   for a, b in pairs.tolist())
+        best = min((node.classes[a, b], int(node.collisions[a, b]), a, b) for a, b in pairs)
         return (best[2], best[3]), best[1]
 
     def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
@@ -274,7 +273,7 @@ class _Instance:
         if not self.wdg:
             return node._replace(informed=True)
         weights = {}
-        for a, b in np.argwhere(np.triu(node.collisions >= 0, 1)).tolist():
+        for a, b in _colliding_pairs(node.collisions):
             weights[a, b] = self.pair_weight(node, a, b)
         return node._replace(bound=max(node.bound, node.cost + dependency.vertex_cover(weights)),
                              informed=True)
@@ -313,6 +312,12 @@ def _name(prioritize: bool, bypass: bool, avoid: bool, wdg: bool, target: bool,
     return "cbs" + "".join(f"+{name}" for name, on in (
         ("prioritize", prioritize), ("bypass", bypass), ("avoid", avoid), ("wdg", wdg),
         ("target", target), ("corridor", corridor), ("rectangle", rectangle)) if on)
+
+
+def _colliding_pairs(collisions: np.ndarray) -> list[list[int]]:
+    """The pairs ``[a, b]`` (a < b) that collide, from ``collisions`` i32[A, A]
+    (:func:`pair_collisions`)."""
+    return np.argwhere(np.triu(collisions >= 0, 1)).tolist()
 
 
 def _swap(padded: np.ndarray, a: int, b: int, step: int) -> bool:

@@ -90,8 +90,6 @@ class Rectangles:
             return None  # an agent is not on a shortest path there
         runs = [_straight_run(self.cells[padded[i]], fields[i][padded[i]], step)
                 for i in (0, 1)]
-        if None in runs:
-            return None
         sign = _common_sign([self.cells[padded[i, last]] - self.cells[padded[i, first]]
                              for i, (first, last) in enumerate(runs)])
         if sign is None:
@@ -153,14 +151,12 @@ class Rectangles:
         return frozenset(barrier)
 
 
-def _straight_run(cells: np.ndarray, arrival: np.ndarray, step: int) -> tuple[int, int] | None:
+def _straight_run(cells: np.ndarray, arrival: np.ndarray, step: int) -> tuple[int, int]:
     """``(first, last)``: the longest stretch of steps around ``step`` along which a padded path
     (its cells i64[T, 2], ``arrival`` i32[T] the fewest steps from its start to each) is at
-    each cell at the fewest steps and moves without turning back on either axis; None when the
-    path is not at its cell at ``step`` on a shortest path."""
+    each cell at the fewest steps and moves without turning back on either axis (the path is at
+    its cell at ``step`` on a shortest path)."""
     on_time = (arrival == np.arange(len(arrival))).tolist()
-    if not on_time[step]:
-        return None
     moves = np.sign(np.diff(cells, axis=0)).tolist()
     first, last = step, step
     signs = [0, 0]

@@ -204,8 +204,8 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
     # A key packs (f, agents met, -t, node): the least f, then the fewest met, then the latest
     # step. f is at least keep_from, the earliest step the agent may end at its goal: with a
     # late finish forced, the search runs deep down one path instead of through every state
-    # that could still reach the goal before then. A state is closed when first popped; one reached again meeting fewer agents before
-    # that is pushed again (its older key is stale).
+    # that could still reach the goal before then. A state is closed when first popped; one
+    # reached again meeting fewer agents before that is pushed again (its older key is stale).
     horizon, n = holder.shape
     layers = horizon + 1
     met = np.full(layers * n, MET_CAP + 1, np.int32)
