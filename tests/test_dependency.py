@@ -156,9 +156,44 @@ def test_corridors_are_the_chains_of_two_neighbour_nodes_between_two_endpoints()
     corners = [as_node(graph, (x, y)) for x in (0, 2, 8, 10) for y in (0, 2)]
     assert sorted(np.flatnonzero(corridors.chain >= 0).tolist()) == sorted(inside + corners)
     assert sorted(corridors.length) == [2] * 8 + [6]
-    assert corridors.distance(as_node(graph, (0, 1)), as_node(graph, (10, 1))) == 10
-    assert corridors.distance(as_node(graph, (0, 1)), as_node(graph, (10, 1)),
-                              avoiding=chain) == UNREACHABLE
+    left, right = as_node(graph, (0, 1)), as_node(graph, (10, 1))
+    assert corridors.field(right)[left] == 10
+    assert corridors.field(right, avoiding=chain)[left] == UNREACHABLE
+    assert corridors.arrival(Constraints(), left, right) == 10
+    assert corridors.arrival(Constraints(), left, right, avoiding=chain) == UNREACHABLE
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_an_arrival_is_a_lower_bound_of_the_first_step_on_the_node(seed):
+    # Against a breadth-first search over (node, step) that keeps every constraint: equal
+    # where the constraints on the target are a range from step 0 (as corridor splits add
+    # them), no larger where the target is also forbidden at later steps.
+    rng = np.random.default_rng(seed)
+    blocked = np.array([[c == "#" for c in row] for row in CORRIDOR])
+    graph = grid_graph(blocked, connectivity=4)
+    free = np.flatnonzero(~blocked.ravel())
+    source, target = (int(v) for v in rng.choice(free, 2, replace=False))
+    range_ = {(t, target) for t in range(int(rng.integers(0, 12)))}
+    elsewhere = {(int(rng.integers(1, 16)), int(v)) for v in rng.choice(free, 20) if v != target}
+    later = {(int(t), target) for t in rng.integers(len(range_) + 1, 30, 3)}
+    for vertex, exact in ((range_ | elsewhere, True), (range_ | elsewhere | later, False)):
+        constraints = Constraints(vertex=frozenset(vertex))
+        truth = _first_arrival(graph, constraints, source, target)
+        found = Corridors(graph).arrival(constraints, source, target)
+        assert found == truth if exact else found <= truth, (vertex, found, truth)
+
+
+def _first_arrival(graph, constraints: Constraints, source: int, target: int) -> int:
+    """The first step an agent from ``source`` can be on ``target`` keeping ``constraints``'
+    vertex constraints (breadth-first over steps)."""
+    nbr, valid = np.asarray(graph.nbr), np.asarray(graph.valid_edges())
+    here = {source}
+    for t in range(200):
+        if target in here:
+            return t
+        here = {int(w) for v in here for w in [v, *nbr[v][valid[v]]]
+                if (t + 1, int(w)) not in constraints.vertex}
+    return UNREACHABLE
 
 
 def test_a_head_on_meeting_in_a_corridor_is_one_split():

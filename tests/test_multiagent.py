@@ -160,7 +160,7 @@ def test_batched_conflicts_match_all_pairs(monkeypatch, table_entries):
     assert {s for s in swap if (s[0], s[2]) not in vertex} <= reported
 
 
-def test_pair_collisions_are_each_pairs_first_vertex_or_swap_step():
+def test_pair_collisions_are_each_pairs_vertex_or_swap_steps():
     _, walks = _colliding_walks()
     first = conflicts_module.pair_collisions(walks)
     for a, b in itertools.permutations(range(len(walks)), 2):
@@ -169,6 +169,7 @@ def test_pair_collisions_are_each_pairs_first_vertex_or_swap_step():
                  or (t > 0 and here[t - 1] == there[t] and here[t] == there[t - 1]
                      and here[t] != here[t - 1])]
         assert first[a, b] == (steps[0] if steps else -1), (a, b)
+        assert conflicts_module.pair_collision_steps(walks, a, b) == steps, (a, b)
     assert (first >= 0).sum() > 20 and (first[~np.eye(len(walks), dtype=bool)] < 0).any()
     assert (conflicts_module.pair_collisions(walks, [7, 3]) == first[[7, 3]]).all()
 

@@ -9,8 +9,10 @@ equal steps) splits it into two children, each forbidding the collision to one o
 and re-planning only that agent. The first node without a collision is an optimal solution.
 
 Improvements, each a switch: ``prioritize`` splits on a cardinal collision first, then a
-semi-cardinal one, then the earliest (Boyarski et al., IJCAI 2015, from the agents' MDDs,
-:mod:`jaxswarm.multiagent.mdd`; a pair's first collision stands for the pair); ``bypass`` takes a
+semi-cardinal one, then any (Boyarski et al., IJCAI 2015, from the agents' MDDs,
+:mod:`jaxswarm.multiagent.mdd`), classifying every collision of every colliding pair and, at
+equal class, taking one that target or corridor reasoning resolves first, as CBSH2-RTC does
+(Li et al., AIJ 2021); ``bypass`` takes a
 child's path into its parent instead of splitting when the child costs no more and collides less
 (ibid.); ``avoid`` has the low level break ties between shortest paths toward the one meeting the
 fewest other agents (a conflict avoidance table, as CBS implementations do); ``wdg`` orders the
@@ -40,7 +42,7 @@ import numpy as np
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import dependency, mdd
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
-from jaxswarm.multiagent.conflicts import pair_collisions
+from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
 from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, forbid,
                                              reservations)
 from jaxswarm.multiagent.corridor import Corridors
@@ -156,9 +158,9 @@ class _Node(NamedTuple):
       constraints: per agent, its :class:`~jaxswarm.multiagent.constraints.Constraints`.
       collisions: i32[A, A] as :func:`pair_collisions` gives them for ``paths``.
       padded: i32[A, T] ``paths`` padded (each resting at its goal after its end).
-      classes: ``(a, b)``: the class of the first collision of agents a < b
-        (:func:`mdd.classify`), filled as ``prioritize`` needs them; a child keeps those of
-        the pairs without its re-planned agent.
+      classes: ``(a, b)``: ``(class, kind, step)`` of the collision of agents a < b to
+        split on first (:meth:`_Instance.ranked`), filled as ``prioritize`` needs them; a
+        child keeps those of the pairs without its re-planned agent.
       informed: whether ``bound`` holds the heuristic (with ``wdg``; computed when the node
         first reaches the top of the frontier).
     """
@@ -234,23 +236,40 @@ class _Instance:
         return levels
 
     def prioritized_collision(self, node: "_Node") -> tuple[tuple[int, int], int] | None:
-        """``((a, b), step)``: of every colliding pair's first collision, a cardinal one first,
-        then a semi-cardinal one, then the earliest (then the lowest pair); None when none."""
+        """``((a, b), step)``: of every collision of every colliding pair, a cardinal one
+        first, then a semi-cardinal one, then any; at equal class a target collision (with
+        ``target``) before the others, then the earliest (then the lowest pair); None when
+        none collides."""
         pairs = _colliding_pairs(node.collisions)
         if not pairs:
             return None
-        padded = node.padded
         for a, b in pairs:
             if (a, b) not in node.classes:
-                step = int(node.collisions[a, b])
-                sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
-                                          int(self.goal_nodes[x]), step, int(padded[x, step]),
-                                          int(padded[x, step - 1]) if _swap(padded, a, b, step)
-                                          else int(padded[x, step]))
-                         for x in (a, b)]
-                node.classes[a, b] = mdd.classify(*sides)
-        best = min((node.classes[a, b], int(node.collisions[a, b]), a, b) for a, b in pairs)
-        return (best[2], best[3]), best[1]
+                node.classes[a, b] = min(self.ranked(node, a, b, step)
+                                         for step in pair_collision_steps(node.padded, a, b))
+        best = min(node.classes[a, b] + (a, b) for a, b in pairs)
+        return (best[3], best[4]), best[2]
+
+    def ranked(self, node: "_Node", a: int, b: int, step: int) -> tuple[int, int, int]:
+        """``(class, kind, step)`` of the collision of agents ``a`` and ``b`` arriving at
+        ``step``: its :func:`mdd.classify` class, and its kind, 0 where one of them rests on
+        its goal (with ``target``), 1 where a corridor split resolves it (with ``corridor``),
+        else 2 (CBSH2-RTC's order of conflict types)."""
+        padded = node.padded
+        swap = _swap(padded, a, b, step)
+        sides = [mdd.cardinal_for(self.agent_mdd(x, node.paths[x], node.constraints[x]),
+                                  int(self.goal_nodes[x]), step, int(padded[x, step]),
+                                  int(padded[x, step - 1]) if swap else int(padded[x, step]))
+                 for x in (a, b)]
+        if self.target and not swap and step >= min(len(node.paths[a]), len(node.paths[b])) - 1:
+            kind = 0
+        elif self.corridors is not None and self.corridors.split(
+                (node.constraints[a], node.constraints[b]), (node.paths[a], node.paths[b]), step,
+                padded[[a, b]]) is not None:
+            kind = 1
+        else:
+            kind = 2
+        return mdd.classify(*sides), kind, step
 
     def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
         """The two children's constraints for the collision of two agents (their

@@ -121,6 +121,15 @@ def pair_collisions(paths, agents=None) -> np.ndarray:
     return _first_collisions(paths, rows)
 
 
+def pair_collision_steps(paths: np.ndarray, a: int, b: int) -> list[int]:
+    """Every step at which agents ``a`` and ``b`` of ``paths`` (i32[A, T], padded) collide,
+    ascending: a vertex conflict at the step or a swap arriving at it (as
+    :func:`pair_collisions` counts them)."""
+    here, there = paths[a], paths[b]
+    swaps = (here[1:] == there[:-1]) & (here[:-1] == there[1:]) & (here[1:] != here[:-1])
+    return sorted(np.flatnonzero(here == there).tolist() + (np.flatnonzero(swaps) + 1).tolist())
+
+
 @jit
 def _first_collisions(paths, rows):
     agents, steps = paths.shape

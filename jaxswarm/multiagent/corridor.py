@@ -10,14 +10,16 @@ step of waiting at a time; corridor reasoning splits once on the order:
 * ``a`` is not on ``e2`` at any step in ``[0, min(t'_a - 1, t_b + k)]``, or
 * ``b`` is not on ``e1`` at any step in ``[0, min(t'_b - 1, t_a + k)]``,
 
-where ``t_a`` is the fewest steps from ``a``'s start to ``e2`` and ``t'_a`` the fewest that avoid
-the corridor (and the same for ``b`` and ``e1``). Every solution keeps one of the two: before
-``t'_a`` an agent reaches ``e2`` only through the corridor, and if ``a`` crosses first, ``b``
-enters only after ``a`` has left ``e2``, so ``b`` reaches ``e1`` after ``t_a + k`` (and the other
-way round). Both ranges are vertex constraints, so the low level and the MDDs need nothing new.
-The split is taken only where both agents are crossing the same corridor at the collision (in
-it, or just out of it), in opposite directions, their starts and goals are outside it, and both
-ranges forbid their current paths; otherwise CBS splits as usual.
+where ``t_a`` is the fewest steps from ``a``'s start to ``e2`` and ``t'_a`` the fewest that
+avoid the corridor, both under ``a``'s constraints (as CBSH2-RTC takes them: a range learnt at
+one split makes the next split's ranges longer; :meth:`Corridors.arrival` gives a lower bound of
+each, which keeps the split sound), and the same for ``b`` and ``e1``. Every solution keeps one
+of the two: before ``t'_a`` an agent reaches ``e2`` only through the corridor, and if ``a``
+crosses first, ``b`` enters only after ``a`` has left ``e2``, so ``b`` reaches ``e1`` after
+``t_a + k`` (and the other way round). Both ranges are vertex constraints, so the low level and
+the MDDs need nothing new. The split is taken only where both agents are crossing the same
+corridor at the collision (in it, or just out of it), in opposite directions, their starts and
+goals are outside it, and both ranges forbid their current paths; otherwise CBS splits as usual.
 """
 from __future__ import annotations
 
@@ -25,8 +27,12 @@ import numpy as np
 
 from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import UNREACHABLE, breadth_first
-from jaxswarm.multiagent.constraints import Constraints
+from jaxswarm.multiagent.constraints import Constraints, reservations
+from jaxswarm.multiagent.spacetime import LIMIT, search
 from jaxswarm.world.graph import Graph
+
+ARRIVAL_EXPANSIONS = 100_000
+"""The space-time states :meth:`Corridors.arrival` expands before it settles for the distance."""
 
 
 class Corridors:
@@ -39,11 +45,12 @@ class Corridors:
     """
 
     def __init__(self, graph: Graph):
+        self.graph = graph
         self.arrays = edge_arrays(graph)
         indptr, heads = self.arrays.indptr, self.arrays.heads
         degree = np.diff(indptr)
         self.chain = np.full(graph.num_nodes, -1, np.int32)
-        self.ends, self.length, self._fields = [], [], {}
+        self.ends, self.length, self._fields, self._arrivals = [], [], {}, {}
         for node in np.flatnonzero(degree == 2).tolist():
             if self.chain[node] >= 0:
                 continue
@@ -64,16 +71,45 @@ class Corridors:
                 self.ends.append(tuple(ends))
                 self.length.append(len(cells) + 1)
 
-    def distance(self, source: int, target: int, avoiding: int = -1) -> int:
-        """Fewest moves from ``source`` to ``target``, avoiding the nodes of corridor
-        ``avoiding`` (-1: none); UNREACHABLE where there is no way."""
+    def field(self, target: int, avoiding: int = -1) -> np.ndarray:
+        """i32[N]: fewest moves from every node to ``target``, avoiding the nodes of corridor
+        ``avoiding`` (-1: none); UNREACHABLE where there is no way (cached)."""
         key = (target, avoiding)
         if key not in self._fields:
             blocked = (self.chain == avoiding) if avoiding >= 0 else np.zeros(len(self.chain),
                                                                               bool)
             self._fields[key] = breadth_first(self.arrays.rev_indptr, self.arrays.rev_tails,
                                               target, blocked)
-        return int(self._fields[key][source])
+        return self._fields[key]
+
+    def arrival(self, constraints: Constraints, source: int, target: int,
+                avoiding: int = -1) -> int:
+        """A lower bound of the first step an agent under ``constraints`` can be on
+        ``target`` from ``source``, avoiding corridor ``avoiding`` (-1: none); UNREACHABLE
+        where there is no way (cached).
+
+        The space-time search's goal must be kept from its arrival on, so of the vertex
+        constraints on ``target`` only those of steps 0, 1, ... without a gap stay (any
+        arrival is after them); dropping the others only lowers the bound.
+        """
+        key = (constraints, source, target, avoiding)
+        if key not in self._arrivals:
+            field = self.field(target, avoiding)
+            banned = {t for t, v in constraints.vertex if v == target}
+            run = 0
+            while run in banned:
+                run += 1
+            kept = constraints._replace(
+                vertex=frozenset((t, v) for t, v in constraints.vertex if v != target or t < run),
+                finish_after=-1)
+            table = reservations(self.graph.num_nodes, kept)
+            if avoiding >= 0:
+                table.parked_from[self.chain == avoiding] = 0
+            path, _, outcome = search(self.graph, source, target, field, table,
+                                      max_expansions=ARRIVAL_EXPANSIONS)
+            self._arrivals[key] = (len(path) - 1 if path is not None
+                                   else int(field[source]) if outcome == LIMIT else UNREACHABLE)
+        return self._arrivals[key]
 
     def split(self, constraints: tuple[Constraints, Constraints], paths, step: int,
               padded: np.ndarray) -> tuple[Constraints, Constraints] | None:
@@ -95,10 +131,10 @@ class Corridors:
         if exits[0] == exits[1] or any(self.chain[v] == corridor for v in ends):
             return None
         k = self.length[corridor]
-        earliest = [self.distance(int(paths[i][0]), exits[i]) for i in (0, 1)]
+        earliest = [self.arrival(constraints[i], int(paths[i][0]), exits[i]) for i in (0, 1)]
         children = []
         for i in (0, 1):
-            around = self.distance(int(paths[i][0]), exits[i], avoiding=corridor)
+            around = self.arrival(constraints[i], int(paths[i][0]), exits[i], avoiding=corridor)
             last = min(around - 1, earliest[1 - i] + k)
             if not 0 <= _first_visit(padded[i], exits[i]) <= last:
                 return None  # the range would not forbid the current path
