@@ -12,7 +12,7 @@ import oracle
 from jaxswarm.multiagent import PLANNERS, cbs, load_instance, validate
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields
 from jaxswarm.multiagent.plan import pack
-from jaxswarm.multiagent.constraints import Constraints, forbid, reservations
+from jaxswarm.multiagent.constraints import Constraints, reservations, split_collision
 from jaxswarm.multiagent.corridor import Corridors
 from jaxswarm.multiagent.dependency import EXACT_VERTICES, pair_extra_cost, vertex_cover
 from jaxswarm.multiagent.spacetime import search
@@ -63,9 +63,7 @@ def _pair_weight(graph, start_nodes, goal_nodes, a: int, b: int, target: bool) -
 
     def split(constraints, pair, step):
         resting_from = np.array([len(path) - 1 for path in pair]) if target else None
-        padded = pack(list(pair))[0]
-        return tuple(forbid(constraints[i], padded, i, 1 - i, step, resting_from)
-                     for i in (0, 1))
+        return split_collision(constraints, pack(list(pair))[0], step, resting_from)
 
     return pair_extra_cost(paths, (Constraints(), Constraints()),
                            lambda i, constraints: _constrained_path(graph, *ends[i], constraints),

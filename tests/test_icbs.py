@@ -12,7 +12,8 @@ from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import (PLANNERS, cbs, ecbs, eecbs, hop_fields, load_instance,
                                  lower_bound, validate)
 from jaxswarm.multiagent import mdd
-from jaxswarm.multiagent.spacetime import Reservations, occupancy, search
+from jaxswarm.multiagent.constraints import Constraints, split_collision
+from jaxswarm.multiagent.spacetime import EXHAUSTED, Reservations, occupancy, search
 from jaxswarm.world.graph import grid_graph
 
 
@@ -198,3 +199,36 @@ def test_a_forced_late_finish_runs_down_one_path(finish):
     path, expanded, _ = search(graph, 0, 1, field, table)
     assert len(path) - 1 == finish and path[-1] == 1 and path[0] == 0
     assert expanded <= 2 * finish + 2
+
+
+def test_a_latest_finish_prunes_every_later_path():
+    # Goal 7 steps away on an open 8 x 8 grid, the goal's two neighbours forbidden until step 9:
+    # the agent finishes at 11 at best, so a latest finish of 10 leaves no path, 11 the same one.
+    graph = grid_graph(np.zeros((8, 8), bool), connectivity=4)
+    goal = 7
+    field = hop_fields(graph, np.array([goal]))[0]
+    table = Reservations.empty(graph.num_nodes, steps=10)
+    table.holder[:10, [6, 15]] = -2
+    free, _, _ = search(graph, 0, goal, field, table)
+    assert len(free) - 1 == 11
+    for latest, finish in ((10, None), (11, 11), (30, 11)):
+        table.latest_finish = latest
+        path, expanded, outcome = search(graph, 0, goal, field, table)
+        if finish is None:
+            assert path is None and outcome == EXHAUSTED and expanded < 100
+        else:
+            assert len(path) - 1 == finish and (path == free).all()
+
+
+def test_a_target_split_makes_disjoint_children():
+    # Agent 1 rests on its goal (node 5) from step 3; agent 0 passes it at step 6. One child
+    # keeps agent 0 off node 5 from step 6 on and has agent 1 finish by 6; the other has agent
+    # 1 finish after 6. Without target reasoning the children are two vertex constraints.
+    padded = np.array([[0, 1, 2, 3, 4, 4, 5, 6], [9, 8, 7, 5, 5, 5, 5, 5]], np.int32)
+    none = (Constraints(), Constraints())
+    parked, later = split_collision(none, padded, 6, np.array([7, 3]))
+    assert parked == (Constraints(parked=frozenset({(6, 5)})), Constraints(finish_by=6))
+    assert later == (Constraints(), Constraints(finish_after=6))
+    plain = split_collision(none, padded, 6)
+    assert plain == ((Constraints(vertex=frozenset({(6, 5)})), Constraints()),
+                     (Constraints(), Constraints(vertex=frozenset({(6, 5)}))))

@@ -43,8 +43,8 @@ from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import dependency, mdd
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
-from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, forbid,
-                                             reservations)
+from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, reservations,
+                                             split_collision)
 from jaxswarm.multiagent.corridor import Corridors
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.rectangle import Rectangles
@@ -188,6 +188,9 @@ class _Instance:
       max_expansions: the limit on expanded space-time states per low-level search.
       began: ``time.perf_counter()`` when the search began.
       counts: ``expanded`` space-time states and constraint-tree ``nodes`` so far.
+      weights: the dependency weights found, by the pair and its two agents' constraints.
+      searched: the paths found without an avoidance table (the two-agent problems' searches),
+        by the agent and its constraints: sibling nodes pose the same ones again.
     """
 
     graph: Graph
@@ -208,6 +211,7 @@ class _Instance:
     corridors: Corridors | None = None
     rectangles: Rectangles | None = None
     weights: dict = dataclasses.field(default_factory=dict)
+    searched: dict = dataclasses.field(default_factory=dict)
 
     def plan_agent(self, agent: int, constraints: Constraints, others=None):
         """The agent's fewest-steps path (i32[T]) under its ``constraints``, or None; with
@@ -215,11 +219,16 @@ class _Instance:
         root, of those planned so far), the one meeting the fewest of them."""
         table = (occupancy(others, self.graph.num_nodes)
                  if self.avoid and others is not None else None)
+        key = (agent, constraints)
+        if table is None and key in self.searched:
+            return self.searched[key]
         path, expanded, _ = search(self.graph, int(self.start_nodes[agent]),
                                    int(self.goal_nodes[agent]), self.fields[agent],
                                    reservations(self.graph.num_nodes, constraints),
                                    max_expansions=self.max_expansions, avoid=table)
         self.counts["expanded"] += expanded
+        if table is None:
+            self.searched[key] = path
         return path
 
     def agent_mdd(self, agent: int, path, constraints: Constraints) -> list[frozenset]:
@@ -271,20 +280,20 @@ class _Instance:
             kind = 2
         return mdd.classify(*sides), kind, step
 
-    def split(self, constraints: tuple, paths: tuple, step: int) -> tuple:
-        """The two children's constraints for the collision of two agents (their
-        ``constraints`` and node lists ``paths``) arriving at ``step``: a corridor split, else
-        a rectangle split, where they are on and apply, else one constraint each
-        (:func:`~jaxswarm.multiagent.constraints.forbid`, with target reasoning if on)."""
+    def split(self, constraints: tuple, paths: tuple, step: int) -> tuple[tuple, tuple]:
+        """The two children of the collision of two agents (their ``constraints`` and node
+        lists ``paths``) arriving at ``step``, each both agents' constraints, child ``i``
+        re-planning agent ``i``: a corridor split, else a rectangle split, where they are on
+        and apply, else :func:`~jaxswarm.multiagent.constraints.split_collision` (with target
+        reasoning if on)."""
         padded = pack(list(paths))[0]
         for reasoning, count in ((self.corridors, "corridors"), (self.rectangles, "rectangles")):
             both = reasoning.split(constraints, paths, step, padded) if reasoning else None
             if both is not None:
                 self.counts[count] += 1
-                return both
+                return (both[0], constraints[1]), (constraints[0], both[1])
         resting_from = np.array([len(path) - 1 for path in paths]) if self.target else None
-        return tuple(forbid(constraints[i], padded, i, 1 - i, step, resting_from)
-                     for i in (0, 1))
+        return split_collision(constraints, padded, step, resting_from)
 
     def bounded(self, node: "_Node") -> "_Node":
         """``node`` informed: with ``wdg``, its bound raised to its cost plus the vertex cover
@@ -361,13 +370,12 @@ def _children(instance: _Instance, node: _Node, pair: tuple[int, int], step: int
     of the pair, forbidding the collision to that agent and re-planning it, none for an agent
     that then has no path. ``tiebreak`` numbers the children in the order they are made."""
     children = []
-    both = instance.split(tuple(node.constraints[a] for a in pair),
-                          tuple(node.paths[a] for a in pair), step)
-    for agent, constraints in zip(pair, both):
-        path = instance.plan_agent(agent, constraints,
-                                   others=np.delete(node.padded, agent, axis=0))
+    splits = instance.split(tuple(node.constraints[a] for a in pair),
+                            tuple(node.paths[a] for a in pair), step)
+    for i, (agent, both) in enumerate(zip(pair, splits)):
+        path = instance.plan_agent(agent, both[i], others=np.delete(node.padded, agent, axis=0))
         if path is not None:
-            children.append(_child(node, agent, path, constraints, next(tiebreak)))
+            children.append(_child(node, agent, path, dict(zip(pair, both)), next(tiebreak)))
     return children
 
 
@@ -394,15 +402,18 @@ def _bypassed(instance: _Instance, node: _Node, children: list[_Node], pair: tup
         return children
     agent = next(a for a in pair if taken.paths[a] is not node.paths[a])
     instance.counts["bypasses"] += 1
-    return [_child(node, agent, taken.paths[agent], node.constraints[agent], next(tiebreak))]
+    return [_child(node, agent, taken.paths[agent], {agent: node.constraints[agent]},
+                   next(tiebreak))]
 
 
-def _child(node: _Node, agent: int, path, constraints: Constraints, order: int) -> _Node:
-    """``node`` with ``agent`` on ``path`` (i32[T]) under its new ``constraints``."""
+def _child(node: _Node, agent: int, path, constraints: dict, order: int) -> _Node:
+    """``node`` with ``agent`` on ``path`` (i32[T]) and the agents of ``constraints`` (agent:
+    :class:`Constraints`) under theirs (the other agents' paths keep them)."""
     paths = list(node.paths)
     paths[agent] = path
     all_constraints = list(node.constraints)
-    all_constraints[agent] = constraints
+    for other, held in constraints.items():
+        all_constraints[other] = held
     steps = node.padded.shape[1]
     padded = np.empty((len(paths), max(steps, len(path))), np.int32)
     padded[:, :steps] = node.padded

@@ -6,9 +6,10 @@ forbidding it to one of them: the node they share at t (a vertex constraint), or
 swap, the agent's move into its node at t (an edge constraint). With target reasoning (Li, Gange,
 Harabor, Stuckey, Ma and Koenig, ICAPS 2020), a vertex collision on the goal of an agent that
 already stays there is split by when that agent finishes: either it finishes after t (a length
-constraint on it), or it finishes by t and the other may never be on that goal from t on. Every
-solution keeps the constraints of one of the two children, so the split keeps CBS complete and
-optimal; it ends in one split what vertex constraints resolve a step at a time.
+constraint on it), or it finishes by t (a length constraint the other way) and the other may never
+be on that goal from t on. Every solution keeps the constraints of one of the two children, and
+none keeps both, so the split keeps CBS complete and optimal; it ends in one split what vertex
+constraints resolve a step at a time.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from jaxswarm.multiagent.agents import UNREACHABLE
 from jaxswarm.multiagent.spacetime import FORBIDDEN, Reservations
 
 
@@ -28,12 +30,15 @@ class Constraints(NamedTuple):
       parked: ``(t, v)``: not on node ``v`` at step ``t`` or any later one.
       finish_after: the agent does not stay at its goal for good from a step at or before this
         one (its cost is larger); -1: no such constraint.
+      finish_by: the agent stays at its goal for good from this step or an earlier one (its
+        cost is at most this); UNREACHABLE: no such constraint.
     """
 
     vertex: frozenset = frozenset()
     edge: frozenset = frozenset()
     parked: frozenset = frozenset()
     finish_after: int = -1
+    finish_by: int = UNREACHABLE
 
 
 def earliest_collision(collisions: np.ndarray) -> tuple[tuple[int, int], int] | None:
@@ -72,6 +77,31 @@ def forbid(constraints: Constraints, padded: np.ndarray, agent: int, other: int,
     return constraints._replace(vertex=constraints.vertex | {(step, here)})
 
 
+def split_collision(constraints: tuple[Constraints, Constraints], padded: np.ndarray, step: int,
+                    resting_from: np.ndarray | None = None) -> tuple[tuple, tuple]:
+    """The two children of the collision of agents 0 and 1 arriving at ``step``: child ``i``
+    holds both agents' constraints, the collision forbidden to agent ``i`` (:func:`forbid`).
+    With target reasoning (``resting_from``, as :func:`forbid` takes it), where agent ``i`` is
+    kept off the goal the other rests on from ``step`` on, the other must also finish by
+    ``step`` in that child, so that no solution keeps both children.
+
+    Args:
+      constraints: the two agents' constraints so far.
+      padded: i32[2, T] their paths (each resting at its goal after its end).
+      step: the step their collision arrives at.
+      resting_from: optional i32[2] the steps from which they rest at their goals.
+    """
+    children = []
+    for i in (0, 1):
+        both = list(constraints)
+        both[i] = forbid(constraints[i], padded, i, 1 - i, step, resting_from)
+        if (resting_from is not None and padded[i, step] == padded[1 - i, step]
+                and step >= resting_from[1 - i]):
+            both[1 - i] = both[1 - i]._replace(finish_by=min(both[1 - i].finish_by, step))
+        children.append(tuple(both))
+    return children[0], children[1]
+
+
 def reservations(num_nodes: int, constraints: Constraints) -> Reservations:
     """The low-level table of one agent's constraints: FORBIDDEN (t, v) entries, banned moves,
     nodes parked from a step on and the earliest finish, over enough steps that the world is
@@ -87,4 +117,5 @@ def reservations(num_nodes: int, constraints: Constraints) -> Reservations:
     if constraints.edge:
         table.banned = np.array(sorted(constraints.edge), np.int32)
     table.earliest_finish = constraints.finish_after + 1
+    table.latest_finish = constraints.finish_by
     return table

@@ -101,7 +101,7 @@ class Corridors:
                 run += 1
             kept = constraints._replace(
                 vertex=frozenset((t, v) for t, v in constraints.vertex if v != target or t < run),
-                finish_after=-1)
+                finish_after=-1, finish_by=UNREACHABLE)
             table = reservations(self.graph.num_nodes, kept)
             if avoiding >= 0:
                 table.parked_from[self.chain == avoiding] = 0

@@ -47,9 +47,9 @@ def pair_extra_cost(paths: tuple, constraints: tuple,
         :class:`~jaxswarm.multiagent.constraints.Constraints`).
       replan: ``replan(i, constraints_i)``: agent ``i``'s (0 or 1) shortest path under
         ``constraints_i``, or None when it has none.
-      split: ``split(constraints, paths, step)``: the two children's constraints for the
-        agents' collision arriving at ``step`` (``paths``: their two node lists), as CBS splits
-        it.
+      split: ``split(constraints, paths, step)``: the two children of the agents' collision
+        arriving at ``step`` (``paths``: their two node lists), each both agents' constraints,
+        child ``i`` re-planning agent ``i``, as CBS splits it.
       max_nodes: the nodes of the two-agent CBS to expand at most.
 
     Returns:
@@ -67,13 +67,13 @@ def pair_extra_cost(paths: tuple, constraints: tuple,
         step = int(pair_collisions(pack(list(pair))[0], [0])[0, 1])
         if step < 0:
             return cost - base
-        for agent, forbidden in enumerate(split(held, pair, step)):
-            path = replan(agent, forbidden)
+        for agent, both in enumerate(split(held, pair, step)):
+            path = replan(agent, both[agent])
             if path is not None:
-                child = list(pair), list(held)
-                child[0][agent], child[1][agent] = path, forbidden
+                child = list(pair)
+                child[agent] = path
                 heapq.heappush(frontier, (cost - len(pair[agent]) + len(path), next(order),
-                                          tuple(child[0]), tuple(child[1])))
+                                          tuple(child), tuple(both)))
     return frontier[0][0] - base if frontier else 0
 
 

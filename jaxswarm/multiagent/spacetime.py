@@ -10,8 +10,9 @@ one. What the other agents hold is a :class:`Reservations` table:
 * ``parked_from`` i32[N]: the step from which an agent stays on the node for good.
 * ``banned`` i32[M, 3]: single moves ``(t, u, v)`` forbidden from step t (CBS's edge
   constraints).
-* ``earliest_finish``: the agent may not stay at its goal for good before this step (CBS's
-  length constraint of target reasoning).
+* ``earliest_finish``: the agent may not stay at its goal for good before this step, and
+  ``latest_finish``: it must stay there for good from this step or an earlier one (CBS's length
+  constraints of target reasoning).
 
 From step ``H`` on nothing moves any more, so the world is static: a state reaching step H is
 finished by the static shortest path that avoids the parked nodes (a breadth-first field from the
@@ -52,12 +53,14 @@ class Reservations:
       parked_from: i32[N] the step from which a node is held for good (UNREACHABLE: never).
       banned: i32[M, 3] forbidden moves ``(t, u, v)``, each with t < H.
       earliest_finish: the first step from which the agent may stay at its goal (at most H).
+      latest_finish: the last step from which it may start staying there (UNREACHABLE: any).
     """
 
     holder: np.ndarray
     parked_from: np.ndarray
     banned: np.ndarray
     earliest_finish: int = 0
+    latest_finish: int = UNREACHABLE
 
     @classmethod
     def empty(cls, num_nodes: int, steps: int = 0) -> "Reservations":
@@ -121,7 +124,8 @@ def search(graph: Graph, start: int, goal: int, heuristic: np.ndarray, reservati
     avoid = np.zeros((0, graph.num_nodes), np.int32) if avoid is None else avoid
     path, expanded, outcome = _search(
         arrays.indptr, arrays.heads, heuristic, finish, start, goal, reservations.holder, parked,
-        reservations.banned, keep_from, max_expansions, np.ascontiguousarray(avoid, np.int32))
+        reservations.banned, keep_from, reservations.latest_finish, max_expansions,
+        np.ascontiguousarray(avoid, np.int32))
     return (path if outcome == FOUND else None), int(expanded), int(outcome)
 
 
@@ -200,12 +204,14 @@ def _met(avoid, v, t):
 
 @jit
 def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banned, keep_from,
-            max_expansions, avoid):
+            latest_finish, max_expansions, avoid):
     # A key packs (f, agents met, -t, node): the least f, then the fewest met, then the latest
     # step. f is at least keep_from, the earliest step the agent may end at its goal: with a
     # late finish forced, the search runs deep down one path instead of through every state
-    # that could still reach the goal before then. A state is closed when first popped; one
-    # reached again meeting fewer agents before that is pushed again (its older key is stale).
+    # that could still reach the goal before then. A state whose f is past latest_finish cannot
+    # finish in time (f is a lower bound of its finish) and is not pushed. A state is closed
+    # when first popped; one reached again meeting fewer agents before that is pushed again
+    # (its older key is stale).
     horizon, n = holder.shape
     layers = horizon + 1
     met = np.full(layers * n, MET_CAP + 1, np.int32)
@@ -217,7 +223,7 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
     if not _open(holder, parked, horizon, start, 0):
         return empty, 0, EXHAUSTED
     f0 = heuristic[start] if horizon > 0 else finish[start]
-    if f0 >= UNREACHABLE:
+    if f0 >= UNREACHABLE or max(f0, keep_from) > latest_finish:
         return empty, 0, EXHAUSTED
     met[start] = 0
     heap, size = _push(heap, size, _key(max(f0, keep_from), 0, layers, horizon, 0, n, start))
@@ -247,12 +253,12 @@ def _search(indptr, heads, heuristic, finish, start, goal, holder, parked, banne
             remaining = finish[w] if nt == horizon else heuristic[w]
             if remaining >= UNREACHABLE:
                 continue
+            f = max(nt + remaining, keep_from)
             meets = min(c + _met(avoid, w, nt), MET_CAP)
-            if meets >= met[state]:
+            if f > latest_finish or meets >= met[state]:
                 continue
             met[state] = meets
             parent[state] = v
-            f = max(nt + remaining, keep_from)
             heap, size = _push(heap, size, _key(f, meets, layers, horizon, nt, n, w))
     return empty, expanded, EXHAUSTED
 
