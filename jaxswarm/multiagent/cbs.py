@@ -11,17 +11,18 @@ and re-planning only that agent. The first node without a collision is an optima
 Improvements, each a switch: ``prioritize`` splits on a cardinal collision first, then a
 semi-cardinal one, then any (Boyarski et al., IJCAI 2015, from the agents' MDDs,
 :mod:`jaxswarm.multiagent.mdd`), classifying every collision of every colliding pair and, at
-equal class, taking one that target or corridor reasoning resolves first, as CBSH2-RTC does
-(Li et al., AIJ 2021); ``bypass`` takes a
-child's path into its parent instead of splitting when the child costs no more and collides less
-(ibid.); ``avoid`` has the low level break ties between shortest paths toward the one meeting the
-fewest other agents (a conflict avoidance table, as CBS implementations do); ``wdg`` orders the
-high level by the sum of costs plus the weighted dependency graph heuristic (Li et al., IJCAI
-2019; :mod:`jaxswarm.multiagent.dependency`), with pathmax, computed when a node first reaches
-the top of the frontier (most never do): CBSH-WDG with all four;
-``target`` splits a collision on the goal of an agent resting there by when it finishes (target
-reasoning, Li et al., ICAPS 2020; :mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits
-two agents meeting head-on in a corridor by which crosses first (corridor reasoning, ibid.;
+equal class, taking one that target or corridor reasoning resolves first, as CBSH2-RTC does (Li
+et al., AIJ 2021), then, with ``wdg``, one of the pair the heuristic weighs most (ours:
+CBSH2-RTC breaks that tie at random); ``bypass`` takes a child's path into its parent instead of
+splitting when the child costs no more and collides less (ibid.); ``avoid`` has the low level
+break ties between shortest paths toward the one meeting the fewest other agents (a conflict
+avoidance table, as CBS implementations do); ``wdg`` orders the high level by the sum of costs
+plus the weighted dependency graph heuristic (Li et al., IJCAI 2019;
+:mod:`jaxswarm.multiagent.dependency`), with pathmax, computed when a node first reaches the top
+of the frontier (most never do): CBSH-WDG with all four; ``target`` splits a collision on the
+goal of an agent resting there by when it finishes (target reasoning, Li et al., ICAPS 2020;
+:mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits two agents meeting head-on in a
+corridor by which crosses first (corridor reasoning, ibid.;
 :mod:`jaxswarm.multiagent.corridor`); ``rectangle`` splits two agents crossing a rectangle of a
 grid on shortest paths by a barrier on each one's way out (rectangle reasoning, Li et al., AAAI
 2019; :mod:`jaxswarm.multiagent.rectangle`). All keep CBS optimal.
@@ -246,9 +247,10 @@ class _Instance:
 
     def prioritized_collision(self, node: "_Node") -> tuple[tuple[int, int], int] | None:
         """``((a, b), step)``: of every collision of every colliding pair, a cardinal one
-        first, then a semi-cardinal one, then any; at equal class a target collision (with
-        ``target``) before the others, then the earliest (then the lowest pair); None when
-        none collides."""
+        first, then a semi-cardinal one, then any; at equal class a target collision, then
+        a corridor one (:meth:`ranked`), then, with ``wdg``, that of the pair of the largest
+        dependency weight, then the earliest (then the lowest pair); None when none
+        collides."""
         pairs = _colliding_pairs(node.collisions)
         if not pairs:
             return None
@@ -256,8 +258,13 @@ class _Instance:
             if (a, b) not in node.classes:
                 node.classes[a, b] = min(self.ranked(node, a, b, step)
                                          for step in pair_collision_steps(node.padded, a, b))
-        best = min(node.classes[a, b] + (a, b) for a, b in pairs)
-        return (best[3], best[4]), best[2]
+        # At equal class and kind, the pair of the largest dependency weight: the heuristic
+        # found it the costliest to resolve (jaxswarm's tie-break; CBSH2-RTC draws at random).
+        weight = ((lambda a, b: self.pair_weight(node, a, b)) if self.wdg
+                  else (lambda a, b: 0))
+        best = min((*node.classes[a, b][:2], -weight(a, b), node.classes[a, b][2], a, b)
+                   for a, b in pairs)
+        return (best[4], best[5]), best[3]
 
     def ranked(self, node: "_Node", a: int, b: int, step: int) -> tuple[int, int, int]:
         """``(class, kind, step)`` of the collision of agents ``a`` and ``b`` arriving at
