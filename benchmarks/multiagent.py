@@ -71,8 +71,8 @@ What is measured
    ``configurations`` counts LaCAM's high-level nodes, the useful work.
 
 4. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
-   ``--cbs`` (default ``room-32-32-4-even-1`` and ``maze-32-32-2-even-1``, two of the 32 x 32
-   files hardest for CBS), stopped after ``--cbs-nodes`` constraint-tree nodes (default
+   ``--cbs`` (default ``room-32-32-4-even-1``, ``maze-32-32-2-even-1`` and
+   ``maze-32-32-4-random-1``, the 32 x 32 files hardest for CBS), stopped after ``--cbs-nodes`` constraint-tree nodes (default
    2,000): one warm-up call on 3 agents, then ``--cbs-repeats`` calls (default 3). The search
    is deterministic, so every call must split as many nodes and expand as many space-time
    states (the useful work), and a plan it solves must pass ``validate`` (the script exits 1
@@ -125,7 +125,7 @@ PIBT_MAP = "random-32-32-20"
 LACAM_INSTANCES = "random-32-32-20:400,random-64-64-10:400,room-64-64-8:400"
 GOAL_STEP_MS = 1.0
 GOAL_LACAM_S = 10.0
-CBS_FILES = "room-32-32-4-even-1,maze-32-32-2-even-1"
+CBS_FILES = "room-32-32-4-even-1,maze-32-32-2-even-1,maze-32-32-4-random-1"
 CBS_AGENTS = 20
 
 
