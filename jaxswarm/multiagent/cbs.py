@@ -45,7 +45,7 @@ from jaxswarm.multiagent import dependency, mdd
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
 from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, reservations,
-                                             split_collision)
+                                             resting_on, split_collision)
 from jaxswarm.multiagent.corridor import Corridors
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.rectangle import Rectangles
@@ -277,11 +277,12 @@ class _Instance:
                                   int(self.goal_nodes[x]), step, int(padded[x, step]),
                                   int(padded[x, step - 1]) if swap else int(padded[x, step]))
                  for x in (a, b)]
-        if self.target and not swap and step >= min(len(node.paths[a]), len(node.paths[b])) - 1:
+        pair, resting_from = padded[[a, b]], self.resting_from((node.paths[a], node.paths[b]))
+        if any(resting_on(pair, i, 1 - i, step, resting_from) for i in (0, 1)):
             kind = 0
         elif self.corridors is not None and self.corridors.split(
                 (node.constraints[a], node.constraints[b]), (node.paths[a], node.paths[b]), step,
-                padded[[a, b]]) is not None:
+                pair) is not None:
             kind = 1
         else:
             kind = 2
@@ -299,8 +300,12 @@ class _Instance:
             if both is not None:
                 self.counts[count] += 1
                 return (both[0], constraints[1]), (constraints[0], both[1])
-        resting_from = np.array([len(path) - 1 for path in paths]) if self.target else None
-        return split_collision(constraints, padded, step, resting_from)
+        return split_collision(constraints, padded, step, self.resting_from(paths))
+
+    def resting_from(self, paths: tuple) -> np.ndarray | None:
+        """With ``target``, i32[2] the steps from which two agents' node lists ``paths`` rest
+        at their goals (their lengths - 1), as target reasoning takes them; else None."""
+        return np.array([len(path) - 1 for path in paths]) if self.target else None
 
     def bounded(self, node: "_Node") -> "_Node":
         """``node`` informed: with ``wdg``, its bound raised to its cost plus the vertex cover

@@ -69,12 +69,21 @@ def forbid(constraints: Constraints, padded: np.ndarray, agent: int, other: int,
     if here != padded[other, step]:
         return constraints._replace(
             edge=constraints.edge | {(step - 1, int(padded[agent, step - 1]), here)})
-    if resting_from is not None:
-        if step >= resting_from[other]:
-            return constraints._replace(parked=constraints.parked | {(step, here)})
-        if step >= resting_from[agent]:
-            return constraints._replace(finish_after=max(constraints.finish_after, step))
+    if resting_on(padded, other, agent, step, resting_from):
+        return constraints._replace(parked=constraints.parked | {(step, here)})
+    if resting_on(padded, agent, other, step, resting_from):
+        return constraints._replace(finish_after=max(constraints.finish_after, step))
     return constraints._replace(vertex=constraints.vertex | {(step, here)})
+
+
+def resting_on(padded: np.ndarray, resting: int, other: int, step: int,
+               resting_from: np.ndarray | None) -> bool:
+    """Whether the collision of agents ``resting`` and ``other`` (rows of ``padded``, i32[A,
+    T]) arriving at ``step`` is a target collision on ``resting``'s goal: both on one node,
+    ``resting`` staying at its goal from ``resting_from[resting]`` (as :func:`forbid` takes
+    it; None: without target reasoning, never) at or before ``step``."""
+    return (resting_from is not None and padded[resting, step] == padded[other, step]
+            and step >= resting_from[resting])
 
 
 def split_collision(constraints: tuple[Constraints, Constraints], padded: np.ndarray, step: int,
@@ -95,8 +104,7 @@ def split_collision(constraints: tuple[Constraints, Constraints], padded: np.nda
     for i in (0, 1):
         both = list(constraints)
         both[i] = forbid(constraints[i], padded, i, 1 - i, step, resting_from)
-        if (resting_from is not None and padded[i, step] == padded[1 - i, step]
-                and step >= resting_from[1 - i]):
+        if resting_on(padded, 1 - i, i, step, resting_from):
             both[1 - i] = both[1 - i]._replace(finish_by=min(both[1 - i].finish_by, step))
         children.append(tuple(both))
     return children[0], children[1]
