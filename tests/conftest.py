@@ -5,6 +5,8 @@ import pytest
 from jaxswarm.runtime.cpu import THREADS_VARIABLE
 from jaxswarm.runtime.programs import release_if_crowded
 
+pytest_plugins = ["compile_ledger"]
+
 SHARED = Path(os.environ.get("JAXSWARM_SHARED", Path(__file__).resolve().parents[2] / "shared"))
 MOVINGAI = SHARED / "benchdata" / "movingai"
 # Where the library looks for Moving AI maps named in sweep specs (it never guesses a folder).

@@ -92,8 +92,11 @@ def test_demo_rejects_a_bad_map_or_swarm_in_a_line_with_exit_status_2(capsys, ar
     assert message in error.splitlines()[-1] and "Traceback" not in error
 
 
+@pytest.mark.slow  # rfd_graded's programs on a 32 x 32 map, about 30 s cold
 def test_demo_plans_on_a_moving_ai_map_between_given_cells(movingai_dir, tmp_path, capsys,
                                                           monkeypatch):
+    """Twin in the default tier: the demo of one swarm on a paper map (the same command), and
+    test_movingai.py's maps."""
     monkeypatch.chdir(tmp_path)
     assert main(["demo", "--map", str(movingai_dir / "mapf" / "empty-32-32.map"), "--start", "0,0",
                  "--goal", "5,3", "--repeats", "1", "--iterations", "3", "--drops", "8",

@@ -1,14 +1,17 @@
 """Every registered swarm's promises (:mod:`jaxswarm.swarm.testing`) on its conformance world
 (maze20 for the walkers, the 6 x 6 plane for the bees): one key, one result (alone equals the
-same key in batches of 1, 3 and 64 runs; 1,000 in the slow suite), reproducible per key, valid
-results never below the optimum, a batch over params compiled once, and its golden records
-(``tests/golden/swarms.json``) replayed bit for bit. Sweep rows on other thread and device
-counts, in processes of their own, are checked in ``test_sweep.py``.
+same key in a batch of 3 runs; in batches of 1 and 64, and of 1,000, in the slow tier),
+reproducible per key, valid results never below the optimum, a batch over params compiled once,
+and its golden records (``tests/golden/swarms.json``) replayed bit for bit. Sweep rows on other
+thread and device counts, in processes of their own, are checked in ``test_sweep.py``.
 
 One test class per swarm: under ``--dist loadscope`` (the Makefile's) a class runs on one
-worker, which compiles the swarm's programs (alone, and in batches of 1, 3 and 64) once for all
-its checks (the golden records are runs alone at the shared size), and the swarms spread over
-the workers, those slowest to compile first."""
+worker, which builds the swarm's two programs of the default tier (a run alone and a batch of 3
+runs, at the shared size) once for all its checks (the golden records are runs alone at the
+shared size), and the swarms spread over the workers, those slowest to compile first. A batch
+of 3 runs of 32 agents walks on one lane an agent; the walker's queue, whose lanes take agent
+after agent, is checked in the default tier by ``test_walk.py`` (a batch of walks with more
+agents than lanes, each as alone) and here in the slow tier (batches of 64 runs)."""
 import json
 
 import pytest
@@ -24,8 +27,10 @@ from jaxswarm.swarm.testing import (check_batch_invariant, check_compiles_once,
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
 KEYS = 4
-"""Keys of the default one-key check, each alone and in every width (the width 64 batch holds
-them and copies of the last): a width's program is compiled once whatever the count."""
+"""Keys of the one-key checks, each alone and in every width (a batch of 64 holds them and
+copies of the last): a width's program is compiled once whatever the count."""
+SLOW_WIDTHS = (1, 64)
+"""The batch widths of the slow tier's one-key check, beside the default tier's 3."""
 FIRST = ("iwd_pg", "cabc")
 """The swarms whose programs take longest to compile, whose classes come first."""
 RECORDS = json.loads(GOLDEN.read_text())
@@ -40,10 +45,16 @@ class Conformance:
     def _world(self, maze, field):
         return world_of(self.name, maze, field)
 
-    def test_a_key_gives_one_result_alone_and_in_batches_of_1_3_and_64(self, maze, field):
+    def test_a_key_gives_one_result_alone_and_in_a_batch_of_3(self, maze, field):
         world, task, _ = self._world(maze, field)
         check_batch_invariant(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
-                              keys=KEYS)
+                              widths=(sizes.RUNS,), keys=KEYS)
+
+    @pytest.mark.slow  # a program for each width (its twin: the batch of 3 above)
+    def test_a_key_gives_one_result_alone_and_in_batches_of_1_and_64(self, maze, field):
+        world, task, _ = self._world(maze, field)
+        check_batch_invariant(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
+                              widths=SLOW_WIDTHS, keys=KEYS)
 
     def test_same_key_is_bit_identical_and_vmap_matches_loop(self, maze, field):
         world, task, _ = self._world(maze, field)
@@ -94,8 +105,10 @@ def test_every_registered_swarm_has_its_class():
         f"TestSwarm_{n}" for n in swarms.registered()}
 
 
-def test_a_hooked_walk_gives_one_result_alone_and_in_batches(maze):
+@pytest.mark.parametrize("widths", [
+    (sizes.RUNS,), pytest.param(SLOW_WIDTHS, marks=pytest.mark.slow)], ids=str)
+def test_a_hooked_walk_gives_one_result_alone_and_in_batches(maze, widths):
     # Drops that change the soil as they walk read each other's writes: in a batch, as alone.
     world, task, _ = maze
     check_batch_invariant(make("iwd", local_updates="while_walking", **SMALL), world, task,
-                          iterations=ITERATIONS, keys=KEYS)
+                          iterations=ITERATIONS, widths=widths, keys=KEYS)

@@ -8,6 +8,10 @@ stays in the test's folder. A snippet that prints is followed by a block fenced 
 holding what it prints, where ``...`` stands for any text (doctest's ELLIPSIS; runs of spaces
 compare equal). A snippet that needs what a test machine lacks is marked in the Markdown by the line
 ``<!-- skip: REASON -->`` right above it; the test checks that every skipped one is marked so.
+
+Running the snippets compiles the programs of their own sizes in processes of their own, so they
+run in the slow tier; their twin in the default tier compiles each snippet and imports every name
+it imports, which fails on the usual way a snippet goes stale (a renamed or moved name).
 """
 from __future__ import annotations
 
@@ -20,6 +24,7 @@ from pathlib import Path
 
 import pytest
 from conftest import SHARED
+from repo_scripts import import_what_it_imports
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCUMENTS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
@@ -62,6 +67,15 @@ def root_view(folder: Path) -> Path:
     return view
 
 
+@pytest.mark.parametrize("document", DOCUMENTS, ids=lambda path: path.name)
+def test_every_snippet_parses_and_its_imports_resolve(document):
+    for skip, code, _ in snippets(document):
+        if skip is not None:
+            continue
+        import_what_it_imports(code, f"{document.name} snippet")
+
+
+@pytest.mark.slow  # processes of their own, at the snippets' sizes (twin: the test above)
 @pytest.mark.parametrize("document", DOCUMENTS, ids=lambda path: path.name)
 def test_every_snippet_runs_as_written_and_prints_what_it_says(document, tmp_path):
     blocks = [(code, output) for skip, code, output in snippets(document) if skip is None]

@@ -150,7 +150,10 @@ def test_a_bad_log_room_is_refused():
         make("aco_star", log_moves=0)
 
 
+@pytest.mark.slow  # the frames' and the robot's programs, cramped and roomy: about 45 s cold
 def test_memory_frames_and_the_robot_walk_again_with_room(cramped):
+    """Twin in the default tier: test_run_makes_a_run_whose_walk_overflowed_again_with_room (the
+    retry these callers share)."""
     swarm, graph, task = cramped
     roomy = make("aco_star", num_agents=16)
     params = swarm.default_params

@@ -34,9 +34,9 @@ variable only lives for the test (monkeypatch). Nothing is installed, and no use
 change. Before a notebook's own cells, the test runs one extra cell, added to the in-memory copy
 only. It prints the kernel's ``sys.prefix``, and the test checks that this equals pytest's.
 
-Run time on 2 CPU cores, mostly JAX compiling: about 15 s for ``many_agents`` in the default
-suite; the others (from 25 s to two minutes each) are slow checks. Each cell may take up to
-``CELL_TIMEOUT`` seconds.
+Run time on 2 CPU cores, mostly JAX compiling: from 15 s to two minutes a notebook, so every run
+is a slow check; the default tier parses every cell and imports what each imports. Each cell may
+take up to ``CELL_TIMEOUT`` seconds.
 """
 from __future__ import annotations
 
@@ -48,6 +48,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from repo_scripts import import_what_it_imports
 
 
 
@@ -211,6 +212,20 @@ def test_bees(notebook_env):
     assert count_images(nb) >= 2
 
 
+@pytest.mark.parametrize("path", sorted(NOTEBOOKS.glob("*.ipynb")), ids=lambda path: path.name)
+def test_every_notebook_cell_parses_and_its_imports_resolve(path):
+    """The default tier's twin of the notebook runs (slow tier): a cell that no longer parses or
+    imports a name that moved fails here without a kernel."""
+    nb = nbformat.read(path, as_version=4)
+    for index, cell in enumerate(nb.cells):
+        if cell.cell_type != "code":
+            continue
+        code = "\n".join(line for line in cell.source.splitlines()
+                         if not line.lstrip().startswith(("%", "!")))  # IPython's own lines
+        import_what_it_imports(code, f"{path.name} cell {index}")
+
+
+@pytest.mark.slow  # the multi-agent planners' and the crowd's programs, about 20 s warm
 def test_many_agents(notebook_env):
     from PIL import Image
 

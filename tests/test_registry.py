@@ -80,9 +80,12 @@ def test_the_papers_variants_are_the_defaults():
     assert {name: float(getattr(pg, name)) for name in standard} == pytest.approx(standard)
 
 
+@pytest.mark.slow  # runs at the sizes of its records, about 60 s cold
 @pytest.mark.parametrize("record", json.loads(GOLDEN.read_text()),
                          ids=lambda r: f"{r['map']}-seed{r['seed']}")
 def test_rfd_graded_replays_its_recorded_runs(record):
+    """Twin in the default tier: rfd_graded's golden records at the shared size
+    (test_conformance.py)."""
     chosen = paper_map(record["map"])
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)

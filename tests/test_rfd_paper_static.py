@@ -1,6 +1,10 @@
 """The RFD paper's Table 1 script (sweeps/rfd_paper_static.py) at a tiny size, with the rows it
 runs (jaxswarm.studies.rfd_table1): its files, its rows (the variants of ACO and of RFD*), the
-costs it reports, the best paths it draws, its provenance and its transcription of the paper."""
+costs it reports, the best paths it draws, its provenance and its transcription of the paper.
+
+The script's run compiles programs of its own sizes, so the tests that read it are in the slow
+tier; their twins in the default tier check the rows it runs (the eta and travelled rows), its
+paper cells and its arguments, and each swarm's runs in test_conformance.py."""
 from __future__ import annotations
 
 import csv
@@ -51,6 +55,7 @@ def rows(out):
         return list(reader)
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_one_row_per_algorithm_and_seed(rows):
     assert sorted((r["map"], r["algorithm"], int(r["seed"])) for r in rows) == sorted(
         (MAP, a, s) for a in (*EXACT, *SWARMS) for s in range(SEEDS))
@@ -65,6 +70,7 @@ def test_one_row_per_algorithm_and_seed(rows):
             assert r["iterations"] == ""
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_costs_against_the_optimum(rows):
     optimum = {float(r["optimum"]) for r in rows}
     assert len(optimum) == 1
@@ -84,6 +90,7 @@ def test_costs_against_the_optimum(rows):
             assert gap == math.inf, r
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_markdown_has_ours_beside_the_papers(out, rows):
     lines = (out / "table.md").read_text(encoding="utf-8").splitlines()
     ours = f"| Dijkstra | ours | {float(rows[0]['optimum']):.2f} ({SEEDS}/{SEEDS}) |"
@@ -101,6 +108,7 @@ def test_markdown_has_ours_beside_the_papers(out, rows):
         assert sum(line.startswith(f"| {algorithm} | ours | ") for line in lines) == 3
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_markdown_counts_the_runs_that_reach_the_optimum(out, rows):
     lines = (out / "table.md").read_text(encoding="utf-8").splitlines()
     section = lines.index(next(line for line in lines if line.startswith("## Runs that reach")))
@@ -112,6 +120,7 @@ def test_markdown_counts_the_runs_that_reach_the_optimum(out, rows):
         assert line == f"| {algorithm} | ours | {optimal}/{SEEDS} |"
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_markdown_and_json_carry_the_provenance(out):
     text = (out / "table.md").read_text(encoding="utf-8")
     record = json.loads((out / "provenance.json").read_text(encoding="utf-8"))
@@ -159,6 +168,7 @@ def test_the_travelled_row_runs_rfd_star_eroding_every_path():
     assert rfd_table1.BY_SWARM["rfd_star"].label == "RFD* (paper)"
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_figure_and_no_temporary_files(out):
     assert sorted(p.name for p in out.iterdir()) == [
         "best_paths.png", "provenance.json", "runs.csv", "table.md"]
@@ -166,6 +176,7 @@ def test_figure_and_no_temporary_files(out):
     assert image.ndim == 3 and min(image.shape[:2]) > 100
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 75 s cold
 def test_best_paths_are_valid_and_match_the_rows(out):
     # out: the compiled runs are cached, so this second solve is quick.
     rows, best = script.solve_map(MAP, SEEDS, iterations=ITERATIONS, agents=AGENTS)

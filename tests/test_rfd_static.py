@@ -1,6 +1,10 @@
 """The static RFD table script (sweeps/rfd_static.py: rfd, rfd_star, rfd_graded) at a tiny size:
 the rows it writes agree with Dijkstra and with each other, and its table summarises them, each
-row labelled the paper's or ours, under the provenance."""
+row labelled the paper's or ours, under the provenance.
+
+The script's run compiles programs of its own sizes, so the tests that read it are in the slow
+tier; their twins in the default tier: its bad arguments here, each swarm's runs replayed alone
+in test_conformance.py, and the replay of a sweep's rows in test_sweep.py."""
 from __future__ import annotations
 
 import csv
@@ -29,6 +33,7 @@ def out(tmp_path_factory):
     return folder
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 25 s cold
 def test_rows_carry_the_dijkstra_optimum_and_a_consistent_gap(out):
     with open(out / "runs.csv", newline="") as f:
         rows = list(csv.DictReader(f))
@@ -53,6 +58,7 @@ def test_rows_carry_the_dijkstra_optimum_and_a_consistent_gap(out):
     assert all(r["success"] == "True" for r in rows if r["algorithm"] == "rfd_graded")
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 25 s cold
 def test_table_summarises_the_rows(out):
     with open(out / "runs.csv", newline="") as f:
         rows = list(csv.DictReader(f))
@@ -69,6 +75,7 @@ def test_table_summarises_the_rows(out):
         assert cells[4].startswith(f"{sum(finite) / len(finite):.2f}" if finite else "n/a")
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 25 s cold
 def test_table_starts_with_the_provenance(out):
     text = (out / "table.md").read_text()
     record = json.loads((out / "provenance.json").read_text())
@@ -93,6 +100,7 @@ def test_bad_arguments_stop_before_any_run(tmp_path, capsys, argv, message):
     assert not any(tmp_path.iterdir())
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 25 s cold
 def test_every_row_replays_alone_bit_for_bit(out):
     # Each row's run_record (swarm, params, map entry, key data) runs it again alone.
     from jaxswarm.sweep.replay import replay_row
@@ -107,6 +115,7 @@ def test_every_row_replays_alone_bit_for_bit(out):
         assert replayed.sweep_map.label == MAP
 
 
+@pytest.mark.slow  # the script's run at its own sizes (fixture out), about 25 s cold
 def test_the_replay_command_takes_a_results_folder(out, tmp_path, capsys):
     from jaxswarm.cli import main
 

@@ -24,12 +24,14 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.maps.planes import paper_plane
 from jaxswarm.plot.sweep import heatmap_figure, line_figure, plot_sweep, summary
 import jaxswarm
+from jaxswarm import cli
 from jaxswarm.swarm import definition, make, make_task, registered, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
 from jaxswarm.sweep.maps import resolve_map
 from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.store import ResultsStore
+from jaxswarm.sweep import runner
 from jaxswarm.sweep.batches import group_size
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 
@@ -203,7 +205,10 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     assert {"git_commit", "jaxswarm", "devices", "config", "maps"} <= set(metadata)
 
 
+@pytest.mark.slow  # programs of a cramped log and of a roomy one, about 60 s cold
 def test_a_chunk_whose_walk_overflowed_its_log_is_made_again_with_room(finished, tmp_path):
+    """Twin in the default tier: test_log.py's run and batch made again with room (the retry this
+    runner shares)."""
     _, _, frame = finished
     messages = []
     cramped = run_sweep(spec_from_dict(tiny(config={"log_moves": 16})), tmp_path / "out",
@@ -245,7 +250,9 @@ def test_a_bees_sweep_over_planes_carries_the_visibility_graph_optimum(tmp_path)
                                      size="50x50")]
 
 
+@pytest.mark.slow  # programs of a 40-iteration run with patience, about 40 s cold
 def test_a_sweep_with_patience_stops_its_runs_as_run_does(tmp_path):
+    """Twin in the default tier: test_the_runner_takes_the_specs_stop_rules."""
     spec = spec_from_dict(tiny(sweep={"maps": ["mosaic20"], "seeds": 2, "iterations": 40,
                                       "patience": 3},
                                params={"p_base": [20.0], "alpha": [8.0]}))
@@ -260,6 +267,23 @@ def test_a_sweep_with_patience_stops_its_runs_as_run_does(tmp_path):
                            iterations=40, patience=3)
         assert row.iterations == int(trace.iterations) and row.cost == float(state.best_cost)
     assert (frame["iterations"] < 40).all()  # patience, not the budget, stopped them
+
+
+def test_the_runner_takes_the_specs_stop_rules(tmp_path, monkeypatch):
+    asked = {}
+
+    class Asked(Exception):
+        pass
+
+    def batches(algorithm, config, iterations, patience, *_):
+        asked.update(iterations=iterations, patience=patience)
+        raise Asked
+
+    monkeypatch.setattr(runner, "RunBatches", batches)
+    spec = spec_from_dict(tiny(sweep={"iterations": 40, "patience": 3}))
+    with pytest.raises(Asked):
+        run_sweep(spec, tmp_path / "out", progress=False, log=lambda _: None)
+    assert asked == {"iterations": 40, "patience": 3}
 
 
 def test_same_spec_resumes_without_recomputing_and_other_spec_is_refused(finished):
@@ -556,11 +580,13 @@ def one_key_document(name: str) -> dict:
             "config": config}
 
 
-@pytest.mark.parametrize("name", [
-    "iwd", *(pytest.param(name, marks=pytest.mark.slow) for name in registered()
-             if name != "iwd")])
+@pytest.mark.slow  # processes of their own at their own sizes
+@pytest.mark.parametrize("name", registered())
 def test_a_row_is_the_run_alone_on_any_thread_and_device_count_and_process(name, tmp_path):
-    # iwd with drops that change the soil as they walk, the walker's hardest case.
+    """Twins in the default tier: a row is its run alone in this process
+    (test_rows_are_tidy_and_match_single_runs), and a batch of walks whose drops change the soil
+    as they walk is each run alone (test_conformance.py's hooked walk)."""
+    # iwd walks with drops that change the soil as they walk, the walker's hardest case.
     document = one_key_document(name)
     fingerprints = []
     # Each setting is a process of its own; the slow cases take only the one unlike the test's.
@@ -583,18 +609,16 @@ def test_a_row_is_the_run_alone_on_any_thread_and_device_count_and_process(name,
     assert fingerprints == [alone] * len(settings)
 
 
-def test_a_replayed_row_gives_the_stored_figures_bit_for_bit(finished, tmp_path):
+def test_a_replayed_row_gives_the_stored_figures_bit_for_bit(finished, tmp_path, capsys):
     _, out, frame = finished
     for row in (0, 7, 23):
         replayed = replay_row(out, row)
         assert replayed.reproduced, replayed.differences
         assert replayed.figures["fingerprint"] == frame["fingerprint"][row]
     figure = tmp_path / "figures"
-    done = subprocess.run([sys.executable, "-m", "jaxswarm.cli", "replay", str(out), "13",
-                           "--out", str(figure)], capture_output=True, text=True, timeout=600,
-                          cwd=REPO)
-    assert done.returncode == 0, done.stderr
-    assert "reproduced bit for bit" in done.stdout and (figure / "row13.png").is_file()
+    assert cli.main(["replay", str(out), "13", "--out", str(figure)]) == 0
+    assert "reproduced bit for bit" in capsys.readouterr().out
+    assert (figure / "row13.png").is_file()
 
 
 def test_a_replay_that_differs_says_which_figure_and_a_bad_row_is_named(finished, tmp_path):

@@ -310,13 +310,20 @@ def test_the_tune_command_prints_its_help_and_names_a_bad_key(tmp_path, capsys):
     assert done.value.code == 2 and "--devices: devices must be" in capsys.readouterr().err
 
 
+def test_a_small_call_is_fitted_to_a_share_of_the_chunk():
+    assert RunBatches("iwd", {"num_agents": 8}, 3, None, 16, fit_calls=True).call_size(3) == 4
+    assert RunBatches("iwd", {"num_agents": 8}, 3, None, 16).call_size(3) == 16
+
+
+@pytest.mark.slow  # programs of both call sizes, about 60 s cold
 def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
+    """Twin in the default tier: the call sizes above (a call's width is another batch width,
+    whose one-key promise the conformance checks keep at width 3)."""
     sweep_map = resolve_map("maze20")
     seeds, params = np.array([3, 4, 5]), {"alpha": np.array([1.0, 2.0, 3.0])}
     outputs = [RunBatches("iwd", {"num_agents": 8}, 3, None, 16, log=lambda _: None,
                           fit_calls=fit).run(sweep_map, seeds, params)
                for fit in (False, True)]
-    assert RunBatches("iwd", {"num_agents": 8}, 3, None, 16, fit_calls=True).call_size(3) == 4
     for name in ("cost", "iterations", "moves", "fingerprint", "target_iterations"):
         np.testing.assert_array_equal(outputs[0][name], outputs[1][name])
 

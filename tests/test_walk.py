@@ -230,14 +230,21 @@ def test_a_small_walk_keeps_most_lanes_busy(monkeypatch):
 
 
 def test_a_batch_of_walks_shares_one_queue_and_walks_as_each_alone():
-    graph = grid_graph(np.random.default_rng(3).random((12, 12)) < 0.2)
+    """A batch whose agents outnumber the walker's lanes: 4 runs of 48 agents step 128 lanes,
+    which take agent after agent from one queue, while a run alone walks a lane an agent; every
+    run walks as it does alone. The default tier's twin of the conformance checks' batches of 64
+    runs (slow tier)."""
+    blocked = np.random.default_rng(3).random((12, 12)) < 0.2
+    blocked[0, 0] = blocked[1, 1] = blocked[11, 11] = False
+    graph = grid_graph(blocked)
     logw = towards(graph, 143, 0.3)
     keys = jax.random.split(jax.random.key(7), 4)
-    starts = jnp.array([0, 0, 143, 13])  # the third run is already at its goal
+    starts = jnp.array([0, 13, 143, 0])  # the third run is already at its goal
+    assert lanes_for(4 * 48) < 4 * 48 and lanes_for(48) == 48
 
     @jax.jit
     def one(key, start):
-        return walk(key, graph, logw, start, 143, num_agents=24, max_steps=100)
+        return walk(key, graph, logw, start, 143, num_agents=48, max_steps=100)
 
     batch = jax.jit(jax.vmap(one))(keys, starts)
     for i in range(4):
