@@ -157,6 +157,7 @@ def pytest_sessionfinish(session):
             session.exitstatus = pytest.ExitCode.TESTS_FAILED
 
 
+@pytest.hookimpl(optionalhook=True)  # pytest-xdist's hook: absent without it
 def pytest_testnodedown(node, error):
     node.config.stash[LEDGER].join(getattr(node, "workeroutput", {}).get("compile_ledger", {}))
 
