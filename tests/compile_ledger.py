@@ -20,6 +20,7 @@ name and the files that built it to ``PATH`` (JSON).
 """
 from __future__ import annotations
 
+import collections
 import inspect
 import json
 import os
@@ -37,8 +38,6 @@ import program_hooks  # noqa: E402 (from SITE)
 
 BUDGETS = Path(__file__).parent / "compile_budgets.toml"
 """The default tier's table of programs per test file."""
-OUT_VARIABLE = "JAXSWARM_LEDGER_OUT"
-"""Where the processes a test starts write what they built (``site/sitecustomize.py``)."""
 DEFAULT_TIER = "not slow"
 """The marker expression of the default tier (``pyproject.toml``'s addopts)."""
 SHOWN = 10
@@ -64,14 +63,16 @@ class Ledger:
         self.window: str | None = None
         self.outbox: Path | None = None
 
-    def record(self, fingerprint: str, name: str, seconds: float = 0.0) -> None:
-        self.built.setdefault(self.owner, {}).setdefault(fingerprint, [name, 0.0])[1] += seconds
+    def record(self, fingerprint: str, name: str, seconds: float = 0.0, owner: str | None = None
+               ) -> None:
+        """Count a program for ``owner`` (default :attr:`owner`)."""
+        programs = self.built.setdefault(self.owner if owner is None else owner, {})
+        programs.setdefault(fingerprint, [name, 0.0])[1] += seconds
 
     def join(self, built: dict[str, dict[str, list]]) -> None:
         for owner, programs in built.items():
             for fingerprint, (name, seconds) in programs.items():
-                self.owner = owner
-                self.record(fingerprint, name, seconds)
+                self.record(fingerprint, name, seconds, owner)
 
     def collect_subprocesses(self) -> None:
         """Count what the processes started since the last call built, for :attr:`owner`."""
@@ -102,7 +103,7 @@ def pytest_configure(config):
         return
     program_hooks.install(ledger.record)
     ledger.outbox = Path(tempfile.mkdtemp(prefix="compile-ledger-"))
-    os.environ[OUT_VARIABLE] = str(ledger.outbox)
+    os.environ[program_hooks.OUT_VARIABLE] = str(ledger.outbox)
     os.environ["PYTHONPATH"] = os.pathsep.join(
         [str(SITE), *filter(None, [os.environ.get("PYTHONPATH")])])
 
@@ -142,11 +143,10 @@ def pytest_fixture_setup(fixturedef, request):
 @pytest.hookimpl(tryfirst=True)
 def pytest_sessionfinish(session):
     ledger = session.config.stash[LEDGER]
-    if hasattr(session.config, "workerinput"):
-        session.config.workeroutput["compile_ledger"] = ledger.built
     if ledger.outbox is not None:
         shutil.rmtree(ledger.outbox, ignore_errors=True)
     if hasattr(session.config, "workerinput"):
+        session.config.workeroutput["compile_ledger"] = ledger.built
         return
     if session.config.getoption("--compile-ledger"):
         _write(ledger, Path(session.config.getoption("--compile-ledger")))
@@ -200,10 +200,7 @@ def pytest_terminal_summary(terminalreporter, config):
         xla = sum(f.startswith("xla:") for f in unique)
         writer.write_sep("=", f"compile ledger ({_tier(config)} tier): {len(unique)} programs "
                               f"({xla} XLA, {len(unique) - xla} numba)")
-        shared: dict[str, int] = {}
-        for built in ledger.built.values():
-            for fingerprint in built:
-                shared[fingerprint] = shared.get(fingerprint, 0) + 1
+        shared = collections.Counter(f for built in ledger.built.values() for f in built)
         writer.write_line(f"{'programs':>9} {'own':>5} {'budget':>6} {'seconds':>8}  file (own: "
                           "built by no other file; seconds: XLA compiling or loading them)")
         table = budgets()

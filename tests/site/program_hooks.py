@@ -32,6 +32,9 @@ Record = Callable[[str, str, float], None]
 XLA took to compile it or to load it from the persistent cache (0 for a numba function, and for
 an XLA program lowered but not compiled)."""
 
+OUT_VARIABLE = "JAXSWARM_LEDGER_OUT"
+"""Names the folder where the processes a test starts write what they built
+(``sitecustomize.py``)."""
 CONTROL_FLOW = frozenset({"while", "scan", "cond"})
 """Primitives that make an eager operation a program worth counting (a loop's or a branch's)."""
 

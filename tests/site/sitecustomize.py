@@ -4,18 +4,18 @@
 started it to count."""
 import os
 
-if os.environ.get("JAXSWARM_LEDGER_OUT"):
+import program_hooks
+
+if os.environ.get(program_hooks.OUT_VARIABLE):
     import atexit
     import json
-
-    import program_hooks
 
     _built: dict[str, list] = {}
 
     def _record(fingerprint, name, seconds):
         _built.setdefault(fingerprint, [name, 0.0])[1] += seconds
 
-    def _write(folder=os.environ["JAXSWARM_LEDGER_OUT"]):
+    def _write(folder=os.environ[program_hooks.OUT_VARIABLE]):
         if _built and os.path.isdir(folder):
             with open(os.path.join(folder, f"{os.getpid()}.json"), "w") as out:
                 json.dump(_built, out)
