@@ -175,11 +175,25 @@ def test_excluded_and_invalid_edges_are_never_taken():
     assert bool(result.arrived.any())
 
 
-@pytest.mark.parametrize("lanes, compact, smallest",
-                         [(8, 4, 16), (64, 10 ** 9, 16), (5, 2, 16), (64, 2, 2)])
-def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact, smallest):
+@pytest.fixture
+def walker_constants(monkeypatch):
+    """``set(**values)`` sets constants of the walker's module for the rest of the test; the
+    jitted :func:`walk` traces again with them, and again with the originals after the test."""
     import jaxswarm.swarm.walking.loop as walk_module
 
+    def set_constants(**values):
+        for name, value in values.items():
+            monkeypatch.setattr(walk_module, name, value)
+        walk.clear_cache()
+
+    yield set_constants
+    monkeypatch.undo()
+    walk.clear_cache()
+
+
+@pytest.mark.parametrize("lanes, compact, smallest",
+                         [(8, 4, 16), (64, 10 ** 9, 16), (5, 2, 16), (64, 2, 2)])
+def test_how_agents_share_the_lanes_changes_no_walk(walker_constants, lanes, compact, smallest):
     graph = grid_graph(np.zeros((16, 16), bool))
     logw = towards(graph, 255, 0.6)  # most agents arrive early, a few wander on
 
@@ -191,9 +205,8 @@ def test_how_agents_share_the_lanes_changes_no_walk(monkeypatch, lanes, compact,
     moves = np.asarray(default.moves)
     # The case under test: agents of very different lengths, so lanes are refilled unevenly.
     assert moves.max() - moves.min() > 4 * STEPS_PER_REFILL
-    monkeypatch.setattr(walk_module, "LANES", lanes)
-    monkeypatch.setattr(walk_module, "COMPACT_SHARE", compact)
-    monkeypatch.setattr(walk_module, "SMALLEST_COMPACTION", smallest)  # (64, 2, 2): five narrowings
+    # (64, 2, 2): five narrowings
+    walker_constants(LANES=lanes, COMPACT_SHARE=compact, SMALLEST_COMPACTION=smallest)
     shared = walks()
     assert int(shared.lane_steps) != int(default.lane_steps)  # another schedule ...
     for (name, value), other in zip(_fields(default).items(), _fields(shared).values()):
@@ -206,12 +219,10 @@ def test_a_loop_steps_about_one_lane_per_eight_agents_within_bounds():
     assert FEWEST_LANES <= LANES
 
 
-def test_a_small_walk_keeps_most_lanes_busy(monkeypatch):
+def test_a_small_walk_keeps_most_lanes_busy(walker_constants):
     """1,024 agents (4 runs of 256, a few of which wander long after the others arrived) on
     ``lanes_for``'s 128 lanes: more of the lane-steps move an agent than with a lane per agent,
     for the same walks."""
-    import jaxswarm.swarm.walking.loop as walk_module
-
     graph = grid_graph(np.random.default_rng(5).random((24, 24)) < 0.2)
     logw = towards(graph, graph.num_nodes - 1, 0.5)
     keys = jax.random.split(jax.random.key(2), 4)
@@ -221,7 +232,7 @@ def test_a_small_walk_keeps_most_lanes_busy(monkeypatch):
                                                  num_agents=256, max_steps=300)))(keys)
 
     queued = walks()
-    monkeypatch.setattr(walk_module, "FEWEST_LANES", 1024)  # a lane for every agent
+    walker_constants(FEWEST_LANES=1024)  # a lane for every agent
     one_each = walks()
     busy = [int(w.moves.sum()) / int(w.lane_steps[0]) for w in (queued, one_each)]
     assert busy[0] > 0.7 and busy[0] > busy[1] + 0.05, busy

@@ -173,7 +173,7 @@ class Walk(NamedTuple):
 
 
 def _padded(log: MoveLog):
-    """:func:`.log.paths` at the full budget, over any leading batch axes of ``log``.
+    """The log's paths and slots, written out at the full budget (:func:`_written_out`).
 
     Raises:
       ValueError: the log (concrete, not traced) overflowed: its rows would be wrong.
@@ -182,6 +182,12 @@ def _padded(log: MoveLog):
         raise ValueError("the walk's log had no room for all its moves: walk again with a "
                          "larger log_moves (jaxswarm.swarm.walking.log.ROOM_FOR_EVERY_MOVE "
                          "has room for every move)")
+    return _written_out(log)
+
+
+@jax.jit
+def _written_out(log: MoveLog):
+    """:func:`.log.paths` at the full budget, over any leading batch axes of ``log``."""
     read = paths
     for _ in range(log.moves.ndim - 1):
         read = jax.vmap(read)
@@ -195,6 +201,8 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
     return bits.union(walk.visited, num_nodes, which)
 
 
+@functools.partial(jax.jit, static_argnames=("num_agents", "max_steps", "greedy_agents", "hook",
+                                             "log_moves"))
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
          max_steps: int, greedy_agents: int = 0, hook: StepHook | None = None, memory=None,
          hook_params=None, log_moves: int | None = None) -> Walk:
@@ -219,7 +227,9 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
         :func:`~.log.room_blocks`); more, and the log says it overflowed (:mod:`.log`).
 
     Returns:
-      A :class:`Walk`. Under ``vmap`` the walks of the batch share one queue (module docstring).
+      A :class:`Walk`. One compiled program per set of static options and shapes, called alone
+      or inside ``jit``; under ``vmap`` the walks of the batch share one queue (module
+      docstring).
     """
     if log_moves is not None and log_moves < 1:
         raise ValueError(f"log_moves must be at least 1, got {log_moves}")
