@@ -6,7 +6,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import sizes
 
+from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import STANDARD_IWD, global_update, soil_taken, velocity_after
@@ -95,6 +97,33 @@ def test_an_arrived_drop_updates_the_soil_of_its_moves_by_eq_5():
     assert np.all(after[untouched] == 1000.0)
 
 
+SIDE = 24
+"""The side of the grids the drops walk on (a smaller map is cut out of one by obstacles): one
+program of the walk and one of the arrived drops' updates for all of them."""
+
+
+def cut_out(obstacles):
+    """A SIDE x SIDE grid, ``obstacles`` (bool[H, W]) in its corner and blocked elsewhere."""
+    grid = np.ones((SIDE, SIDE), bool)
+    grid[:obstacles.shape[0], :obstacles.shape[1]] = obstacles
+    return grid_graph(grid)
+
+
+def comb():
+    """A corridor (0, 0) .. (4, 0) with dead ends below (1, 0) and (3, 0), and its task from end
+    to end."""
+    obstacles = np.zeros((2, 5), bool)
+    obstacles[1, [0, 2, 4]] = True  # the row below is a comb
+    graph = cut_out(obstacles)
+    return graph, make_task(graph, (0, 0), (4, 0))
+
+
+def drops_of(key, graph, task, soil, params=P, **options):
+    """:func:`drop_walk` of 32 drops in the map's step budget over ``soil``, f32[N, K] (a
+    weakly typed one, ``jnp.full`` of a Python float, would be a program of its own)."""
+    return drop_walk(key, graph, task, soil, params, num_agents=32, max_steps=None, **options)
+
+
 def assert_sequential_soil(graph, soil, drops):
     """The drops' soil and states equal a loop over the arrived drops in agent order and their
     moves in move order (NumPy float32, the soil taken over each whole row), bit for bit; the
@@ -122,16 +151,14 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     # shuts the right end off, where the second task's goal lies.
     blocked = np.zeros((3, 9), bool)
     blocked[:, 6] = True
-    graph = grid_graph(blocked)
+    graph = cut_out(blocked)
     tasks = [make_task(graph, (0, 1), goal) for goal in ((5, 1), (8, 1))]
     soil = jax.random.uniform(jax.random.key(3), graph.nbr.shape, minval=900.0, maxval=1100.0)
-    drops = drop_walk(jax.random.key(2), graph, tasks[0], soil, P, num_agents=16,
-                      max_steps=None)
+    drops = drops_of(jax.random.key(2), graph, tasks[0], soil)
     assert np.asarray(drops.arrived).sum() >= 2
     expected = assert_sequential_soil(graph, soil, drops)
     # A batch of that run and one whose drops cannot arrive: each run's soil as alone.
-    batch = jax.jit(jax.vmap(lambda task: drop_walk(
-        jax.random.key(2), graph, task, soil, P, num_agents=16, max_steps=None)))(
+    batch = jax.jit(jax.vmap(lambda task: drops_of(jax.random.key(2), graph, task, soil)))(
         jax.tree_util.tree_map(lambda *x: jnp.stack(x), *tasks))
     assert not batch.arrived[1].any()
     np.testing.assert_array_equal(np.asarray(batch.memory[0]), expected)
@@ -139,14 +166,10 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
 
 
 def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
-    # A dead end above the corridor's middle: drops that enter it get stuck.
-    free = np.zeros((2, 5), bool)
-    free[1, [0, 2, 4]] = True  # blocked: the row below is a comb
-    graph = grid_graph(free)
-    table_soil = jnp.full(graph.nbr.shape, 10_000.0)
-    task = make_task(graph, (0, 0), (4, 0))
-    drops = drop_walk(jax.random.key(1), graph, task, table_soil, P, num_agents=32,
-                      max_steps=None)
+    # Dead ends beside the corridor: drops that enter them get stuck.
+    graph, task = comb()
+    table_soil = jnp.full(graph.nbr.shape, 10_000.0, jnp.float32)
+    drops = drops_of(jax.random.key(1), graph, task, table_soil)
     assert drops.arrived.any() and (~drops.arrived).any()
     changed = np.asarray(drops.memory) != 10_000.0
     rows, slots = np.nonzero(changed)
@@ -161,10 +184,10 @@ def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
 def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_after_the_walk():
     # On an open grid the arrived drops' walks fit the narrowest width of the work after a
     # walk (128 moves), some drops that did not arrive walk longer.
-    graph = grid_graph(np.zeros((24, 24), bool))
+    graph = grid_graph(np.zeros((SIDE, SIDE), bool))
     task = make_task(graph, (0, 0), (10, 10))
     soil = jax.random.uniform(jax.random.key(2), graph.nbr.shape, minval=9_000.0, maxval=11_000.0)
-    drops = drop_walk(jax.random.key(0), graph, task, soil, P, num_agents=32, max_steps=None)
+    drops = drops_of(jax.random.key(0), graph, task, soil)
     moves, arrived = np.asarray(drops.moves), np.asarray(drops.arrived)
     assert moves[arrived].max() <= NARROWEST < moves[~arrived].max()
     # Every drop's whole row, as before the cut: the same bits for the arrived drops.
@@ -172,13 +195,9 @@ def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_afte
 
 
 def test_backtracking_drops_back_out_of_dead_ends():
-    free = np.zeros((2, 5), bool)
-    free[1, [0, 2, 4]] = True
-    graph = grid_graph(free)
-    task = make_task(graph, (0, 0), (4, 0))
-    soil = jnp.full(graph.nbr.shape, 10_000.0)
-    drops = drop_walk(jax.random.key(1), graph, task, soil, P, num_agents=32, max_steps=None,
-                      backtrack=True)
+    graph, task = comb()
+    soil = jnp.full(graph.nbr.shape, 10_000.0, jnp.float32)
+    drops = drops_of(jax.random.key(1), graph, task, soil, backtrack=True)
     assert drops.arrived.all()
     paths = np.asarray(drops.path)
     for path, moves in zip(paths, np.asarray(drops.moves)):
@@ -304,11 +323,20 @@ def test_global_update_on_the_best_path():
     assert np.array_equal(after[~changed], np.asarray(soil)[~changed])
 
 
+def shared_map():
+    """The shared sizes' map (``tests/sizes.py``) and its task."""
+    chosen = paper_map(sizes.MAP)
+    graph = chosen.graph()
+    return graph, make_task(graph, chosen.start, chosen.goal)
+
+
 def test_iwd_finds_the_corridor_and_its_soil_falls_along_it():
-    graph = grid_graph(np.zeros((1, 6), bool))
-    swarm = make("iwd", num_agents=4)
+    obstacles = np.ones(shared_map()[0].shape, bool)
+    obstacles[0, :6] = False  # a corridor (0, 0) .. (5, 0) in the shared map's shape
+    graph = grid_graph(obstacles)
+    swarm = make("iwd", **sizes.CONFIG)
     state, trace = run(swarm, jax.random.key(0), graph, make_task(graph, 0, 5),
-                       swarm.default_params, iterations=3)
+                       swarm.default_params, iterations=sizes.ITERATIONS, budget=3)
     assert float(swarm.best(state).cost) == pytest.approx(5.0)
     soil, initial = np.asarray(state.soil), swarm.default_params.initial_soil
     assert np.all(soil[:5, EAST] < initial) and np.all(soil[:, 2] == initial)  # no west moves
@@ -323,16 +351,16 @@ def test_bad_params_are_named():
 
 
 def test_every_run_counts_its_fitness_calls():
-    graph = grid_graph(np.zeros((4, 4), bool))
+    graph, task = shared_map()
     for name in ("iwd", "aco_star"):
-        swarm = make(name, num_agents=8)
-        _, trace = run(swarm, jax.random.key(2), graph, make_task(graph, 0, 15),
-                       swarm.default_params, iterations=5)
+        swarm = make(name, **sizes.CONFIG)
+        _, trace = run(swarm, jax.random.key(2), graph, task, swarm.default_params,
+                       iterations=sizes.ITERATIONS)
         used = int(trace.iterations)
         evaluations = np.asarray(trace.evaluations)
         # One call per agent that arrived: a complete path whose length was evaluated.
         np.testing.assert_array_equal(evaluations[:used],
-                                      np.round(np.asarray(trace.arrived)[:used] * 8))
+                                      np.round(np.asarray(trace.arrived)[:used] * sizes.AGENTS))
         assert evaluations[used:].sum() == 0 and evaluations.sum() > 0
 
 
@@ -358,7 +386,7 @@ def test_drops_that_arrive_find_mosaic50_where_drops_that_all_take_soil_did_not(
 def test_hook_params_of_an_inner_vmap_reach_every_member_of_an_outer_one():
     # Keys outside (params shared), params inside: the outer batch rule meets params that the
     # inner one folded to one per run; each member must walk with its own.
-    graph = grid_graph(np.zeros((8, 8), bool))
+    graph = grid_graph(np.zeros((SIDE, SIDE), bool))
     task = make_task(graph, (0, 0), (7, 7))
     soil = jax.random.uniform(jax.random.key(5), graph.nbr.shape, minval=1.0, maxval=10_000.0)
     keys = jax.random.split(jax.random.key(0), 2)
@@ -366,7 +394,7 @@ def test_hook_params_of_an_inner_vmap_reach_every_member_of_an_outer_one():
         alpha=jnp.array([0.0, 3.0], jnp.float32))
 
     def moves(key, params):
-        return drop_walk(key, graph, task, soil, params, num_agents=8, max_steps=None).moves
+        return drops_of(key, graph, task, soil, params).moves
 
     nested = jax.jit(jax.vmap(lambda key: jax.vmap(lambda p: moves(key, p))(params)))(keys)
     for i in range(2):

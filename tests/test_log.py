@@ -17,13 +17,16 @@ from jaxswarm.world.graph import grid_graph
 
 OPEN = grid_graph(np.zeros((24, 24), bool))
 """An open grid: uniform walkers wander far before they reach a corner near the start."""
+AGENTS, STEPS = 32, 300
+"""The walkers of the tests' walks and logs, and their step budget."""
 
 
-def _walk(log_moves, max_steps=300, agents=32):
+def _walk(log_moves):
+    """AGENTS uniform walkers on OPEN for STEPS steps, their log with room for ``log_moves``
+    moves an agent (one program a room)."""
     table = jnp.where(OPEN.nbr >= 0, 0.0, -jnp.inf)
-    return jax.jit(lambda key: walk(key, OPEN, table, 0, 3 * 24 + 3, num_agents=agents,
-                                    max_steps=max_steps, log_moves=log_moves))(
-        jax.random.key(0))
+    return walk(jax.random.key(0), OPEN, table, 0, 3 * 24 + 3, num_agents=AGENTS,
+                max_steps=STEPS, log_moves=log_moves)
 
 
 def test_a_log_without_room_says_so_and_its_size_changes_no_move():
@@ -43,22 +46,22 @@ def test_a_log_without_room_says_so_and_its_size_changes_no_move():
 
 
 def test_reading_the_log_gives_the_padded_rows_it_was_made_of():
-    walked = _walk(ROOM_FOR_EVERY_MOVE, max_steps=100, agents=12)
+    walked = _walk(ROOM_FOR_EVERY_MOVE)
     path, slots = np.asarray(walked.path), np.asarray(walked.slots)
     moves = np.asarray(walked.moves)
     # Written out, each row holds its moves, then -1; the path starts at the start.
-    for a in range(12):
+    for a in range(AGENTS):
         assert (path[a, :moves[a] + 1] >= 0).all() and (path[a, moves[a] + 1:] == -1).all()
         assert (slots[a, :moves[a]] >= 0).all() and (slots[a, moves[a]:] == -1).all()
     assert (path[:, 0] == 0).all()
     # The same rows through from_rows (another layout: a fixed stride per agent).
-    strided = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), 0, 100)
+    strided = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), 0, STEPS)
     for log in (walked.log, strided):
-        for width in (BLOCK - 1, 40, 100):
+        for width in (BLOCK - 1, 40, STEPS):
             cut_path, cut_slots = paths(log, width)
             np.testing.assert_array_equal(cut_path, path[:, :width + 1])
             np.testing.assert_array_equal(cut_slots, slots[:, :width])
-        picked = np.random.default_rng(0).integers(-2, 104, (12, 7))
+        picked = np.random.default_rng(0).integers(-2, STEPS + 4, (AGENTS, 7))
         nodes, slot = columns(log, jnp.asarray(picked))
         padded_path = np.pad(path, ((0, 0), (0, 10)), constant_values=-1)
         padded_slots = np.pad(slots, ((0, 0), (0, 10)), constant_values=-1)
@@ -68,23 +71,23 @@ def test_reading_the_log_gives_the_padded_rows_it_was_made_of():
         np.testing.assert_array_equal(np.asarray(slot)[inside],
                                       np.take_along_axis(padded_slots, picked, 1)[inside])
         assert (np.asarray(nodes)[~inside] == -1).all()
-        for a in (0, 5, 11):
-            np.testing.assert_array_equal(agent_path(log, jnp.int32(a), 101), path[a])
+        for a in (0, 5, 11, AGENTS - 1):
+            np.testing.assert_array_equal(agent_path(log, jnp.int32(a), STEPS + 1), path[a])
         assert not bool(all_same(log))
 
 
 def test_all_same_sees_one_different_move_anywhere():
     row = np.arange(1, 41, dtype=np.int32)
-    path = np.tile(np.concatenate([[0], row, [-1] * 4]), (5, 1))
-    slots = np.tile(np.concatenate([row % 8, [-1] * 4]), (5, 1)).astype(np.int8)
-    moves = np.full(5, 40, np.int32)
+    path = np.tile(np.concatenate([[0], row, [-1] * (STEPS - 40)]), (AGENTS, 1))
+    slots = np.tile(np.concatenate([row % 8, [-1] * (STEPS - 40)]), (AGENTS, 1)).astype(np.int8)
+    moves = np.full(AGENTS, 40, np.int32)
 
     def same(path, slots, moves):
         return bool(all_same(from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves),
-                                       0, 44)))
+                                       0, STEPS)))
 
     assert same(path, slots, moves)
-    for agent, move in [(0, 0), (3, 17), (4, 39)]:
+    for agent, move in [(0, 0), (3, 17), (4, 39), (AGENTS - 1, 39)]:
         changed = slots.copy()
         changed[agent, move] = (changed[agent, move] + 1) % 8
         assert not same(path, changed, moves)

@@ -72,11 +72,19 @@ def corridor():
     return graph, make_task(graph, (0, 0), (4, 0))
 
 
+def iterate(swarm, graph, task, params, state, budget=1):
+    """``(state, trace)`` of ``budget`` iterations of ``swarm`` from ``state``, by ``run`` at the
+    shared iteration count with a traced budget: one program per swarm and map shape, whatever the
+    budget, the params and the state's values."""
+    return run(swarm, jax.random.key(0), graph, task, params, iterations=ITERATIONS, state=state,
+               budget=budget)
+
+
 def one_iteration(swarm, graph, task, **params):
     params = swarm.default_params._replace(**{k: jnp.float32(v) for k, v in params.items()})
     state = swarm.init(jax.random.key(0), graph, task, params)
-    state, info = swarm.step(state, graph, task, params)
-    assert float(info.arrived) == 1.0
+    state, trace = iterate(swarm, graph, task, params, state)
+    assert float(trace.arrived[0]) == 1.0
     return np.asarray(state.altitude)
 
 
@@ -111,23 +119,24 @@ def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corrido
     params = swarm.default_params._replace(erosion=jnp.float32(0.5),
                                            initial_height=jnp.float32(100.0))
     state = swarm.init(jax.random.key(0), graph, task, params)
-    state, _ = swarm.step(state, graph, task, params)
-    state, _ = swarm.step(state, graph, task, params._replace(erosion=jnp.float32(2.0)))
+    state, _ = iterate(swarm, graph, task, params, state)
+    state, _ = iterate(swarm, graph, task, params._replace(erosion=jnp.float32(2.0)), state)
     np.testing.assert_allclose(state.altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
 
 
 def test_graded_carving_drains_into_a_river_without_arriving():
-    # Nodes 3 and 4 of a 1 x 6 corridor are carved; the drops may walk 3 steps, so they stop on
-    # node 3 without reaching the goal and carve 0-2 to slope x (walked to 3 + depth of 3).
+    # Nodes 2, 3 and 4 of a 1 x 6 corridor are carved; the drops may walk 2 steps (the swarm of
+    # test_ground_explored_in_vain_rises_towards_the_frontier), so they stop on node 2 without
+    # reaching the goal and carve 0-1 to slope x (walked to 2 + depth of 2).
     graph = grid_graph(np.zeros((1, 6), bool))
     task = make_task(graph, (0, 0), (5, 0))
-    swarm = make("rfd_graded", num_agents=4, max_steps=3)
+    swarm = make("rfd_graded", num_agents=4, max_steps=2)
     params = swarm.default_params._replace(erosion=jnp.float32(0.5))
     plateau = float(params.initial_height)
     state = swarm.init(jax.random.key(0), graph, task, params)
-    state = dataclasses.replace(state, altitude=jnp.array([plateau] * 3 + [1.0, 0.5, 0.0]))
-    state, info = swarm.step(state, graph, task, params)
-    assert float(info.arrived) == 0.0
+    state = dataclasses.replace(state, altitude=jnp.array([plateau] * 2 + [1.5, 1.0, 0.5, 0.0]))
+    state, trace = iterate(swarm, graph, task, params, state)
+    assert float(trace.arrived[0]) == 0.0
     np.testing.assert_allclose(state.altitude, [2.5, 2.0, 1.5, 1.0, 0.5, 0.0])
 
 
@@ -169,7 +178,9 @@ def test_a_stuck_drop_fills_its_blind_alley_back_to_the_junction():
 
 
 def test_a_drop_trapped_by_its_own_trail_fills_only_where_it_stopped():
-    graph = grid_graph(np.zeros((3, 3), bool))
+    obstacles = np.zeros((3, 5), bool)
+    obstacles[:, 3:] = True  # an open 3 x 3, in the previous test's 3 x 5 (the same programs)
+    graph = grid_graph(obstacles)
     task = make_task(graph, (0, 0), (2, 2))
     spiral = [(0, 0), (1, 0), (2, 0), (2, 1), (1, 2), (0, 2), (0, 1), (1, 1)]
     assert filled_cells(graph, task, fake_walk(graph, spiral)) == [(1, 1)]
@@ -220,11 +231,12 @@ def test_settling_leaves_no_filled_pit():
     # (2, 1) drains to the unfilled (3, 1); unfilled and carved nodes and (6, 1), which drains
     # into the bed at (5, 1), keep their altitude.
     np.testing.assert_allclose(settled, [101.5, 101.25, 101.0, 100.0, 99.0, 0.0, 102.0])
-    # A filled node without any edge has nowhere to settle to and keeps its altitude.
-    alone = np.ones((3, 3), bool)
+    # A filled node without any edge has nowhere to settle to and keeps its altitude (a map of
+    # the shape above: the same program).
+    alone = np.ones((3, 7), bool)
     alone[1, 1] = False
-    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((9,), 101.0), params))
-    assert lone[4] == 101.0
+    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((21,), 101.0), params))
+    assert lone[row + 1] == 101.0
 
 
 def test_sediment_settles_all_the_way_in_one_call():
@@ -262,8 +274,8 @@ def test_ground_explored_in_vain_rises_towards_the_frontier():
     params = swarm.default_params._replace(initial_height=jnp.float32(100.0),
                                            sediment=jnp.float32(0.5), repose=jnp.float32(0.25))
     state = swarm.init(jax.random.key(0), graph, task, params)
-    state, info = swarm.step(state, graph, task, params)
-    assert float(info.arrived) == 0.0
+    state, trace = iterate(swarm, graph, task, params, state)
+    assert float(trace.arrived[0]) == 0.0
     np.testing.assert_allclose(state.altitude, [101.0, 100.75, 100.5, 100.0, 100.0, 0.0])
 
 
@@ -321,16 +333,22 @@ def test_unreachable_goal_is_a_clean_not_found_result():
         assert (np.asarray(trace.arrived) == 0).all()
 
 
-def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) -> Swarm:
-    """A stand-in swarm (no walking): its first path, of cost 100, appears at iteration
-    ``first_path_at`` (1-based), and the cost drops by one at each of ``improvements``."""
+NEVER = 2 ** 30
+"""An iteration no run reaches."""
+
+
+def _late_arrival_swarm() -> Swarm:
+    """A stand-in swarm (no walking) whose params ``(first_path_at, improvements)`` say when its
+    first path, of cost 100, appears (iteration, 1-based) and at which iterations (i32[2],
+    :data:`NEVER` for none) the cost drops by one: one program for every such schedule."""
     def init(key, graph, task, params):
         return jnp.int32(0), jnp.float32(jnp.inf)
 
     def step(state, graph, task, params):
+        first_path_at, improvements = params
         count = state[0] + 1
         cost = jnp.where(count >= first_path_at, 100.0, jnp.inf)
-        cost = cost - sum(jnp.where(count >= t, 1.0, 0.0) for t in improvements)
+        cost = cost - jnp.sum(jnp.where(count >= improvements, 1.0, 0.0))
         info = StepInfo(iteration_cost=cost, arrived=jnp.float32(0), converged=jnp.array(False),
                         moves=jnp.int32(0), lane_steps=jnp.int32(0), evaluations=jnp.int32(0))
         return (count, cost.astype(jnp.float32)), info
@@ -345,13 +363,17 @@ def _late_arrival_swarm(first_path_at: int, improvements: tuple[int, ...] = ()) 
                  adapt=lambda state, *_: state)
 
 
+LATE = _late_arrival_swarm()
+
+
 @pytest.mark.parametrize("name", ["rfd_star", "ant_system"])
-def test_a_run_stops_when_every_agent_followed_the_same_path(name):
-    obstacles = np.ones((3, 5), bool)
-    obstacles[1] = False  # a one-cell corridor: there is one path
-    graph = grid_graph(obstacles)
-    state, trace = run(make(name, num_agents=8), jax.random.key(0), graph,
-                       make_task(graph, (0, 1), (4, 1)), make(name).default_params, iterations=10)
+def test_a_run_stops_when_every_agent_followed_the_same_path(name, corridor):
+    # On the corridor there is one path. From the initial state, as the erosion tests above run
+    # (rfd_star shares their program).
+    graph, task = corridor
+    swarm = make(name, num_agents=8)
+    state = swarm.init(jax.random.key(0), graph, task, swarm.default_params)
+    state, trace = iterate(swarm, graph, task, swarm.default_params, state, budget=ITERATIONS)
     assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
 
 
@@ -382,8 +404,9 @@ def test_keep_best_calls_an_iteration_converged_only_on_one_path_of_all_agents()
 def test_patience_counts_iterations_without_gain_since_the_first_path(first_path_at,
                                                                        improvements, stops_after):
     graph = grid_graph(np.zeros((2, 2), bool))
-    swarm = _late_arrival_swarm(first_path_at, improvements)
-    state, trace = run(swarm, jax.random.key(0), graph, make_task(graph, (0, 0), (1, 1)), None,
+    schedule = (jnp.int32(first_path_at),
+                jnp.array(improvements + (NEVER,) * (2 - len(improvements)), jnp.int32))
+    state, trace = run(LATE, jax.random.key(0), graph, make_task(graph, (0, 0), (1, 1)), schedule,
                        iterations=40, patience=5)
     assert int(trace.iterations) == stops_after
     assert float(trace.best_cost[stops_after - 1]) == 100.0 - len(improvements)

@@ -72,20 +72,48 @@ def towards(graph, goal, strength=1.0):
                                               graph.nbr.shape))
 
 
+SIDE = 16
+"""The side of the grids walked on (but for the busy lanes' test, which needs more agents):
+:func:`walk` is one program for all maps of a shape and all tables, so these walks build one
+program per set of walk options."""
+AGENTS = 64
+"""The agents of a walk: at most the walker's fewest lanes, so a run alone walks a lane an agent,
+and more than a quarter of them, so a batch of 4 runs outnumbers its lanes."""
+STEPS = SIDE * SIDE - 1
+"""A walk's step budget (the longest walk without revisits)."""
+
+
+def grid(blocked=0.0, seed=0, free=()):
+    """A SIDE x SIDE grid, each cell blocked with probability ``blocked`` but the nodes ``free``."""
+    obstacles = np.random.default_rng(seed).random((SIDE, SIDE)) < blocked
+    obstacles.flat[list(free)] = False
+    return grid_graph(obstacles)
+
+
+def grid_walk(key, graph, table, start, goal, **options):
+    """:func:`walk` of AGENTS agents for STEPS steps, ``start`` and ``goal`` as i32[] (Python
+    ints are weakly typed: a program of their own)."""
+    return walk(key, graph, table, jnp.int32(start), jnp.int32(goal), num_agents=AGENTS,
+                max_steps=STEPS, **options)
+
+
+def batch_of_walks(keys, graph, table, starts, goal):
+    """:func:`grid_walk` under ``vmap``, a run a key and start: their agents share one queue."""
+    return jax.vmap(lambda key, start: grid_walk(key, graph, table, start, goal))(keys, starts)
+
+
 def test_walks_are_valid_self_avoiding_and_measured():
-    obstacles = np.random.default_rng(0).random((10, 10)) < 0.25
-    obstacles[0, 0] = obstacles[9, 9] = False
-    graph = grid_graph(obstacles)
-    result = jax.jit(lambda key: walk(key, graph, uniform(graph), 0, 99, num_agents=64,
-                                      max_steps=60))(jax.random.key(3))
+    goal = SIDE * SIDE - 1
+    graph = grid(0.25, free=(0, goal))
+    result = grid_walk(jax.random.key(3), graph, uniform(graph), 0, goal)
     path = np.asarray(result.path)
-    for a in range(64):
+    for a in range(AGENTS):
         nodes = path[a][path[a] >= 0]
         assert len(set(nodes.tolist())) == len(nodes)  # no revisits
         assert bool(is_valid_path(graph, result.path[a], start=0))
         assert float(path_length(graph, result.path[a])) == pytest.approx(float(result.length[a]))
         if result.arrived[a]:
-            assert nodes[-1] == 99 and not result.stuck[a]
+            assert nodes[-1] == goal and not result.stuck[a]
         assert nodes[-1] == int(result.position[a])
     # Stuck agents really have no unvisited free neighbour left.
     valid, nbr = np.asarray(graph.valid_edges()), np.asarray(graph.nbr)
@@ -94,8 +122,8 @@ def test_walks_are_valid_self_avoiding_and_measured():
         here = int(result.position[a])
         assert all(nbr[here, k] in nodes for k in range(8) if valid[here, k])
     moves = np.asarray(result.moves)
-    assert moves.max() <= 60 and (moves == (path >= 0).sum(axis=1) - 1).all()
-    assert moves.sum() <= int(result.lane_steps) <= 64 * 60 + 64 * STEPS_PER_REFILL
+    assert moves.max() <= STEPS and (moves == (path >= 0).sum(axis=1) - 1).all()
+    assert moves.sum() <= int(result.lane_steps) <= AGENTS * (STEPS + STEPS_PER_REFILL)
     np.testing.assert_array_equal(np.asarray(result.slots) >= 0, path[:, 1:] >= 0)
 
 
@@ -124,52 +152,55 @@ def test_walks_on_a_general_graph_are_valid_and_record_their_nodes():
 
 
 def test_visited_nodes_is_the_union_of_the_selected_paths():
-    graph = grid_graph(np.random.default_rng(2).random((9, 9)) < 0.2)
-    result = walk(jax.random.key(2), graph, uniform(graph), 40, 80, num_agents=16, max_steps=40)
+    nodes, centre = SIDE * SIDE, SIDE * SIDE // 2 + SIDE // 2
+    graph = grid(0.2, seed=2, free=(centre, nodes - 1))
+    result = grid_walk(jax.random.key(2), graph, uniform(graph), centre, nodes - 1)
     path = np.asarray(result.path)
-    np.testing.assert_array_equal(unpacked(result.visited, 81).any(axis=0),
-                                  np.asarray(visited_nodes(result, 81)))
+    np.testing.assert_array_equal(unpacked(result.visited, nodes).any(axis=0),
+                                  np.asarray(visited_nodes(result, nodes)))
     which = np.asarray(result.arrived)
-    expected = np.zeros(81, bool)
+    expected = np.zeros(nodes, bool)
     expected[path[~which][path[~which] >= 0]] = True
-    np.testing.assert_array_equal(np.asarray(visited_nodes(result, 81, ~result.arrived)),
+    np.testing.assert_array_equal(np.asarray(visited_nodes(result, nodes, ~result.arrived)),
                                   expected)
     assert expected.any() and not expected.all()
 
 
 def test_walk_into_a_dead_end_gets_stuck_and_start_at_goal_arrives():
-    obstacles = np.ones((3, 5), bool)
+    obstacles = np.ones((SIDE, SIDE), bool)
     obstacles[1, :4] = False  # a corridor (0,1)..(3,1) closed at the east end
     graph = grid_graph(obstacles)
-    result = walk(jax.random.key(0), graph, uniform(graph), 5, 14, num_agents=3, max_steps=10)
+    west, east, goal = SIDE, SIDE + 3, 2 * SIDE + 4  # the goal (4,2) is blocked
+    result = grid_walk(jax.random.key(0), graph, uniform(graph), west, goal)
     assert bool(result.stuck.all()) and not bool(result.arrived.any())
-    np.testing.assert_array_equal(result.position, [8, 8, 8])
-    np.testing.assert_array_equal(result.path[:, :5], [[5, 6, 7, 8, -1]] * 3)
-    # One block of 3 lanes: all are stuck after three moves, so the loop ends there.
-    assert int(result.lane_steps) == 3 * STEPS_PER_REFILL
-    at_goal = walk(jax.random.key(0), graph, uniform(graph), 6, 6, num_agents=2, max_steps=5)
+    np.testing.assert_array_equal(result.position, [east] * AGENTS)
+    np.testing.assert_array_equal(result.path[:, :5], [[*range(west, east + 1), -1]] * AGENTS)
+    # One block of a lane per agent: all are stuck after three moves, so the loop ends there.
+    assert int(result.lane_steps) == AGENTS * STEPS_PER_REFILL
+    at_goal = grid_walk(jax.random.key(0), graph, uniform(graph), west + 1, west + 1)
     assert bool(at_goal.arrived.all()) and int(at_goal.lane_steps) == 0
 
 
 def test_greedy_agents_descend_deterministically_and_the_others_do_not():
-    graph = grid_graph(np.zeros((8, 8), bool))
-    goal = 63
+    graph = grid()
+    goal = SIDE * SIDE - 1
     logw = towards(graph, goal)  # prefer moves towards the goal
-    walks = [walk(jax.random.key(k), graph, logw, 0, goal, num_agents=16, max_steps=20,
-                  greedy_agents=2) for k in range(3)]
+    walks = [grid_walk(jax.random.key(k), graph, logw, 0, goal, greedy_agents=2)
+             for k in range(3)]
+    diagonal = list(range(0, goal + 1, SIDE + 1))
     for result in walks:
-        np.testing.assert_array_equal(result.path[0], [0, 9, 18, 27, 36, 45, 54, 63] + [-1] * 13)
+        np.testing.assert_array_equal(result.path[0],
+                                      diagonal + [-1] * (STEPS + 1 - len(diagonal)))
         np.testing.assert_array_equal(result.path[1], result.path[0])
-        assert float(result.length[0]) == pytest.approx(7 * np.sqrt(2), rel=1e-6)
+        assert float(result.length[0]) == pytest.approx((SIDE - 1) * np.sqrt(2), rel=1e-6)
     drawn = np.stack([np.asarray(result.path[2:]) for result in walks])
     assert (drawn != drawn[0]).any()  # drawing agents vary with the key
 
 
 def test_excluded_and_invalid_edges_are_never_taken():
-    graph = grid_graph(np.zeros((5, 5), bool))
+    graph = grid()
     logw = jnp.zeros(graph.nbr.shape).at[:, 4:].set(-jnp.inf)  # the algorithm forbids diagonals
-    result = walk(jax.random.key(4), graph, edge_table(graph, logw), 0, 24, num_agents=32,
-                  max_steps=30)
+    result = grid_walk(jax.random.key(4), graph, edge_table(graph, logw), 0, 4 * SIDE + 4)
     slots = np.asarray(result.slots)
     assert slots.max() <= 3 and (slots[slots >= 0] >= 0).all()
     assert bool(result.arrived.any())
@@ -194,12 +225,12 @@ def walker_constants(monkeypatch):
 @pytest.mark.parametrize("lanes, compact, smallest",
                          [(8, 4, 16), (64, 10 ** 9, 16), (5, 2, 16), (64, 2, 2)])
 def test_how_agents_share_the_lanes_changes_no_walk(walker_constants, lanes, compact, smallest):
-    graph = grid_graph(np.zeros((16, 16), bool))
-    logw = towards(graph, 255, 0.6)  # most agents arrive early, a few wander on
+    graph = grid()
+    goal = SIDE * SIDE - 1
+    logw = towards(graph, goal, 0.6)  # most agents arrive early, a few wander on
 
     def walks():
-        return jax.jit(lambda key: walk(key, graph, logw, 0, 255, num_agents=64, max_steps=255,
-                                        greedy_agents=2))(jax.random.key(0))
+        return grid_walk(jax.random.key(0), graph, logw, 0, goal, greedy_agents=2)
 
     default = walks()
     moves = np.asarray(default.moves)
@@ -241,26 +272,22 @@ def test_a_small_walk_keeps_most_lanes_busy(walker_constants):
 
 
 def test_a_batch_of_walks_shares_one_queue_and_walks_as_each_alone():
-    """A batch whose agents outnumber the walker's lanes: 4 runs of 48 agents step 128 lanes,
+    """A batch whose agents outnumber the walker's lanes: 4 runs of 64 agents step 128 lanes,
     which take agent after agent from one queue, while a run alone walks a lane an agent; every
     run walks as it does alone. The default tier's twin of the conformance checks' batches of 64
     runs (slow tier)."""
-    blocked = np.random.default_rng(3).random((12, 12)) < 0.2
-    blocked[0, 0] = blocked[1, 1] = blocked[11, 11] = False
-    graph = grid_graph(blocked)
-    logw = towards(graph, 143, 0.3)
+    goal = SIDE * SIDE - 1
+    graph = grid(0.2, seed=3, free=(0, SIDE + 1, goal))
+    logw = towards(graph, goal, 0.3)
     keys = jax.random.split(jax.random.key(7), 4)
-    starts = jnp.array([0, 13, 143, 0])  # the third run is already at its goal
-    assert lanes_for(4 * 48) < 4 * 48 and lanes_for(48) == 48
+    starts = jnp.array([0, SIDE + 1, goal, 0])  # the third run is already at its goal
+    assert lanes_for(4 * AGENTS) < 4 * AGENTS and lanes_for(AGENTS) == AGENTS
 
-    @jax.jit
-    def one(key, start):
-        return walk(key, graph, logw, start, 143, num_agents=48, max_steps=100)
-
-    batch = jax.jit(jax.vmap(one))(keys, starts)
+    batch = batch_of_walks(keys, graph, logw, starts, goal)
     for i in range(4):
-        alone = one(keys[i], starts[i])
+        alone = grid_walk(keys[i], graph, logw, starts[i], goal)
         for (name, value), other in zip(_fields(alone).items(), _fields(batch).values()):
             np.testing.assert_array_equal(value, other[i], err_msg=name)
     assert int(batch.moves.sum()) <= int(batch.lane_steps[0])  # one loop's count for all
-    assert int(one(keys[2], 143).lane_steps) == 0 and bool(batch.arrived[2].all())
+    assert int(grid_walk(keys[2], graph, logw, goal, goal).lane_steps) == 0
+    assert bool(batch.arrived[2].all())
