@@ -6,17 +6,14 @@ import sizes
 
 from jaxswarm.exact import optimal_length
 from jaxswarm.exact.visibility import shortest_path
-from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import make, make_task
 from jaxswarm.world.plane import Plane
 
 
 @pytest.fixture(scope="module")
 def maze():
-    chosen = paper_map(sizes.MAP)
-    graph = chosen.graph()
-    return graph, make_task(graph, chosen.start, chosen.goal), optimal_length(
-        graph, chosen.start, chosen.goal)
+    graph, task = sizes.maze()
+    return graph, task, optimal_length(graph, int(task.start), int(task.goal))
 
 
 @pytest.fixture(scope="module")

@@ -2,6 +2,9 @@
 an iteration count is a new XLA program (seconds to a minute of compiling), so a test that does
 not need sizes of its own takes these, and varies a run's length through ``run``'s traced
 ``budget`` rather than its static ``iterations``."""
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.swarm import Task, make_task
+from jaxswarm.world.graph import Graph
 from jaxswarm.world.plane import Plane, make_plane
 
 MAP = "maze20"
@@ -16,6 +19,14 @@ RUNS = 3
 conformance checks of a swarm share that program."""
 CONFIG = dict(num_agents=AGENTS)
 """The swarm options of the shared size: ``make(name, **CONFIG)``."""
+
+
+def maze() -> tuple[Graph, Task]:
+    """``(graph, task)``: the walkers' shared world, the paper map :data:`MAP` from its start to
+    its goal."""
+    chosen = paper_map(MAP)
+    graph = chosen.graph()
+    return graph, make_task(graph, chosen.start, chosen.goal)
 
 
 def plane() -> tuple[Plane, tuple[float, float], tuple[float, float]]:

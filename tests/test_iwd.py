@@ -323,15 +323,8 @@ def test_global_update_on_the_best_path():
     assert np.array_equal(after[~changed], np.asarray(soil)[~changed])
 
 
-def shared_map():
-    """The shared sizes' map (``tests/sizes.py``) and its task."""
-    chosen = paper_map(sizes.MAP)
-    graph = chosen.graph()
-    return graph, make_task(graph, chosen.start, chosen.goal)
-
-
 def test_iwd_finds_the_corridor_and_its_soil_falls_along_it():
-    obstacles = np.ones(shared_map()[0].shape, bool)
+    obstacles = np.ones(sizes.maze()[0].shape, bool)
     obstacles[0, :6] = False  # a corridor (0, 0) .. (5, 0) in the shared map's shape
     graph = grid_graph(obstacles)
     swarm = make("iwd", **sizes.CONFIG)
@@ -351,7 +344,7 @@ def test_bad_params_are_named():
 
 
 def test_every_run_counts_its_fitness_calls():
-    graph, task = shared_map()
+    graph, task = sizes.maze()
     for name in ("iwd", "aco_star"):
         swarm = make(name, **sizes.CONFIG)
         _, trace = run(swarm, jax.random.key(2), graph, task, swarm.default_params,
@@ -368,8 +361,7 @@ def test_every_run_counts_its_fitness_calls():
 def test_drops_that_arrive_find_mosaic50_where_drops_that_all_take_soil_did_not():
     """With Shah-Hosseini's standard values (the defaults before 0.8.0's calibration): a path
     in 6 of 6 seeds, and in at most 2 when every drop takes soil as it walks."""
-    from jaxswarm.maps.paper import paper_map
-
+    
     chosen = paper_map("mosaic50")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
