@@ -2,6 +2,7 @@ import os
 from pathlib import Path
 
 import pytest
+import sizes
 from jaxswarm.runtime.cpu import THREADS_VARIABLE
 from jaxswarm.runtime.programs import release_if_crowded
 
@@ -35,3 +36,12 @@ def movingai_dir():
             pytest.fail(f"Moving AI data not found at {MOVINGAI} (CI must have ../shared)")
         pytest.skip(f"Moving AI data not found at {MOVINGAI}")
     return MOVINGAI
+
+
+@pytest.fixture(scope="session")
+def swarm_run(request) -> sizes.SharedRun:
+    """The run alone of the registered swarm that ``request.param`` names (indirect
+    parametrization: ``@pytest.mark.parametrize("swarm_run", ["rfd"], indirect=True)``) at the
+    shared size (:func:`sizes.shared_run`), made once per worker for every test that needs a run
+    of that swarm: its golden record, the figures drawn of it."""
+    return sizes.shared_run(request.param)

@@ -2,8 +2,12 @@
 an iteration count is a new XLA program (seconds to a minute of compiling), so a test that does
 not need sizes of its own takes these, and varies a run's length through ``run``'s traced
 ``budget`` rather than its static ``iterations``."""
+from typing import Any, NamedTuple
+
+import jax
+
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import Task, make_task
+from jaxswarm.swarm import Swarm, Task, Trace, make, make_task, run
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.plane import Plane, make_plane
 
@@ -33,3 +37,39 @@ def plane() -> tuple[Plane, tuple[float, float], tuple[float, float]]:
     """``(plane, start, goal)``: the bees' shared world, a 6 x 6 plane with one rectangle beside
     the straight way from start to goal."""
     return make_plane([(2.5, 3.0, 3.5, 5.0)], (6.0, 6.0)), (0.5, 2.5), (5.5, 2.5)
+
+
+def world_of(name: str) -> tuple[Graph | Plane, Task]:
+    """``(world, task)``: the conformance world of the registered swarm ``name``, the plane of
+    :func:`plane` for the bees, the maze of :func:`maze` for the walkers."""
+    if make(name).world is Plane:
+        field, start, goal = plane()
+        return field, make_task(field, start, goal)
+    return maze()
+
+
+class SharedRun(NamedTuple):
+    """One run alone of a registered swarm at the shared size on its conformance world, from
+    ``jax.random.key(SEED)`` with its default params: what :func:`shared_run` returns."""
+
+    swarm: Swarm
+    world: Graph | Plane
+    task: Task
+    state: Any
+    trace: Trace
+
+
+SEED = 0
+"""The key of a shared run (and of the first golden record of each swarm)."""
+
+
+def shared_run(name: str) -> SharedRun:
+    """The run alone of the registered swarm ``name`` that the tests share (``swarm_run``,
+    a session fixture of ``tests/conftest.py``): ``make(name, **CONFIG)`` on
+    :func:`world_of` for :data:`ITERATIONS` iterations from key :data:`SEED`, the program its
+    conformance checks and golden records compile."""
+    swarm = make(name, **CONFIG)
+    world, task = world_of(name)
+    state, trace = run(swarm, jax.random.key(SEED), world, task, swarm.default_params,
+                       iterations=ITERATIONS)
+    return SharedRun(swarm, world, task, state, trace)

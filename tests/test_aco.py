@@ -10,31 +10,34 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, run
 from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.world.graph import grid_graph
-from jaxswarm.world.paths import is_valid_path, path_length, step_slots
+from jaxswarm.world.paths import is_valid_path, path_length
 
 
 def corridor():
-    """A one-cell corridor (0,1)..(4,1): every ant walks the same path of length 4."""
-    obstacles = np.ones((3, 5), bool)
-    obstacles[1] = False
+    """A one-cell corridor (0,1)..(16,1) in a map of the shared shape (:data:`sizes.MAP`'s):
+    every ant walks the same path of length 16."""
+    obstacles = np.ones(sizes.maze()[0].shape, bool)
+    obstacles[1, :17] = False
     graph = grid_graph(obstacles)
-    return graph, make_task(graph, (0, 1), (4, 1))
+    return graph, make_task(graph, (0, 1), (16, 1))
 
 
 def test_ant_system_deposits_q_over_length_on_both_directions():
     graph, task = corridor()
-    swarm = make("ant_system", num_agents=8)
+    swarm = make("ant_system", **sizes.CONFIG)
     params = swarm.default_params._replace(rho=jnp.float32(1.0), q=jnp.float32(2.0))
-    state = swarm.init(jax.random.key(0), graph, task, params)
-    state, info = swarm.step(state, graph, task, params)
-    assert float(info.arrived) == 1.0
+    # One iteration (budget 1) of the run at the shared size.
+    state, trace = run(swarm, jax.random.key(0), graph, task, params,
+                       iterations=sizes.ITERATIONS, budget=1)
+    assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
     tau = np.asarray(state.pheromone)
-    east, west = 0, 2
-    for x in range(4):  # every edge of the corridor: 8 ants x Q / 4
-        assert tau[5 + x, east] == pytest.approx(8 * 2.0 / 4)
-        assert tau[6 + x, west] == pytest.approx(8 * 2.0 / 4)
+    east, west, width = 0, 2, graph.shape[1]
+    amount = sizes.AGENTS * 2.0 / 16  # every ant x Q / 16
+    for x in range(16):  # every edge of the corridor, (x,1) - (x+1,1)
+        assert tau[width + x, east] == pytest.approx(amount)
+        assert tau[width + x + 1, west] == pytest.approx(amount)
     # Nothing anywhere else: every other slot holds the floor (rho = 1), about 1.2e-38.
-    assert tau.sum() == pytest.approx(2 * 4 * 8 * 2.0 / 4)
+    assert tau.sum() == pytest.approx(2 * 16 * amount)
 
 
 def test_ants_that_did_not_arrive_leave_the_deposit_unchanged_and_do_not_widen_it():
@@ -72,20 +75,19 @@ def test_pheromone_is_symmetric_and_max_min_stays_in_its_bounds():
 
 @pytest.mark.parametrize("name", ["ant_system", "aco_star"])
 def test_pheromone_at_rho_09_never_becomes_impassable(name):
-    """alley20, rho = 0.9, 48 iterations: 0.1 ** 48 = 1e-48 is far below the smallest
-    normal float32 (1.18e-38), where float32 arithmetic would make tau 0 and its log -inf. Every
-    valid edge keeps a finite log-weight: the edges left unwalked lie at the floor."""
+    """alley20, rho = 0.9, from tau0 = 1e-31 (what an edge holds after 31 evaporations from 1):
+    after the run's 8 iterations an edge left unwalked would hold 1e-31 * 0.1 ** 8 = 1e-39, below
+    the smallest normal float32 (1.18e-38), where float32 arithmetic would make tau 0 and its
+    log -inf. Every valid edge keeps a finite log-weight: the edges left unwalked lie at the
+    floor."""
     chosen = paper_map("alley20")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
     swarm = make(name, **sizes.CONFIG)
-    params = swarm.default_params._replace(rho=np.float32(0.9))
-    state, ran = None, 0
-    for seed in range(6):
-        state, trace = run(swarm, jax.random.key(seed), graph, task, params,
-                           iterations=sizes.ITERATIONS, state=state)
-        ran += int(trace.iterations)
-    assert ran == 6 * sizes.ITERATIONS
+    params = swarm.default_params._replace(rho=np.float32(0.9), tau0=np.float32(1e-31))
+    state, trace = run(swarm, jax.random.key(0), graph, task, params,
+                       iterations=sizes.ITERATIONS)
+    assert int(trace.iterations) == sizes.ITERATIONS
     valid = np.asarray(graph.valid_edges())
     tau = np.asarray(state.pheromone)[valid]
     table = np.asarray(aco.transition_rule(graph, task, state.pheromone, params,
@@ -114,28 +116,30 @@ def test_improved_max_min_starts_from_its_first_ants_path_and_keeps_the_floor(fi
     chosen = paper_map("alley20")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("improved_max_min_aco", first_ant=first_ant)
-    params = swarm.default_params
-    state = swarm.init(jax.random.key(0), graph, task, params)
+    swarm = make("improved_max_min_aco", first_ant=first_ant, **sizes.CONFIG)
+    # rho = 0.5: within the run's 8 iterations an edge off every best path decays below tau_min.
+    params = swarm.default_params._replace(rho=np.float32(0.5))
+    key = jax.random.key(0)
+    # No iteration (budget 0): the state swarm.init makes, from the program of the run below.
+    state, _ = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS, budget=0)
     first = np.asarray(state.best_path)
     nodes = first[first >= 0]
     assert bool(is_valid_path(graph, state.best_path, task.start, task.goal))
     assert len(set(nodes.tolist())) == len(nodes)  # its memory: no node twice
     assert float(state.best_cost) == pytest.approx(float(path_length(graph, state.best_path)))
     if first_ant == "greedy":  # a deterministic depth-first ant
-        path, cost, _ = bug2_path(graph, task.start, task.goal)
+        # Node numbers as ints, as test_bug2.py passes them: the program of its 20 x 20 maps.
+        path, cost, _ = bug2_path(graph, int(task.start), int(task.goal))
         np.testing.assert_array_equal(nodes, np.asarray(path)[: len(nodes)])
     # Algorithm 1: nothing is deposited before the first population has walked.
     np.testing.assert_array_equal(np.asarray(state.pheromone), float(params.tau0))
-    for _ in range(60):
-        state, _ = swarm.step(state, graph, task, params)
+    state, _ = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS)
     # The last update floored every edge and added delta on the best path's: each of its edges
-    # holds at least tau_min + q. An edge off every best path decays by 0.9 ** 60 and rests on
+    # holds at least tau_min + q. An edge off every best path decays by 0.5 ** 8 and rests on
     # the floor: most edges do.
-    tau = np.asarray(state.pheromone)
-    on_best = tau[np.asarray(state.best_path[:-1])[np.asarray(state.best_path[1:]) >= 0],
-                  np.asarray(step_slots(graph, state.best_path))[np.asarray(
-                      state.best_path[1:]) >= 0]]
+    tau, nbr, best = map(np.asarray, (state.pheromone, graph.nbr, state.best_path))
+    here, there = best[:-1][best[1:] >= 0], best[1:][best[1:] >= 0]
+    on_best = tau[here, np.argmax(nbr[here] == there[:, None], axis=1)]  # each step's slot
     assert on_best.min() >= float(params.tau_min + params.q) * (1 - 1e-6)
     assert np.median(tau[np.asarray(graph.valid_edges())]) == pytest.approx(
         float(params.tau_min))

@@ -4,6 +4,7 @@ from pathlib import Path
 import jax.numpy as jnp
 import matplotlib
 import pytest
+import sizes
 
 matplotlib.use("Agg")
 
@@ -12,8 +13,10 @@ from jaxswarm.cli import main  # noqa: E402
 
 def test_demo_of_one_swarm_prints_it_beside_the_exact_planners(tmp_path, capsys):
     out = tmp_path / "demo.png"
-    assert main(["demo", "--map", "maze20", "--repeats", "1", "--drops", "16", "--iterations", "5",
-                 "--swarms", "rfd_graded", "--out", str(out)]) == 0
+    # The shared size (tests/sizes.py): the demo's run is the conformance checks' program.
+    assert main(["demo", "--map", sizes.MAP, "--repeats", "1", "--drops", str(sizes.AGENTS),
+                 "--iterations", str(sizes.ITERATIONS), "--swarms", "rfd_graded",
+                 "--out", str(out)]) == 0
     text = capsys.readouterr().out
     rows = {planner: re.search(rf"^{re.escape(planner)}\s+(\S+)\s+(\S+)", text, re.MULTILINE)
             for planner in ("Dijkstra", "A*", "bidirectional A*", "RFD graded (ours)")}
@@ -186,7 +189,8 @@ def test_mapf_writes_a_gif_with_one_frame_per_step(movingai_dir, capsys, tmp_pat
     from PIL import Image
 
     monkeypatch.chdir(tmp_path)
-    assert main(["mapf", *_mapf_files(movingai_dir, scen="random-1"), "--agents", "5",
+    # The instance of the planners' test above: the same program checks the plans' conflicts.
+    assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "5",
                  "--planner", "prioritized", "--order", "random", "--seed", "3"]) == 0
     text = capsys.readouterr().out
     gif = tmp_path / "out" / "mapf_empty-32-32_prioritized.gif"  # the default place
@@ -195,16 +199,20 @@ def test_mapf_writes_a_gif_with_one_frame_per_step(movingai_dir, capsys, tmp_pat
     with Image.open(gif) as image:
         assert image.format == "GIF" and image.n_frames == frames
     out = tmp_path / "elsewhere" / "cbs.gif"
-    assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "2", "--planner", "cbs",
+    assert main(["mapf", *_mapf_files(movingai_dir), "--agents", "5", "--planner", "cbs",
                  "--gif", str(out)]) == 0
     assert out.read_bytes()[:6] == b"GIF89a"
 
 
 def test_mapf_names_the_agent_and_exits_1_when_not_solved(tmp_path, capsys):
-    (tmp_path / "corridor.map").write_text("type octile\nheight 1\nwidth 5\nmap\n.....\n")
-    (tmp_path / "swap.scen").write_text("version 1\n"  # two agents swapping ends: impossible
-                                        "0\tcorridor.map\t5\t1\t0\t0\t4\t0\t4\n"
-                                        "0\tcorridor.map\t5\t1\t4\t0\t0\t0\t4\n")
+    # A corridor (0, 0)..(4, 0) cut out of a 32 x 32 map, the shape of the Moving AI maps above
+    # (the same programs), and two agents swapping its ends: impossible.
+    rows = [".....".ljust(32, "@")] + ["@" * 32] * 31
+    (tmp_path / "corridor.map").write_text("type octile\nheight 32\nwidth 32\nmap\n"
+                                           + "".join(row + "\n" for row in rows))
+    (tmp_path / "swap.scen").write_text("version 1\n"
+                                        "0\tcorridor.map\t32\t32\t0\t0\t4\t0\t4\n"
+                                        "0\tcorridor.map\t32\t32\t4\t0\t0\t0\t4\n")
     assert main(["mapf", str(tmp_path / "corridor.map"), str(tmp_path / "swap.scen"),
                  "--agents", "2", "--planner", "prioritized"]) == 1
     text = capsys.readouterr().out

@@ -2,6 +2,8 @@
 that arrived applied after the walk in agent order, the soil updates of drops that share an edge
 in one step applied in lane order (``while_walking``), bit-identically, the walker hook, and
 drops that back out of dead ends."""
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -99,7 +101,7 @@ def test_an_arrived_drop_updates_the_soil_of_its_moves_by_eq_5():
 
 SIDE = 24
 """The side of the grids the drops walk on (a smaller map is cut out of one by obstacles): one
-program of the walk and one of the arrived drops' updates for all of them."""
+program of :func:`drops_of` for all of them."""
 
 
 def cut_out(obstacles):
@@ -118,10 +120,28 @@ def comb():
     return graph, make_task(graph, (0, 0), (4, 0))
 
 
-def drops_of(key, graph, task, soil, params=P, **options):
+@functools.partial(jax.jit, static_argnames=("backtrack",))
+def drops_of(key, graph, task, soil, params, *, backtrack=False):
     """:func:`drop_walk` of 32 drops in the map's step budget over ``soil``, f32[N, K] (a
-    weakly typed one, ``jnp.full`` of a Python float, would be a program of its own)."""
-    return drop_walk(key, graph, task, soil, params, num_agents=32, max_steps=None, **options)
+    weakly typed one, ``jnp.full`` of a Python float, would be a program of its own). One
+    program for every SIDE x SIDE map (the map, task, soil and params are arguments), and one
+    with ``backtrack``."""
+    return drop_walk(key, graph, task, soil, params, num_agents=32, max_steps=None,
+                     backtrack=backtrack)
+
+
+@jax.jit
+def drop_batches(keys, graph, tasks, soil, params):
+    """:func:`drops_of` of each of ``keys`` with its task of ``tasks`` (an outer ``vmap``, the
+    params shared) and each of ``params`` (an inner one): one program for the tests of
+    batches."""
+    return jax.vmap(lambda key, task: jax.vmap(
+        lambda p: drops_of(key, graph, task, soil, p))(params))(keys, tasks)
+
+
+def stack(*trees):
+    """The pytrees stacked leaf by leaf along a new leading axis."""
+    return jax.tree_util.tree_map(lambda *x: jnp.stack(x), *trees)
 
 
 def assert_sequential_soil(graph, soil, drops):
@@ -154,22 +174,24 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     graph = cut_out(blocked)
     tasks = [make_task(graph, (0, 1), goal) for goal in ((5, 1), (8, 1))]
     soil = jax.random.uniform(jax.random.key(3), graph.nbr.shape, minval=900.0, maxval=1100.0)
-    drops = drops_of(jax.random.key(2), graph, tasks[0], soil)
+    drops = drops_of(jax.random.key(2), graph, tasks[0], soil, P)
     assert np.asarray(drops.arrived).sum() >= 2
     expected = assert_sequential_soil(graph, soil, drops)
-    # A batch of that run and one whose drops cannot arrive: each run's soil as alone.
-    batch = jax.jit(jax.vmap(lambda task: drops_of(jax.random.key(2), graph, task, soil)))(
-        jax.tree_util.tree_map(lambda *x: jnp.stack(x), *tasks))
+    # A batch of that run and one whose drops cannot arrive, each under an inner batch of the
+    # same params twice: each run's soil as alone.
+    batch = drop_batches(stack(jax.random.key(2), jax.random.key(2)), graph, stack(*tasks),
+                         soil, per_lane(P, 2))
     assert not batch.arrived[1].any()
-    np.testing.assert_array_equal(np.asarray(batch.memory[0]), expected)
-    np.testing.assert_array_equal(np.asarray(batch.memory[1]), np.asarray(soil))
+    for member in range(2):
+        np.testing.assert_array_equal(np.asarray(batch.memory[0, member]), expected)
+        np.testing.assert_array_equal(np.asarray(batch.memory[1, member]), np.asarray(soil))
 
 
 def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
     # Dead ends beside the corridor: drops that enter them get stuck.
     graph, task = comb()
     table_soil = jnp.full(graph.nbr.shape, 10_000.0, jnp.float32)
-    drops = drops_of(jax.random.key(1), graph, task, table_soil)
+    drops = drops_of(jax.random.key(1), graph, task, table_soil, P)
     assert drops.arrived.any() and (~drops.arrived).any()
     changed = np.asarray(drops.memory) != 10_000.0
     rows, slots = np.nonzero(changed)
@@ -187,7 +209,7 @@ def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_afte
     graph = grid_graph(np.zeros((SIDE, SIDE), bool))
     task = make_task(graph, (0, 0), (10, 10))
     soil = jax.random.uniform(jax.random.key(2), graph.nbr.shape, minval=9_000.0, maxval=11_000.0)
-    drops = drops_of(jax.random.key(0), graph, task, soil)
+    drops = drops_of(jax.random.key(0), graph, task, soil, P)
     moves, arrived = np.asarray(drops.moves), np.asarray(drops.arrived)
     assert moves[arrived].max() <= NARROWEST < moves[~arrived].max()
     # Every drop's whole row, as before the cut: the same bits for the arrived drops.
@@ -197,7 +219,7 @@ def test_drops_that_did_not_arrive_change_nothing_and_do_not_widen_the_work_afte
 def test_backtracking_drops_back_out_of_dead_ends():
     graph, task = comb()
     soil = jnp.full(graph.nbr.shape, 10_000.0, jnp.float32)
-    drops = drops_of(jax.random.key(1), graph, task, soil, backtrack=True)
+    drops = drops_of(jax.random.key(1), graph, task, soil, P, backtrack=True)
     assert drops.arrived.all()
     paths = np.asarray(drops.path)
     for path, moves in zip(paths, np.asarray(drops.moves)):
@@ -376,20 +398,16 @@ def test_drops_that_arrive_find_mosaic50_where_drops_that_all_take_soil_did_not(
 
 
 def test_hook_params_of_an_inner_vmap_reach_every_member_of_an_outer_one():
-    # Keys outside (params shared), params inside: the outer batch rule meets params that the
-    # inner one folded to one per run; each member must walk with its own.
+    # Keys (and their task) outside, params shared; params inside: the outer batch rule meets
+    # params that the inner one folded to one per run; each member must walk with its own.
     graph = grid_graph(np.zeros((SIDE, SIDE), bool))
     task = make_task(graph, (0, 0), (7, 7))
     soil = jax.random.uniform(jax.random.key(5), graph.nbr.shape, minval=1.0, maxval=10_000.0)
     keys = jax.random.split(jax.random.key(0), 2)
-    params = jax.tree_util.tree_map(lambda p: jnp.stack([p, p]), P)._replace(
-        alpha=jnp.array([0.0, 3.0], jnp.float32))
-
-    def moves(key, params):
-        return drops_of(key, graph, task, soil, params).moves
-
-    nested = jax.jit(jax.vmap(lambda key: jax.vmap(lambda p: moves(key, p))(params)))(keys)
+    params = per_lane(P, 2)._replace(alpha=jnp.array([0.0, 3.0], jnp.float32))
+    nested = drop_batches(keys, graph, stack(task, task), soil, params).moves
     for i in range(2):
         for j in range(2):
-            alone = moves(keys[i], jax.tree_util.tree_map(lambda x, j=j: x[j], params))
+            alone = drops_of(keys[i], graph, task, soil,
+                             jax.tree_util.tree_map(lambda x, j=j: x[j], params)).moves
             np.testing.assert_array_equal(nested[i, j], alone, err_msg=f"key {i}, params {j}")

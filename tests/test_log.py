@@ -3,30 +3,34 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+import sizes
 
 from jaxswarm.dynamic.events import memory_frames
 from jaxswarm.dynamic.robot import hidden_blocks, swarm_robot
-from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm import make, run
 from jaxswarm.swarm.core import with_room
-from jaxswarm.swarm.testing import batched_params, outcome, run_batch
+from jaxswarm.swarm.testing import _run_batch, batched_params, outcome, run_batch
 from jaxswarm.swarm.walking import step_budget, walk
 from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same,
                                         columns, default_log_moves, from_rows, log_blocks, paths,
                                         room_blocks)
 from jaxswarm.world.graph import grid_graph
 
-OPEN = grid_graph(np.zeros((24, 24), bool))
-"""An open grid: uniform walkers wander far before they reach a corner near the start."""
-AGENTS, STEPS = 32, 300
-"""The walkers of the tests' walks and logs, and their step budget."""
+SIDE = 16
+OPEN = grid_graph(np.zeros((SIDE, SIDE), bool))
+"""An open grid: uniform walkers wander far before they reach a cell near the start."""
+AGENTS, STEPS = 64, SIDE * SIDE - 1
+"""The walkers of the tests' walks and logs, and their step budget: the sizes of
+``test_walk.py``'s walks, so that a walk with the default room is one program for both files."""
 
 
 def _walk(log_moves):
     """AGENTS uniform walkers on OPEN for STEPS steps, their log with room for ``log_moves``
-    moves an agent (one program a room)."""
-    table = jnp.where(OPEN.nbr >= 0, 0.0, -jnp.inf)
-    return walk(jax.random.key(0), OPEN, table, 0, 3 * 24 + 3, num_agents=AGENTS,
-                max_steps=STEPS, log_moves=log_moves)
+    moves an agent (one program a room); start and goal as i32[] (Python ints are weakly typed:
+    a program of their own), the table as f32 (two Python floats would make it weakly typed)."""
+    table = jnp.where(OPEN.nbr >= 0, jnp.float32(0.0), -jnp.inf)
+    return walk(jax.random.key(0), OPEN, table, jnp.int32(0), jnp.int32(5 * SIDE + 5),
+                num_agents=AGENTS, max_steps=STEPS, log_moves=log_moves)
 
 
 def test_a_log_without_room_says_so_and_its_size_changes_no_move():
@@ -110,8 +114,8 @@ def test_a_large_walks_log_does_not_grow_with_a_longer_possible_path():
     assert room_blocks(8, 600, BLOCK, budget) == 8  # a room asked for is the room given
 
     def own_bytes(max_steps):
-        compiled = jax.jit(lambda key: walk(key, graph, table, 0, 1023, num_agents=4096,
-                                            max_steps=max_steps)).lower(jax.random.key(0)).compile()
+        compiled = walk.lower(jax.random.key(0), graph, table, jnp.int32(0), jnp.int32(1023),
+                              num_agents=4096, max_steps=max_steps).compile()
         analysis = compiled.memory_analysis()
         return analysis.output_size_in_bytes + analysis.temp_size_in_bytes
 
@@ -120,29 +124,33 @@ def test_a_large_walks_log_does_not_grow_with_a_longer_possible_path():
 
 @pytest.fixture(scope="module")
 def cramped():
-    """ACO* with one block of room per ant, on an open grid where ants walk far: its walks
-    overflow."""
-    graph = grid_graph(np.zeros((16, 16), bool))
-    task = make_task(graph, (0, 0), (15, 15))
-    return make("aco_star", num_agents=16, log_moves=BLOCK), graph, task
+    """ACO* at the shared size on the shared maze (:mod:`sizes`) with one block of room per ant:
+    its ants walk far before they reach the goal, so its walks overflow. With room (at this size
+    the default room holds every move) it is the conformance checks' ACO*, whose programs its
+    runs share."""
+    graph, task = sizes.maze()
+    return make("aco_star", **sizes.CONFIG, log_moves=BLOCK), graph, task
 
 
 def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
     swarm, graph, task = cramped
     params = swarm.default_params
-    roomy = make("aco_star", num_agents=16)
-    keys = jax.random.split(jax.random.key(2), 3)
-    mapped = jax.vmap(lambda key: run(swarm, key, graph, task, params, iterations=4))(keys)
-    assert bool(np.asarray(mapped[1].overflowed).any())  # the caller who maps run sees it
+    roomy = make("aco_star", **sizes.CONFIG)
+    keys = jax.random.split(jax.random.key(2), sizes.RUNS)
+    grid = batched_params(params, sizes.RUNS)
+    # _run_batch is run_batch without its retry: jit of vmap of run, a caller who maps run and
+    # so sees the flag (the same program as run_batch's first try below).
+    mapped = _run_batch(swarm, keys, graph, task, grid, iterations=sizes.ITERATIONS)
+    assert bool(np.asarray(mapped[1].overflowed).any())
     for key in keys:
-        alone = run(swarm, key, graph, task, params, iterations=4)
+        alone = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS)
         assert not bool(alone[1].overflowed)
-        want = run(roomy, key, graph, task, params, iterations=4)
+        want = run(roomy, key, graph, task, params, iterations=sizes.ITERATIONS)
         assert jax.tree_util.tree_all(jax.tree_util.tree_map(
             lambda x, y: bool(np.array_equal(x, y, equal_nan=True)),
             outcome(alone), outcome(want)))
-    batch = run_batch(swarm, keys, graph, task, batched_params(params, 3), iterations=4)
-    want = run_batch(roomy, keys, graph, task, batched_params(params, 3), iterations=4)
+    batch = run_batch(swarm, keys, graph, task, grid, iterations=sizes.ITERATIONS)
+    want = run_batch(roomy, keys, graph, task, grid, iterations=sizes.ITERATIONS)
     assert not bool(np.asarray(batch[1].overflowed).any())
     np.testing.assert_array_equal(batch[0].best_cost, want[0].best_cost)
     assert with_room(swarm).config.log_moves == ROOM_FOR_EVERY_MOVE
@@ -158,14 +166,14 @@ def test_memory_frames_and_the_robot_walk_again_with_room(cramped):
     """Twin in the default tier: test_run_makes_a_run_whose_walk_overflowed_again_with_room (the
     retry these callers share)."""
     swarm, graph, task = cramped
-    roomy = make("aco_star", num_agents=16)
+    roomy = make("aco_star", **sizes.CONFIG)
     params = swarm.default_params
     state = swarm.init(jax.random.key(0), graph, task, params)
     assert bool(swarm.step(state, graph, task, params)[1].overflowed)  # the case under test
     got = memory_frames(swarm, state, graph, task, params, 3)
     want = memory_frames(roomy, state, graph, task, params, 3)
     np.testing.assert_array_equal(got[1], want[1])
-    hidden = hidden_blocks(graph, (0, 0), (15, 15), count=2, seed=0)
+    hidden = hidden_blocks(graph, int(task.start), int(task.goal), count=2, seed=0)
     got, want = (swarm_robot(s, jax.random.key(1), graph, task, hidden, params, iterations=3,
                              patience=None, max_plans=2) for s in (swarm, roomy))
     assert not bool(got.overflowed)

@@ -32,11 +32,30 @@ def test_widths_are_powers_of_four_times_128_then_the_whole():
     assert move_widths(10) == (10,)
 
 
+def cut_sum(moves, values, run, shared, used=None):
+    """:func:`width_and_sum` on one run's ``values`` (f32[4, 1023]) cut by :func:`on_moves`.
+    Applied outside ``jit``, every test's run alone is one program: on_moves's own."""
+    return on_moves(width_and_sum, moves, (values,), run, shared, used=used)
+
+
+@jax.jit
+def batches(moves, values, runs, shared):
+    """:func:`cut_sum` of R runs (``moves`` i32[R, 4], ``values`` f32[R, 4, 1023]) batched
+    three ways, one program for the tests of batches: with their own run inputs ``runs``
+    (f32[R]) and the shared input 1, by a ``vmap`` and by a ``vmap`` of ``vmap`` (R x 1); with
+    the run input 1 and their own shared inputs ``shared`` (f32[R]), by a ``vmap``."""
+    one = jnp.float32(1.0)
+    flat = jax.vmap(cut_sum, in_axes=(0, 0, 0, None))(moves, values, runs, one)
+    nested = jax.vmap(jax.vmap(cut_sum, in_axes=(0, 0, None, None)), in_axes=(0, 0, 0, None))(
+        moves[:, None], values[:, None], runs, one)
+    own = jax.vmap(cut_sum, in_axes=(0, 0, None, 0))(moves, values, one, shared)
+    return flat, nested, own
+
+
 def test_one_walk_gets_the_narrowest_width_that_holds_its_moves_and_the_same_bits():
     moves = jnp.array([3, 70, 0, 12], jnp.int32)
     values = walk_columns(moves)
-    width, total, running = jax.jit(lambda m, v: on_moves(
-        width_and_sum, m, (v,), jnp.float32(2.0), jnp.float32(3.0)))(moves, values)
+    width, total, running = cut_sum(moves, values, jnp.float32(2.0), jnp.float32(3.0))
     assert int(width) == 128
     full = width_and_sum((values,), np.float32(2.0), np.float32(3.0))
     np.testing.assert_array_equal(total, full[1])
@@ -49,45 +68,41 @@ def test_agents_not_used_do_not_widen_the_cut():
     values = walk_columns(moves)
     values[1] = 0.0  # the function gives the unused agent no weight
 
-    def width(m, v, used):
-        return on_moves(width_and_sum, m, (v,), jnp.float32(1.0), jnp.float32(1.0), used=used)
+    def width(used):
+        return int(cut_sum(moves, values, jnp.float32(1.0), jnp.float32(1.0), used=used)[0])
 
-    assert int(jax.jit(width)(moves, values, used)[0]) == 128
-    assert int(jax.jit(width)(moves, values, None)[0]) == 1023
+    assert width(used) == 128
+    assert width(None) == 1023
 
 
 def test_a_batch_shares_one_width_at_any_nesting():
     moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1], [1, 1, 1, 1]], jnp.int32)
     values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])
-
-    def one(m, v, run):
-        return on_moves(width_and_sum, m, (v,), run, jnp.float32(1.0))
-
-    width, total, _ = jax.jit(jax.vmap(one))(moves, values, jnp.arange(3.0))
+    runs = jnp.array([1.0, 2.0, 3.0])
+    (width, total, _), nested, _ = batches(moves, values, runs, jnp.ones(3))
     np.testing.assert_array_equal(width, [512, 512, 512])
-    alone = [one(m, v, jnp.float32(r)) for r, (m, v) in enumerate(zip(moves, values))]
+    alone = [cut_sum(m, v, r, jnp.float32(1.0)) for m, v, r in zip(moves, values, runs)]
     assert [int(a[0]) for a in alone] == [128, 512, 128]
     np.testing.assert_array_equal(total, np.stack([a[1] for a in alone]))
-    nested = jax.jit(jax.vmap(jax.vmap(one, in_axes=(0, 0, None)), in_axes=(0, 0, 0)))(
-        moves.reshape(3, 1, 4), values.reshape(3, 1, 4, -1), jnp.arange(3.0))
     np.testing.assert_array_equal(nested[0], np.full((3, 1), 512))
     np.testing.assert_array_equal(nested[1][:, 0], total)
 
 
 def test_a_batched_shared_input_lets_each_run_pick_its_own_width():
-    moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1]], jnp.int32)
+    moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1], [700, 1, 0, 1]], jnp.int32)
     values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])
-    width, total, _ = jax.vmap(lambda m, v, s: on_moves(width_and_sum, m, (v,), 1.0, s))(
-        moves, values, jnp.array([1.0, 2.0]))
-    np.testing.assert_array_equal(width, [128, 512])
-    np.testing.assert_allclose(total[1], 2 * values[1].astype(np.float64).sum(1), rtol=1e-5)
+    shared = jnp.array([1.0, 2.0, 3.0])
+    width, total, _ = batches(moves, values, jnp.ones(3), shared)[2]
+    np.testing.assert_array_equal(width, [128, 512, 1023])
+    want = np.asarray(shared)[:, None] * values.astype(np.float64).sum(2)
+    np.testing.assert_allclose(total, want, rtol=1e-5)
 
 
-@pytest.mark.parametrize("moves", [[0, 0], [1023, 5]])
+@pytest.mark.parametrize("moves", [[0, 0, 0, 0], [1023, 5, 0, 3]])
 def test_no_moves_and_a_whole_budget(moves):
-    values = walk_columns(moves, agents=2)
-    width, total, _ = on_moves(width_and_sum, jnp.array(moves, jnp.int32), (values,),
-                               jnp.float32(1.0), jnp.float32(1.0))
+    values = walk_columns(moves)
+    width, total, _ = cut_sum(jnp.array(moves, jnp.int32), values, jnp.float32(1.0),
+                              jnp.float32(1.0))
     assert int(width) == (128 if max(moves) == 0 else 1023)
     np.testing.assert_array_equal(total, ordered_sum(values, axis=1))
 
@@ -99,16 +114,17 @@ def weighted_sum(moves, run, shared):
 
 
 def test_it_runs_inside_a_vmapped_cond_with_constants():
-    # A vmapped lax.cond with a batched predicate batches every constant of its branches.
+    # A vmapped lax.cond with a batched predicate batches every constant of its branches
+    # (jitted, the batch is one program; applied outside jit, each on_moves of it is one).
     def branch(values):
         moves = jnp.sum(values > 0, axis=1, dtype=jnp.int32)
         return (on_moves(width_and_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0))[1]
                 + on_moves(weighted_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0)))
 
-    values = np.stack([walk_columns([3, 9], agents=2, seed=i) for i in range(3)])
-    got = jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(2), v))(
+    values = np.stack([walk_columns([3, 9, 0, 1], seed=i) for i in range(3)])
+    got = jax.jit(jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(4), v)))(
         values, jnp.array([True, False, True]))
-    np.testing.assert_array_equal(got[1], [0.0, 0.0])
+    np.testing.assert_array_equal(got[1], np.zeros(4))
     np.testing.assert_array_equal(got[2], branch(values[2]))
 
 
@@ -157,19 +173,23 @@ def empty_record(agents):
             jnp.int32(0))
 
 
+def fold(log, used, run, shared):
+    """:func:`record` folded over one run's ``used`` agents of 5 (:func:`random_log`'s budget).
+    Applied outside ``jit``, every test's run alone is one program: fold_agents's own."""
+    return fold_agents(record, log, empty_record(5), run, shared, used=used)
+
+
 def test_fold_agents_takes_the_used_agents_in_agent_order_on_their_own_rows():
     moves = [3, 700, 0, 12, 40]
     used = np.array([True, False, True, True, True])
     log, path, slots = random_log(moves)
-    turns, turn, sums, widest = jax.jit(lambda log, used: fold_agents(
-        record, log, empty_record(5), jnp.int32(1), jnp.int32(0), used=used))(log, used)
+    turns, turn, sums, widest = fold(log, used, jnp.int32(1), jnp.int32(0))
     want_turn, want_sums = expected_record(path, slots, used)
     assert int(turns) == 4
     np.testing.assert_array_equal(turn, want_turn)
     np.testing.assert_array_equal(sums, want_sums)
     assert int(widest) == 128  # the unused agent's 700 moves do not widen the rows
-    everyone = fold_agents(record, log, empty_record(5), jnp.int32(1), jnp.int32(0),
-                           used=jnp.ones(5, bool))
+    everyone = fold(log, np.ones(5, bool), jnp.int32(1), jnp.int32(0))
     assert int(everyone[3]) == 1023
     np.testing.assert_array_equal(everyone[2], expected_record(path, slots, np.ones(5, bool))[1])
 
@@ -182,24 +202,27 @@ def test_a_batch_of_folds_equals_each_run_alone_at_any_nesting():
     used = jnp.array([[1, 0, 1, 0, 1], [0] * 5, [1, 1, 0, 1, 1]], bool)
     runs = jnp.array([1, 2, 3], jnp.int32)
 
-    def one(log, used, run):
-        return fold_agents(record, log, empty_record(5), run, jnp.int32(4), used=used)
+    @jax.jit
+    def fold_batches(log, used, runs):
+        """The runs folded by a ``vmap``, by a ``vmap`` of ``vmap`` (R x 1), and by a ``vmap``
+        that batches the shared input too: one program."""
+        four = jnp.int32(4)
+        flat = jax.vmap(fold, in_axes=(0, 0, 0, None))(log, used, runs, four)
+        nested = jax.vmap(jax.vmap(fold, in_axes=(0, 0, None, None)), in_axes=(0, 0, 0, None))(
+            jax.tree_util.tree_map(lambda x: x[:, None], log), used[:, None], runs, four)
+        return flat, nested, jax.vmap(fold)(log, used, runs, jnp.full(3, four))
 
-    batch = jax.jit(jax.vmap(one))(log, used, runs)
+    batch, nested, shared = fold_batches(log, used, runs)
     for r, (_, path, slots) in enumerate(logs):
-        alone = one(jax.tree_util.tree_map(lambda x: x[r], log), used[r], runs[r])
+        alone = fold(jax.tree_util.tree_map(lambda x: x[r], log), used[r], runs[r], jnp.int32(4))
         for got, want in zip(batch, alone):
             np.testing.assert_array_equal(got[r], want)
         want_turn, want_sums = expected_record(path, slots, np.asarray(used[r]), r + 1, 4)
         np.testing.assert_array_equal(batch[1][r], want_turn)
         np.testing.assert_array_equal(batch[2][r], want_sums)
     np.testing.assert_array_equal(batch[3], [128, 0, 128])  # no run's used agent made 600 moves
-    nested = jax.jit(jax.vmap(jax.vmap(one, in_axes=(0, 0, None))))(
-        jax.tree_util.tree_map(lambda x: x[:, None], log), used[:, None], runs)
     for got, want in zip(nested, batch):
         np.testing.assert_array_equal(got[:, 0], want)
     # A batched shared input: each run folds on its own, to the same result.
-    shared = jax.vmap(lambda log, used, run, s: fold_agents(
-        record, log, empty_record(5), run, s, used=used))(log, used, runs, jnp.full(3, 4))
     for got, want in zip(shared, batch):
         np.testing.assert_array_equal(got, want)

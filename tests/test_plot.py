@@ -293,23 +293,25 @@ def test_draw_trace_plots_the_run_and_the_optimum():
     plt.close(fig)
 
 
-def test_plot_swarm_run_writes_two_panels(tmp_path):
-    import jax
-
+@pytest.mark.parametrize("swarm_run", ["rfd_star"], indirect=True)
+def test_plot_swarm_run_writes_two_panels(swarm_run, tmp_path):
     from jaxswarm.plot.graph import plot_swarm_run
-    from jaxswarm.swarm import make, make_task, run
 
-    graph = grid_graph(np.zeros((6, 6), bool))
-    task = make_task(graph, (0, 0), (5, 5))
-    swarm = make("rfd_star", num_agents=8)
-    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params, iterations=3)
+    swarm, graph, task, state, trace = swarm_run
+    best = swarm.best(state)
+    optimum = dijkstra(graph, int(task.start), int(task.goal)).cost
     out = tmp_path / "run.png"
-    fig = plot_swarm_run(graph, state.altitude, swarm.best(state), trace, start=(0, 0),
-                         goal=(5, 5), optimum=5 * np.sqrt(2), field_label="altitude", path=out)
+    fig = plot_swarm_run(graph, state.altitude, best, trace, start=int(task.start),
+                         goal=int(task.goal), optimum=optimum, field_label="altitude", path=out)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    image = fig.axes[0].get_images()[0]
-    np.testing.assert_allclose(image.get_array().filled(np.nan).ravel(), state.altitude, rtol=1e-6)
+    shown = fig.axes[0].get_images()[0].get_array()
+    altitude = np.asarray(state.altitude)
+    hidden = np.ma.getmaskarray(shown).ravel()
+    np.testing.assert_array_equal(hidden, ~np.asarray(graph.free) | ~np.isfinite(altitude))
+    np.testing.assert_allclose(shown.compressed(), altitude[~hidden], rtol=1e-6)
     trace_axes = [ax for ax in fig.axes if ax.get_xlabel() == "iteration"]
     assert len(trace_axes) == 1
-    assert trace_axes[0].get_lines()[0].get_ydata()[-1] == float(swarm.best(state).cost)
+    lines = trace_axes[0].get_lines()
+    assert lines[0].get_ydata()[-1] == float(best.cost)
+    assert lines[-1].get_ydata()[0] == optimum
     plt.close(fig)

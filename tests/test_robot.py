@@ -14,49 +14,63 @@ from jaxswarm.maps.random import random_path_map
 from jaxswarm.swarm import make, make_task
 from jaxswarm.swarm.core import Task
 from jaxswarm.world.graph import grid_graph, path_map_graph
-from jaxswarm.world.paths import is_valid_path, path_length, trim
+from jaxswarm.world.paths import is_valid_path, pad, path_length, trim
 
 SQRT2 = float(np.sqrt(2))
+SIDE = 5
+"""The side of the maps walked here: the detour world's, so that every walk of a plan (a plan of
+``SIDE ** 2`` nodes, as D* Lite's) is one program."""
 
 
 def free_grid(height, width):
     return grid_graph(np.zeros((height, width), bool))
 
 
+def plan(*nodes):
+    """i32[SIDE ** 2]: a plan through ``nodes``, -1 padded."""
+    return pad(nodes, SIDE ** 2)
+
+
+def top_row_path_map():
+    """A SIDE x SIDE thin-wall path map whose only passages join its top row's cells (nodes 0,
+    1, ..., SIDE - 1) east and west: a corridor."""
+    connections = np.zeros((SIDE, SIDE, 8), bool)
+    connections[0, :-1, 0] = True  # east moves 0 -> 1 -> ... -> SIDE - 1
+    connections[0, 1:, 2] = True  # and back west
+    return path_map_graph(connections)
+
+
 def test_the_robot_stops_before_a_hidden_cell_and_sees_it():
-    graph = free_grid(1, 5)  # a corridor 0-1-2-3-4
+    graph = free_grid(SIDE, SIDE)  # the robot walks the top row 0-1-2-3-4
     hidden = make_event(graph, block=[3])
     world = apply_event(hidden, graph, make_task(graph, 0, 4))[0]
-    leg = walk_plan(world, graph, jnp.array([0, 1, 2, 3, 4, -1]))
+    leg = walk_plan(world, graph, plan(0, 1, 2, 3, 4))
     assert int(leg.stop) == 2 and not bool(leg.reached)
     assert float(leg.length) == pytest.approx(2.0)
     assert int(leg.seen.start) == 2
     assert sorted(np.asarray(leg.seen.block).tolist()) == [-1, -1, 3]
     assert np.all(np.asarray(leg.seen.close) == -1)
-    clear = walk_plan(graph, graph, jnp.array([0, 1, 2, 3, 4, -1]))
+    clear = walk_plan(graph, graph, plan(0, 1, 2, 3, 4))
     assert bool(clear.reached) and int(clear.stop) == 4 and int(clear.seen.start) == -1
-    nothing = walk_plan(graph, graph, jnp.full((6,), -1))
+    nothing = walk_plan(graph, graph, plan())
     assert not bool(nothing.reached) and float(nothing.length) == 0.0
 
 
 def test_a_diagonal_squeezing_past_a_hidden_cell_reveals_that_cell():
-    graph = free_grid(2, 2)  # 0 1 / 2 3: the diagonal 0 -> 3 needs 1 and 2 free
-    world = apply_event(make_event(graph, block=[(1, 0)]), graph, make_task(graph, 0, 3))[0]
-    leg = walk_plan(world, graph, jnp.array([0, 3]))
+    graph = free_grid(SIDE, SIDE)  # 0 1 / 5 6: the diagonal 0 -> 6 needs 1 and 5 free
+    world = apply_event(make_event(graph, block=[(1, 0)]), graph, make_task(graph, 0, 6))[0]
+    leg = walk_plan(world, graph, plan(0, 6))
     assert int(leg.stop) == 0 and float(leg.length) == 0.0
     assert sorted(np.asarray(leg.seen.block).tolist()) == [-1, -1, 1]
 
 
 def test_a_hidden_thin_wall_is_seen_as_a_closed_passage():
-    connections = np.zeros((1, 3, 8), bool)
-    connections[0, 0, 0] = connections[0, 1, 0] = True  # east moves 0 -> 1 -> 2
-    connections[0, 1, 2] = connections[0, 2, 2] = True  # and back west
-    graph = path_map_graph(connections)
+    graph = top_row_path_map()
     hidden = make_event(graph, close=[((1, 0), (2, 0))])
     task = make_task(graph, 0, 2)
     world = apply_event(hidden, graph, task)[0]
     assert bool(graph.valid_edges()[1, 0]) and not bool(world.valid_edges()[1, 0])
-    leg = walk_plan(world, graph, jnp.array([0, 1, 2]))
+    leg = walk_plan(world, graph, plan(0, 1, 2))
     assert int(leg.stop) == 1 and np.asarray(leg.seen.close).tolist() == [[1, 0]]
     assert np.all(np.asarray(leg.seen.block) == -1)
     # Closing is both directions, and opening undoes it.
@@ -78,9 +92,9 @@ def robot_invariants(known, start, goal, hidden, walk):
     travelled no less than the optimum with full knowledge."""
     task = make_task(known, start, goal)
     world = apply_event(hidden, known, task)[0]
-    stood = trim(walk.trajectory)
-    assert bool(is_valid_path(world, jnp.asarray(stood), task.start, task.goal))
-    assert float(path_length(world, jnp.asarray(stood))) == pytest.approx(
+    # The padded trajectory (-1 after the last node stood on): one program whatever the route.
+    assert bool(is_valid_path(world, walk.trajectory, task.start, task.goal))
+    assert float(path_length(world, walk.trajectory)) == pytest.approx(
         float(walk.travelled), rel=1e-5)
     assert float(walk.travelled) >= check_world(known, start, goal, hidden) - 1e-4
 
@@ -177,7 +191,7 @@ def test_hidden_blocks_lie_on_the_way_and_keep_the_goal_reachable():
     assert cells[0] in first  # the first block is on the way the robot plans first
     check_world(known, start, goal, hidden)
     with pytest.raises(ValueError, match="only 0 of 1 hidden blocks keep the goal reachable"):
-        hidden_blocks(free_grid(1, 5), 0, 4, count=1, seed=0)
+        hidden_blocks(top_row_path_map(), 0, 4, count=1, seed=0)
 
 
 def test_bad_worlds_are_named():

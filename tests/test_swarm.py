@@ -15,7 +15,8 @@ from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, make, make_task, run
 from jaxswarm.swarm.core import StepInfo, keep_best
-from jaxswarm.swarm.testing import Compilations, check_reproducible, check_valid_results
+from jaxswarm.swarm.testing import (Compilations, batched_params, check_reproducible,
+                                     check_valid_results, run_batch)
 from jaxswarm.swarm.walking import Walk
 from jaxswarm.swarm.walking.log import from_rows
 from jaxswarm.world.graph import Graph, grid_graph
@@ -40,88 +41,106 @@ def test_the_conformance_suite_catches_a_swarm_that_breaks_it(maze):
         check_reproducible(fixed, graph, task)
 
 
-def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once(maze):
-    graph, task, _ = maze
+def test_rfd_star_sweep_over_p_base_and_alpha_compiles_once():
+    # A batch of sizes.RUNS runs, each of another p_base and alpha (the batch program the
+    # conformance checks build), and a batch of other values of both.
+    graph, task = sizes.maze()
     swarm = make("rfd_star", **SMALL)
-    p_base, alpha = jnp.meshgrid(jnp.array([5.0, 20.0, 50.0, 200.0]), jnp.arange(1.0, 5.0))
-    grid = swarm.default_params._replace(p_base=p_base.ravel(), alpha=alpha.ravel())
-    grid = jax.tree_util.tree_map(lambda x: jnp.broadcast_to(x, (16,)), grid)
-    compiled = jax.jit(jax.vmap(lambda p: run(swarm, jax.random.key(1), graph, task, p,
-                                              iterations=ITERATIONS)[1].best_cost))
+    grid = batched_params(swarm.default_params, sizes.RUNS)._replace(
+        p_base=jnp.array([5.0, 50.0, 200.0]), alpha=jnp.array([1.0, 2.0, 4.0]))
     other = jax.tree_util.tree_map(lambda x: x * 1.01, grid)
+    keys = jax.random.split(jax.random.key(1), sizes.RUNS)
     with Compilations() as built:
-        compiled(grid)
-        compiled(other)
+        run_batch(swarm, keys, graph, task, grid, iterations=ITERATIONS)
+        run_batch(swarm, keys, graph, task, other, iterations=ITERATIONS)
     assert built.count == 1, built.names
 
 
+def iterate(swarm, graph, task, params, state=None, budget=1, seed=0):
+    """``(state, trace)`` of ``budget`` iterations of ``swarm``, from fresh memory or from
+    ``state``, by ``run`` at the shared iteration count with a traced budget: one program per
+    swarm and map shape, whatever the budget, the params and the state's values. A swarm of the
+    shared size on the shared map's shape runs the programs test_conformance.py (fresh memory)
+    and test_dynamic.py (from a state) build."""
+    return run(swarm, jax.random.key(seed), graph, task, params, iterations=ITERATIONS,
+               state=state, budget=budget)
+
+
+def fresh_altitudes(graph, task, params):
+    """A river swarm's altitudes in fresh memory, as its ``init`` sets them (without a program):
+    ``initial_height``, the goal at 0."""
+    return jnp.full((graph.num_nodes,), params.initial_height).at[task.goal].set(0.0)
+
+
 @pytest.mark.parametrize("law", ["linear", "exponential"])
-def test_no_erosion_and_no_sediment_leave_altitudes_alone(maze, law):
-    graph, task, _ = maze
-    swarm = make("rfd_star", num_agents=32, erosion_law=law)
+def test_no_erosion_and_no_sediment_leave_altitudes_alone(law):
+    graph, task = sizes.maze()
+    swarm = make("rfd_star", erosion_law=law, **SMALL)
     params = swarm.default_params._replace(erosion=jnp.float32(0.0), sediment=jnp.float32(0.0))
-    state = swarm.init(jax.random.key(0), graph, task, params)
-    stepped, _ = swarm.step(state, graph, task, params)
-    np.testing.assert_array_equal(stepped.altitude, state.altitude)
+    state, _ = iterate(swarm, graph, task, params, budget=ITERATIONS)
+    np.testing.assert_array_equal(state.altitude, fresh_altitudes(graph, task, params))
 
 
 @pytest.fixture(scope="module")
 def corridor():
-    """A 1 x 5 corridor from (0, 0) to (4, 0): every drop walks the same four unit edges."""
-    graph = grid_graph(np.zeros((1, 5), bool))
+    """A corridor from (0, 0) to (4, 0) in the shared map's shape, every other cell blocked:
+    every drop walks the same four unit edges. N, the graph's node count, counts the blocked
+    cells too."""
+    obstacles = np.ones(sizes.maze()[0].shape, bool)
+    obstacles[0, :5] = False
+    graph = grid_graph(obstacles)
     return graph, make_task(graph, (0, 0), (4, 0))
 
 
-def iterate(swarm, graph, task, params, state, budget=1):
-    """``(state, trace)`` of ``budget`` iterations of ``swarm`` from ``state``, by ``run`` at the
-    shared iteration count with a traced budget: one program per swarm and map shape, whatever the
-    budget, the params and the state's values."""
-    return run(swarm, jax.random.key(0), graph, task, params, iterations=ITERATIONS, state=state,
-               budget=budget)
-
-
-def one_iteration(swarm, graph, task, **params):
+def one_iteration(swarm, graph, task, state=None, **params):
+    """The state after one iteration of ``swarm`` with ``params`` (the others default), from
+    fresh memory or from ``state``, in which every drop arrived."""
     params = swarm.default_params._replace(**{k: jnp.float32(v) for k, v in params.items()})
-    state = swarm.init(jax.random.key(0), graph, task, params)
     state, trace = iterate(swarm, graph, task, params, state)
     assert float(trace.arrived[0]) == 1.0
-    return np.asarray(state.altitude)
+    return state
 
 
 def test_linear_erosion_is_eqs_4_and_5(corridor):
     # Only edge 3 -> 4 has a gradient (1 - 0) / 1: node 3 loses E / (N - 1) summed over the D
-    # drops; eq. 5 then gives every node that total / (N - 1); the goal is reset to 0.
+    # drops, 1 / 4 with E = (N - 1) / 4; eq. 5 then gives every node, blocked ones too, that
+    # total / (N - 1); the goal is reset to 0.
     graph, task = corridor
-    swarm = make("rfd_star", num_agents=8, erosion_law="linear")
-    altitude = one_iteration(swarm, graph, task, initial_height=1.0, erosion=1.0, sediment=0.0)
-    np.testing.assert_allclose(altitude, [1 + 1 / 16, 1 + 1 / 16, 1 + 1 / 16,
-                                          1 - 1 / 4 + 1 / 16, 0.0], rtol=1e-6)
+    n = graph.num_nodes
+    swarm = make("rfd_star", erosion_law="linear", **SMALL)
+    state = one_iteration(swarm, graph, task, initial_height=1.0, erosion=(n - 1) / 4,
+                          sediment=0.0)
+    expected = np.full(n, 1 + 1 / (4 * (n - 1)))
+    expected[3:5] = 1 - 1 / 4 + 1 / (4 * (n - 1)), 0.0
+    np.testing.assert_allclose(state.altitude, expected, rtol=1e-6)
 
 
 def test_exponential_erosion_erodes_no_node_below_the_node_it_drains_to(corridor):
     # p_base ** gradient asks 1 on the three flat edges and p_base = 2 on the last one, each
-    # times E / ((N - 1) D) = 1 / 32 per drop. A flat move's node would sink below the node it
-    # goes to: it gives nothing. Node 3 asks 8 / 32 * 2 = 1 / 2 and drains to the goal (0): it
-    # gives it. Eq. 5: every node gains (1 / 2) / 4.
+    # times E / ((N - 1) D) = 1 / (4 D) per drop (E = (N - 1) / 4). A flat move's node would
+    # sink below the node it goes to: it gives nothing. Node 3 asks D / (4 D) * 2 = 1 / 2 and
+    # drains to the goal (0): it gives it. Eq. 5: every node, blocked ones too, gains
+    # (1 / 2) / (N - 1).
     graph, task = corridor
-    swarm = make("rfd_star", num_agents=8, erosion_law="exponential")
-    altitude = one_iteration(swarm, graph, task, p_base=2.0, initial_height=1.0, erosion=1.0,
-                             sediment=0.0)
-    np.testing.assert_allclose(altitude, [1 + 1 / 8] * 3 + [1 - 1 / 2 + 1 / 8, 0.0], rtol=1e-6)
+    n = graph.num_nodes
+    swarm = make("rfd_star", erosion_law="exponential", **SMALL)
+    state = one_iteration(swarm, graph, task, p_base=2.0, initial_height=1.0,
+                          erosion=(n - 1) / 4, sediment=0.0)
+    expected = np.full(n, 1 + 1 / (2 * (n - 1)))
+    expected[3:5] = 1 - 1 / 2 + 1 / (2 * (n - 1)), 0.0
+    np.testing.assert_allclose(state.altitude, expected, rtol=1e-6)
 
 
 def test_graded_erosion_cuts_the_bed_to_slope_times_the_remaining_length(corridor):
     graph, task = corridor
-    swarm = make("rfd_graded", num_agents=8)
-    altitude = one_iteration(swarm, graph, task, erosion=0.5, initial_height=100.0)
-    np.testing.assert_allclose(altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
+    swarm = make("rfd_graded", **SMALL)
+    bed = np.full(graph.num_nodes, 100.0)  # the blocked cells stay on the plateau
+    bed[:5] = [2.0, 1.5, 1.0, 0.5, 0.0]
+    state = one_iteration(swarm, graph, task, erosion=0.5, initial_height=100.0)
+    np.testing.assert_allclose(state.altitude, bed)
     # A higher slope cuts less deep, and the bed never rises: min(old, new) per node.
-    params = swarm.default_params._replace(erosion=jnp.float32(0.5),
-                                           initial_height=jnp.float32(100.0))
-    state = swarm.init(jax.random.key(0), graph, task, params)
-    state, _ = iterate(swarm, graph, task, params, state)
-    state, _ = iterate(swarm, graph, task, params._replace(erosion=jnp.float32(2.0)), state)
-    np.testing.assert_allclose(state.altitude, [2.0, 1.5, 1.0, 0.5, 0.0])
+    state = one_iteration(swarm, graph, task, state, erosion=2.0, initial_height=100.0)
+    np.testing.assert_allclose(state.altitude, bed)
 
 
 def test_graded_carving_drains_into_a_river_without_arriving():
@@ -158,9 +177,8 @@ def fake_walk(graph, cells, stuck=True):
 
 def filled_cells(graph, task, walk_):
     from jaxswarm.swarm import rfd
-    swarm = make("rfd_graded", num_agents=1)
-    altitude = swarm.init(jax.random.key(0), graph, task, swarm.default_params).altitude
-    table = rfd.graded_transition(graph, task, altitude, swarm.default_params)
+    params = make("rfd_graded").default_params
+    table = rfd.graded_transition(graph, task, fresh_altitudes(graph, task, params), params)
     filled = np.flatnonzero(np.asarray(rfd.blind_alleys(graph, table, walk_)))
     return sorted((int(v) % graph.shape[1], int(v) // graph.shape[1]) for v in filled)
 
@@ -213,40 +231,48 @@ def test_graded_gradients_between_bed_and_plateau_are_clipped():
     assert logw(5, 4) == -np.inf and logw(1, 2) > 1e29
 
 
+STRIP = 200
+"""The length of the one-row maps the altitude rules are checked on, a shorter map being cut out
+of one by obstacles: one program of each rule for all of them."""
+
+
+def strip(free_cells: int, altitudes):
+    """A 1 x STRIP map whose first ``free_cells`` cells are free (the others blocked), and
+    f32[STRIP] altitudes: ``altitudes`` on its first cells, 100 (the plateau of these tests)
+    on the others."""
+    obstacles = np.ones((1, STRIP), bool)
+    obstacles[0, :free_cells] = False
+    altitude = np.full(STRIP, 100.0, np.float32)
+    altitude[:len(altitudes)] = altitudes
+    return grid_graph(obstacles), jnp.asarray(altitude)
+
+
 def test_settling_leaves_no_filled_pit():
     from jaxswarm.swarm import rfd
-    obstacles = np.zeros((3, 7), bool)
-    obstacles[:, 6] = True
-    obstacles[1, 6] = False  # (6, 1) is free but walled in on the east
-    obstacles[[0, 2], :] = True
-    graph = grid_graph(obstacles)  # a corridor (0, 1)..(5, 1), and (6, 1) joined to (5, 1)
+    # A corridor (0, 0)..(5, 0), and (6, 0) joined to (5, 0) only.
+    graph, altitude = strip(7, [101.0, 100.5, 101.0, 100.0, 99.0, 0.0, 102.0])
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
-    altitude = jnp.full((graph.num_nodes,), 100.0)
-    row = 7  # node of (x, 1) is 7 + x
-    altitude = altitude.at[row + jnp.arange(7)].set(
-        jnp.array([101.0, 100.5, 101.0, 100.0, 99.0, 0.0, 102.0]))
-    settled = np.asarray(rfd.settle(graph, altitude, params))[row: row + 7]
-    # (1, 1) is a pit between two 101s: raised to 101.25, which makes (0, 1) a pit in turn.
-    # (2, 1) drains to the unfilled (3, 1); unfilled and carved nodes and (6, 1), which drains
-    # into the bed at (5, 1), keep their altitude.
+    settled = np.asarray(rfd.settle(graph, altitude, params))[:7]
+    # (1, 0) is a pit between two 101s: raised to 101.25, which makes (0, 0) a pit in turn.
+    # (2, 0) drains to the unfilled (3, 0); unfilled and carved nodes and (6, 0), which drains
+    # into the bed at (5, 0), keep their altitude.
     np.testing.assert_allclose(settled, [101.5, 101.25, 101.0, 100.0, 99.0, 0.0, 102.0])
-    # A filled node without any edge has nowhere to settle to and keeps its altitude (a map of
-    # the shape above: the same program).
-    alone = np.ones((3, 7), bool)
-    alone[1, 1] = False
-    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((21,), 101.0), params))
-    assert lone[row + 1] == 101.0
+    # A filled node without any edge has nowhere to settle to and keeps its altitude.
+    alone = np.ones((1, STRIP), bool)
+    alone[0, 1] = False
+    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((STRIP,), 101.0, jnp.float32),
+                                 params))
+    assert lone[1] == 101.0
 
 
 def test_sediment_settles_all_the_way_in_one_call():
     # Filled ground (101) along a 200-cell corridor drains only through its east end (100): it
     # settles to a slope of repose down to there, which takes about 200 sweeps.
     from jaxswarm.swarm import rfd
-    graph = grid_graph(np.zeros((1, 200), bool))
+    graph, altitude = strip(STRIP, [101.0] * (STRIP - 1))
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
-    altitude = jnp.full((200,), 101.0).at[199].set(100.0)
     settled = np.asarray(rfd.settle(graph, altitude, params))
     np.testing.assert_allclose(settled[:199], 101.0 + 0.25 * (198 - np.arange(199)))
     assert settled[199] == 100.0
@@ -254,15 +280,15 @@ def test_sediment_settles_all_the_way_in_one_call():
 
 def test_a_drop_erodes_the_banks_it_visits():
     from jaxswarm.swarm import rfd
-    graph = grid_graph(np.zeros((1, 5), bool))
+    graph, altitude = strip(5, [100.0, 7.0, 9.0, 0.5, 0.0])
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        erosion=jnp.float32(1.0))
-    altitude = jnp.array([100.0, 7.0, 9.0, 0.5, 0.0])
-    visited = jnp.array([True, True, True, False, False])
+    visited = jnp.arange(STRIP) < 3
     eroded = np.asarray(rfd.erode_banks(graph, altitude, visited, params))
     # (2, 0) sees the bed at (3, 0): 0.5 + 1. (1, 0) looks once, at the old 9 and the uncarved
-    # plateau, and keeps its 7; the plateau node and the unvisited nodes are left alone.
-    np.testing.assert_allclose(eroded, [100.0, 7.0, 1.5, 0.5, 0.0])
+    # plateau, and keeps its 7; the plateau nodes and the unvisited nodes are left alone.
+    np.testing.assert_allclose(eroded[:5], [100.0, 7.0, 1.5, 0.5, 0.0])
+    np.testing.assert_array_equal(eroded[5:], 100.0)
 
 
 def test_ground_explored_in_vain_rises_towards_the_frontier():
@@ -281,6 +307,8 @@ def test_ground_explored_in_vain_rises_towards_the_frontier():
 
 def test_with_exact_altitudes_the_greedy_drop_walks_a_shortest_path():
     from jaxswarm.exact.field import distance_field
+    # Few drops on a large map: with more drops or on a smaller map, the drops that draw their
+    # moves walk a shortest path as well, and a greedy drop that did not would go unnoticed.
     chosen = paper_map("mosaic50")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
@@ -368,12 +396,10 @@ LATE = _late_arrival_swarm()
 
 @pytest.mark.parametrize("name", ["rfd_star", "ant_system"])
 def test_a_run_stops_when_every_agent_followed_the_same_path(name, corridor):
-    # On the corridor there is one path. From the initial state, as the erosion tests above run
-    # (rfd_star shares their program).
+    # On the corridor there is one path.
     graph, task = corridor
-    swarm = make(name, num_agents=8)
-    state = swarm.init(jax.random.key(0), graph, task, swarm.default_params)
-    state, trace = iterate(swarm, graph, task, swarm.default_params, state, budget=ITERATIONS)
+    swarm = make(name, **SMALL)
+    _, trace = iterate(swarm, graph, task, swarm.default_params, budget=ITERATIONS)
     assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
 
 
@@ -412,6 +438,20 @@ def test_patience_counts_iterations_without_gain_since_the_first_path(first_path
     assert float(trace.best_cost[stops_after - 1]) == 100.0 - len(improvements)
 
 
+def test_a_patience_that_cannot_stop_a_run_is_none_and_shares_its_program():
+    graph, task = sizes.maze()
+    swarm = make("rfd", **sizes.CONFIG)
+    key = jax.random.key(4)
+    without = run(swarm, key, graph, task, swarm.default_params, iterations=sizes.ITERATIONS)
+    with Compilations() as built:
+        for patience in (sizes.ITERATIONS, sizes.ITERATIONS + 5):
+            same = run(swarm, key, graph, task, swarm.default_params,
+                       iterations=sizes.ITERATIONS, patience=patience)
+            np.testing.assert_array_equal(same[1].best_cost, without[1].best_cost)
+            np.testing.assert_array_equal(same[0].altitude, without[0].altitude)
+    assert built.count == 0, built.names
+
+
 @pytest.mark.parametrize("field, value, message", [
     ("p_base", float("nan"), "p_base must be finite"),
     ("p_base", 0.0, "p_base must be positive"),
@@ -421,16 +461,16 @@ def test_patience_counts_iterations_without_gain_since_the_first_path(first_path
     ("erosion", 0.0, "erosion must be positive"),  # the graded law's slope
     ("repose", -0.1, "repose must be non-negative"),
 ])
-def test_bad_params_are_named(maze, field, value, message):
-    graph, task, _ = maze
+def test_bad_params_are_named(field, value, message):
+    graph, task = sizes.maze()
     swarm = make("rfd_graded", **SMALL)
     params = swarm.default_params._replace(**{field: jnp.float32(value)})
     with pytest.raises(ValueError, match=message):
         run(swarm, jax.random.key(0), graph, task, params, iterations=2)
 
 
-def test_bad_sizes_and_endpoints_are_named(maze):
-    graph, task, _ = maze
+def test_bad_sizes_and_endpoints_are_named():
+    graph, task = sizes.maze()
     with pytest.raises(ValueError, match="num_agents must be at least 1, got 0"):
         make("rfd_star", num_agents=0)
     with pytest.raises(ValueError, match="iterations must be at least 1"):

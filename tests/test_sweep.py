@@ -17,6 +17,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
+import sizes
 
 from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.exact.visibility import shortest_path
@@ -43,12 +44,15 @@ OUTCOME_COLUMNS = ["map", "run", "seed", "p_base", "alpha", "cost", "found", "it
 
 
 def tiny(**changes):
-    """A small spec document: 2 x 2 params x 3 seeds on one paper map and one random map."""
+    """A small spec document: 2 x 2 params x 3 seeds on one paper map and one random map, at the
+    shared size of ``tests/sizes.py``. Both maps are 20 x 20, so every chunk (5 runs, the width
+    of test_tune.py's calls too) is one compiled program, and a row's run alone is the
+    conformance checks' run of rfd_star."""
     document = {
         "sweep": {"name": "tiny", "algorithm": "rfd_star",
-                  "maps": ["mosaic20", {"random": 12, "seed": 4}], "seeds": 3, "iterations": 6,
-                  "chunk_size": 5},
-        "config": {"num_agents": 8},
+                  "maps": ["mosaic20", {"random": 20, "seed": 4}], "seeds": 3,
+                  "iterations": sizes.ITERATIONS, "chunk_size": 5},
+        "config": dict(sizes.CONFIG),
         "params": {"p_base": [5.0, 20.0], "alpha": {"start": 2, "stop": 8, "num": 2}},
     }
     for section, values in changes.items():
@@ -122,13 +126,16 @@ def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path):
 
 
 def _tiny_movingai(folder):
-    """A 3 x 2 Moving AI map whose second scenario row starts on an obstacle."""
-    (folder / "tiny.map").write_text("type octile\nheight 2\nwidth 3\nmap\n..@\n...\n")
+    """A Moving AI map of the shared 20 x 20 shape, open but for one obstacle at (2, 0), on which
+    the second scenario row starts."""
+    rows = ["..@" + "." * 17] + ["." * 20] * 19
+    (folder / "tiny.map").write_text("type octile\nheight 20\nwidth 20\nmap\n"
+                                     + "\n".join(rows) + "\n")
     (folder / "tiny-even-1.scen").write_text(
-        "version 1\n0\ttiny.map\t3\t2\t0\t0\t2\t1\t2.41421356\n"
-        "0\ttiny.map\t3\t2\t2\t0\t0\t1\t2.0\n")
+        "version 1\n0\ttiny.map\t20\t20\t0\t0\t2\t1\t2.41421356\n"
+        "0\ttiny.map\t20\t20\t2\t0\t0\t1\t2.0\n")
     (folder / "tiny-random-1.scen").write_text(
-        "version 1\n0\ttiny.map\t3\t2\t2\t1\t0\t0\t2.41421356\n")
+        "version 1\n0\ttiny.map\t20\t20\t2\t1\t0\t0\t2.41421356\n")
 
 
 @pytest.mark.parametrize("entry, message", [
@@ -186,12 +193,12 @@ def test_rows_are_tidy_and_match_single_runs(finished):
     # path of the optimal moves 18.656855): an optimal run has gap 0, never a negative one.
     assert (rows["optimum"] == optimal_length(graph, chosen.start, chosen.goal)).all()
     assert (frame["gap"][frame["found"]] >= 0).all()
-    swarm = make("rfd_star", num_agents=8)
+    swarm = make("rfd_star", **sizes.CONFIG)
     for _, row in rows.iloc[[0, 7, 11]].iterrows():  # a row equals run() with key(seed)
         params = swarm.default_params._replace(p_base=jnp.float32(row.p_base),
                                                alpha=jnp.float32(row.alpha))
         state, trace = run(swarm, jax.random.key(int(row.seed)), graph, task, params,
-                           iterations=6)
+                           iterations=sizes.ITERATIONS)
         assert float(swarm.best(state).cost) == pytest.approx(row.cost, rel=0, abs=0)
         assert int(trace.iterations) == row.iterations
     # The store is a Parquet dataset pandas reads directly, with a metadata record.
@@ -260,7 +267,7 @@ def test_a_sweep_with_patience_stops_its_runs_as_run_does(tmp_path):
     chosen = paper_map("mosaic20")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
-    swarm = make("rfd_star", num_agents=8)
+    swarm = make("rfd_star", **sizes.CONFIG)
     params = swarm.default_params._replace(p_base=np.float32(20.0), alpha=np.float32(8.0))
     for _, row in frame.iterrows():
         state, trace = run(swarm, jax.random.key(int(row.seed)), graph, task, params,
@@ -308,7 +315,7 @@ def _rewrite_metadata(out, change):
 def test_a_store_records_the_swarms_definition_and_refuses_another(finished, tmp_path):
     spec, out, _ = finished
     metadata = json.loads((out / "metadata.json").read_text())
-    assert metadata["swarm"] == definition(make("rfd_star", num_agents=8))
+    assert metadata["swarm"] == definition(make("rfd_star", **sizes.CONFIG))
     assert metadata["swarm"]["config"]["erosion_law"] == "linear"
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-
+import sizes
 from repo_scripts import load_script
 
 from jaxswarm.cli import main
@@ -28,31 +28,36 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def document(**changes):
-    """A small tune spec document: IWD's alpha (beta tied to it) and rho_n on two 20 x 20 paper
-    maps, held out on a third."""
-    tune_table = {"name": "tiny", "algorithm": "iwd", "method": "race", "budget": 60,
-                  "objective": "gap", "iterations": 4, "seed": 3, "chunk_size": 16,
+    """A small tune spec document: RFD*'s alpha (erosion tied to it) and p_base on two 20 x 20
+    paper maps, held out on a third, at the shared size of ``tests/sizes.py``.
+
+    Every call of its runs holds at most 5 (at most 5 settings race on an instance, 2 are held
+    out), so it is padded to a quarter of the chunk of 20: 5 runs, the chunk of test_sweep.py's
+    sweeps, whose compiled program the two files share."""
+    tune_table = {"name": "tiny", "algorithm": "rfd_star", "method": "race", "budget": 60,
+                  "objective": "gap", "iterations": sizes.ITERATIONS, "seed": 3,
+                  "chunk_size": 20,
                   "training": {"maps": ["maze20", "mosaic20"], "seeds": 6},
                   "held_out": {"maps": ["alley20"], "seeds": [100, 101]},
                   "race": {"first_test": 3}}
-    doc = {"tune": tune_table, "config": {"num_agents": 8},
-           "params": {"alpha": {"low": 0.5, "high": 4.0}, "beta": {"tied": "alpha"},
-                      "rho_n": {"low": 0.01, "high": 0.9, "log": True}}}
+    doc = {"tune": tune_table, "config": dict(sizes.CONFIG),
+           "params": {"alpha": {"low": 1.0, "high": 100.0}, "erosion": {"tied": "alpha"},
+                      "p_base": {"low": 1.5, "high": 1000.0, "log": True}}}
     for section, values in changes.items():
         doc[section] = dict(doc.get(section, {}), **values)
     return doc
 
 
 def test_a_spec_becomes_a_space_with_ties_and_fixed_values():
-    spec = tune_spec_from_dict(document(params={"initial_soil": 500}))
-    assert spec.space.free == ["alpha", "rho_n"]
-    assert spec.space.domains["beta"] == Tied("alpha")
-    assert spec.space.domains["rho_n"] == Real(0.01, 0.9, True)
-    assert spec.fixed == {"initial_soil": 500.0}
+    spec = tune_spec_from_dict(document(params={"sediment": 0.5}))
+    assert spec.space.free == ["alpha", "p_base"]
+    assert spec.space.domains["erosion"] == Tied("alpha")
+    assert spec.space.domains["p_base"] == Real(1.5, 1000.0, True)
+    assert spec.fixed == {"sediment": 0.5}
     assert spec.training.pairs[:2] == [(0, 0), (0, 1)] and len(spec.training.pairs) == 12
     assert spec.held_out.seeds == (100, 101)
-    assert json.loads(json.dumps(spec.as_dict()))["space"]["beta"] == {"kind": "Tied",
-                                                                        "to": "alpha"}
+    assert json.loads(json.dumps(spec.as_dict()))["space"]["erosion"] == {"kind": "Tied",
+                                                                           "to": "alpha"}
 
 
 @pytest.mark.parametrize("changes, message", [
@@ -64,18 +69,20 @@ def test_a_spec_becomes_a_space_with_ties_and_fixed_values():
     (dict(tune={"training": {"maps": ["maze21"], "seeds": 2}}), "tune.training.maps[0]"),
     (dict(tune={"race": {"alpha": 2}}), "tune.race.alpha: must be a number in (0, 1)"),
     (dict(params={"alpha": {"low": 4, "high": 1}}), "params.alpha: low and high must be"),
-    (dict(params={"beta": {"tied": "gamma"}}), "params.beta.tied: 'gamma' is not a searched"),
-    (dict(params={"rho_n": {"low": 0, "high": 1, "log": True}}), "params.rho_n: log must be"),
-    (dict(params={"rho": {"low": 0.1, "high": 0.5}}), "params.rho: unknown param of iwd"),
-    (dict(params={"rho_n": {"low": 0.5, "high": 3.0}}), "params.rho_n: 3.0 is not a valid"),
+    (dict(params={"erosion": {"tied": "gamma"}}),
+     "params.erosion.tied: 'gamma' is not a searched"),
+    (dict(params={"p_base": {"low": 0, "high": 1, "log": True}}), "params.p_base: log must be"),
+    (dict(params={"rho": {"low": 0.1, "high": 0.5}}), "params.rho: unknown param of rfd_star"),
+    (dict(params={"sediment": {"low": -1.0, "high": 1.0}}),
+     "params.sediment: -1.0 is not a valid"),
     (dict(config={"num_agents": {"choices": [8, -1]}}), "[config]"),
-    (dict(config={"agents": 8}), "config.agents: unknown config of iwd"),
+    (dict(config={"agents": 8}), "config.agents: unknown config of rfd_star"),
     (dict(unknown={}), "unknown: unknown section"),
     (dict(tune={"baseline": 3}), "tune.baseline: must be a table"),
-    (dict(tune={"baseline": {"beta": 1.0}}), "tune.baseline.beta: not a searched param of this "
-                                             "spec; searched: alpha, rho_n"),
-    (dict(tune={"baseline": {"alpha": 9.0}}), "tune.baseline.alpha: must be a number in [0.5, "
-                                              "4.0], got 9.0"),
+    (dict(tune={"baseline": {"erosion": 1.0}}), "tune.baseline.erosion: not a searched param of "
+                                                "this spec; searched: alpha, p_base"),
+    (dict(tune={"baseline": {"alpha": 900.0}}), "tune.baseline.alpha: must be a number in [1.0, "
+                                                "100.0], got 900.0"),
     (dict(tune={"held_out": {"maps": ["mosaic20"], "seeds": [5, 100]}}),
      "tune.held_out: 1 instance(s) are also training instances (e.g. map 'mosaic20' with seed 5)"),
 ])
@@ -131,7 +138,7 @@ def planted(method, budget=600):
     spec = tune_spec_from_dict(document(
         tune={"method": method, "budget": budget, "training": {"maps": ["maze20"],
                                                                 "seeds": 40}},
-        params={"alpha": {"low": 0.5, "high": 4.0}, "beta": 1.0, "rho_n": 0.9}))
+        params={"alpha": {"low": 0.5, "high": 4.0}, "erosion": 1.0, "p_base": 50.0}))
     return spec, PlantedEvaluator(spec)
 
 
@@ -185,14 +192,15 @@ def test_the_es_gradient_points_downhill_from_centred_ranks():
 
 def test_a_baseline_is_where_the_search_starts_and_what_the_best_is_judged_beside(tmp_path):
     spec = tune_spec_from_dict(document(tune={"baseline": {"alpha": 2.0}, "budget": 30}))
-    rho_n = float(make("iwd").default_params.rho_n)
-    assert baseline_values(spec) == {"alpha": 2.0, "beta": 2.0, "rho_n": pytest.approx(rho_n)}
+    p_base = float(make("rfd_star").default_params.p_base)
+    assert baseline_values(spec) == {"alpha": 2.0, "erosion": 2.0,
+                                     "p_base": pytest.approx(p_base)}
     # A store records the baseline; a spec without one records itself as before the key.
     assert spec.as_dict()["baseline"] == {"alpha": 2.0}
     assert "baseline" not in tune_spec_from_dict(document()).as_dict()
     result = tune(spec, tmp_path / "tune", log=lambda _: None)
     first = result.held_out.iloc[0]
-    assert first["label"] == "baseline" and first["alpha"] == first["beta"] == 2.0
+    assert first["label"] == "baseline" and first["alpha"] == first["erosion"] == 2.0
     runs = pd.read_parquet(tmp_path / "tune" / "runs")
     assert (runs.loc[runs["setting"] == 0, "param.alpha"] == 2.0).all()
 
@@ -230,11 +238,11 @@ def test_a_tune_rescores_the_best_beside_its_baseline_on_held_out_instances(fini
     assert 0 < result.runs_spent <= spec.budget
     table = result.held_out
     assert list(table["label"][:2]) == ["baseline", "best"]
-    assert table["alpha"].iloc[0] == float(make("iwd").default_params.alpha)  # no [tune.baseline]
+    assert table["alpha"].iloc[0] == float(make("rfd_star").default_params.alpha)  # no baseline
     assert (table["runs"] == 2).all()
     assert (table["low"] <= table["objective"]).all() and (
         table["objective"] <= table["high"]).all()
-    assert table["alpha"].iloc[1] == result.best["alpha"] == result.best["beta"]
+    assert table["alpha"].iloc[1] == result.best["alpha"] == result.best["erosion"]
     for name in ("held_out.csv", "race.csv", "race.png", "best.json", "metadata.json"):
         assert (out / name).is_file()
     runs = pd.read_parquet(out / "runs")

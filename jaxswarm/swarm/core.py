@@ -208,7 +208,8 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
       params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
       iterations: the iteration budget T (static).
       patience: stop after this many iterations without improvement of a path found
-        (static; None = never).
+        (static; None = never). A patience of ``iterations`` or more cannot stop a run early, so
+        it runs the program of None.
       state: a State to continue from (the memory of an earlier run, after
         :func:`jaxswarm.dynamic.events.change` when the map or the task changed); its key is
         replaced by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
@@ -231,6 +232,8 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
         raise ValueError(f"iterations must be at least 1, got {iterations}")
     if patience is not None and patience < 1:
         raise ValueError(f"patience must be at least 1, got {patience}")
+    if patience is not None and patience >= iterations:
+        patience = None
     require_world(swarm, world)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
