@@ -37,7 +37,12 @@ def test_configure_refuses_once_jax_has_started():
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/task")
-@pytest.mark.parametrize("devices, threads, pool", [(1, 1, 1), (2, 1, 2), (1, 2, 2)])
+@pytest.mark.parametrize("devices, threads, pool", [
+    (2, 1, 2),
+    # A process each, about 5 s: in the slow tier, their twin the case above.
+    pytest.param(1, 1, 1, marks=pytest.mark.slow),
+    pytest.param(1, 2, 2, marks=pytest.mark.slow),
+])
 def test_configure_sizes_the_device_list_and_the_thread_pool(devices, threads, pool):
     """XLA raises the pool to the device count; the pool threads are named tf_XLAEigen.
     Importing every jaxswarm module first must not start JAX (configure would refuse)."""
