@@ -1,7 +1,9 @@
 """Every transition rule and every memory update against a hand computation.
 
 The maps are 3 x 3 grids (nodes ``y * 3 + x``, 8-connected, diagonals sqrt 2, no corner
-cutting; slot order E S W N SE SW NW NE) or small variants with obstacles. Expected numbers are
+cutting; slot order E S W N SE SW NW NE) or small variants with obstacles, and for rfd_graded's
+step, which starts from fresh memory, a corridor cut out of the shared map's shape: one
+iteration of the run its conformance checks compile (``tests/sizes.py``). Expected numbers are
 computed here from the papers' formulas with ``math`` (see tests/hand.py for the geometry,
 written out independently of the library), never by calling the code under test.
 
@@ -11,20 +13,22 @@ RFD paper (000_eee128c5dbb1fda2): eq. 1-3 (RFD transition), eq. 4-5 (erosion, se
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
-
+import sizes
 from graphs import wandering_walk
 from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_walk, moves,
-                  probabilities, slot, step_length, xy)
+                  node, probabilities, slot, step_length, xy)
+
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.runtime.arithmetic import ordered_sum
-from jaxswarm.swarm import aco, make, make_task
+from jaxswarm.swarm import aco, make, make_task, run
 from jaxswarm.swarm.aco.ant_system import ant_system_update
 from jaxswarm.swarm.aco.bug2 import first_ant_path
 from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDStarParams,
@@ -263,26 +267,44 @@ def test_drops_that_do_not_erode_leave_the_erosion_as_their_whole_rows_would(p_b
     np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
 
 
-CORRIDOR = [1.0, 1.5, 0.0]  # a 1 x 3 corridor, start 0, goal 2: every drop walks 0 -> 1 -> 2
+# The step tests of rfd and rfd_star share one map shape, a row of 4 nodes, and 3 drops: one
+# compiled step per swarm. N = 4 counts the blocked node.
+DROPS = 3
+
+
+def forced_corridor():
+    """Start 0, goal 2, node 3 blocked: every drop walks 0 -> 1 -> 2."""
+    graph = grid(4, 1, blocked=[3])
+    return graph, make_task(graph, 0, 2)
+
+
+def dead_end():
+    """[start, ., #, goal]: every drop walks 0 -> 1 and is stuck (0 visited, 2 blocked)."""
+    graph = grid(4, 1, blocked=[2])
+    return graph, make_task(graph, 0, 3)
+
+
+CORRIDOR = [1.0, 1.5, 0.0, 1.0]  # the altitudes of the forced corridor's step
 
 
 @pytest.mark.parametrize("name, config, erosion, p_base, expected", [
-    # c = E / ((N-1) D) = E / 4. Linear: node 0 (g -0.5) erodes nothing, node 1 (g 1.5) loses
-    # 2 drops * c * 1.5; every node gains the total / 2; the goal is reset to 0.
-    ("rfd", {}, 0.4, None, [1.0 + 0.15, 1.5 - 0.3 + 0.15, 0.0]),
-    ("rfd_star", {}, 0.4, 2.0, [1.0 + 0.15, 1.5 - 0.3 + 0.15, 0.0]),
-    # Exponential, p_base 9: node 0 asks 2 * 0.1 * 9 ** -0.5 = 0.067 but its move climbs (to
-    # 1.5): it gives 0; node 1 asks 2 * 0.1 * 9 ** 1.5 = 5.4 and drains to the goal (0): it gives
-    # 1.5. Every node gains 1.5 / 2. (Unbounded: [3.67, -1.17 clamped to 0, 0].)
-    ("rfd_star", {"erosion_law": "exponential"}, 0.4, 9.0, [1.0 + 0.75, 1.5 - 1.5 + 0.75, 0.0]),
-    # E = 8 (c = 2): node 1 loses 6 and gains 3: -1.5, clamped at 0; node 0 gains 3.
-    ("rfd", {}, 8.0, None, [4.0, 0.0, 0.0]),
+    # c = E / ((N-1) D) = E / 9. Linear: node 0 (g -0.5) erodes nothing, node 1 (g 1.5) loses
+    # 3 drops * c * 1.5; every node gains the total / 3, the blocked one too; the goal is reset
+    # to 0.
+    ("rfd", {}, 0.9, None, [1.0 + 0.15, 1.5 - 0.45 + 0.15, 0.0, 1.0 + 0.15]),
+    ("rfd_star", {}, 0.9, 2.0, [1.0 + 0.15, 1.5 - 0.45 + 0.15, 0.0, 1.0 + 0.15]),
+    # Exponential, p_base 9: node 0 asks 3 * 0.1 * 9 ** -0.5 = 0.1 but its move climbs (to
+    # 1.5): it gives 0; node 1 asks 3 * 0.1 * 9 ** 1.5 = 8.1 and drains to the goal (0): it gives
+    # 1.5. Every node gains 1.5 / 3. (Unbounded: [3.63, -3.87 clamped to 0, 0, 3.73].)
+    ("rfd_star", {"erosion_law": "exponential"}, 0.9, 9.0,
+     [1.0 + 0.5, 1.5 - 1.5 + 0.5, 0.0, 1.0 + 0.5]),
+    # E = 9 (c = 1): node 1 loses 4.5 and gains 1.5: -1.5, clamped at 0; node 0 gains 1.5.
+    ("rfd", {}, 9.0, None, [2.5, 0.0, 0.0, 2.5]),
 ])
 def test_one_step_on_a_forced_corridor_erodes_by_eq4_eq5_then_clamps(name, config, erosion,
                                                                       p_base, expected):
-    graph = grid(3, 1)
-    task = make_task(graph, 0, 2)
-    swarm = make(name, num_agents=2, **config)
+    graph, task = forced_corridor()
+    swarm = make(name, num_agents=DROPS, **config)
     values = dict(erosion=erosion, initial_height=1.0, sediment=0.3)
     if p_base is not None:
         values.update(p_base=p_base, alpha=1.0)
@@ -299,27 +321,27 @@ def test_one_step_on_a_forced_corridor_erodes_by_eq4_eq5_then_clamps(name, confi
 
 @pytest.mark.parametrize("name", ["rfd", "rfd_star"])
 def test_erosion_steps_of_1e9_add_up_over_1000_iterations(name):
-    """The corridor 0 -> 1 -> goal 2 at altitudes 1, 1, 0, two drops, E = 4e-9, no sediment:
-    c = E / ((N-1) D) = 1e-9. Each iteration node 1 (gradient 1 to the goal) loses 2 c = 2e-9,
-    node 0 (gradient about 0 to node 1) about nothing, and eq. 5 gives every node 2e-9 / 2 =
-    1e-9: node 0 rises by 1e-9 and node 1 sinks by 1e-9 an iteration. Both steps are far below
-    half the float32 spacing at 1 (3e-8 below it, 6e-8 above), so without the residual neither
-    altitude would ever move; with it, after 1000 iterations node 0 is 1 + 1e-6 and node 1 is
-    1 - 1e-6, to within a float32 spacing (1.2e-7 above 1, 6e-8 below)."""
-    graph = grid(3, 1)
-    task = make_task(graph, 0, 2)
-    swarm = make(name, num_agents=2)
-    params = swarm.default_params._replace(**f32(erosion=4e-9, initial_height=1.0,
+    """The forced corridor 0 -> 1 -> goal 2 at altitudes 1, 1, 0 (the blocked node 3 at 1), three
+    drops, E = 9e-9, no sediment: c = E / ((N-1) D) = 1e-9. Each iteration node 1 (gradient 1 to
+    the goal) loses 3 c = 3e-9, node 0 (gradient about 0 to node 1) about nothing, and eq. 5
+    gives every node 3e-9 / 3 = 1e-9: node 0 rises by 1e-9 and node 1 sinks by 2e-9 an
+    iteration. Both steps are far below half the float32 spacing at 1 (3e-8 below it, 6e-8
+    above), so without the residual neither altitude would ever move; with it, after 1000
+    iterations node 0 is 1 + 1e-6 and node 1 is 1 - 2e-6, to within a float32 spacing (1.2e-7
+    above 1, 6e-8 below)."""
+    graph, task = forced_corridor()
+    swarm = make(name, num_agents=DROPS)
+    params = swarm.default_params._replace(**f32(erosion=9e-9, initial_height=1.0,
                                                  sediment=0.0))
     state = swarm.init(jax.random.key(0), graph, task, params)
     for _ in range(1000):
         state, _ = step(swarm, state, graph, task, params)
     altitude, residual = np.asarray(state.altitude), np.asarray(state.residual)
     assert altitude[0] - 1.0 == pytest.approx(1e-6, abs=1.2e-7)
-    assert 1.0 - altitude[1] == pytest.approx(1e-6, abs=6e-8)
+    assert 1.0 - altitude[1] == pytest.approx(2e-6, abs=6e-8)
     # What the altitudes do not show yet is in the residual.
     assert (altitude[:2].astype(np.float64) + residual[:2]).tolist() == pytest.approx(
-        [1 + 1e-6, 1 - 1e-6], abs=1e-9)
+        [1 + 1e-6, 1 - 2e-6], abs=1e-9)
     assert altitude[2] == 0.0 and residual[2] == 0.0
 
 
@@ -360,18 +382,23 @@ def test_a_stuck_drop_deposits_sediment_where_it_stands():
     assert np.asarray(got).tolist() == approx(expected)
 
 
+STUCK_SWITCHES = dict(fill_blind_alleys=True, erode="travelled")
+"""RFD*'s two switches for drops that do not arrive, in one swarm (one compiled step) for the two
+tests below: each test's params leave the other switch nothing to do (the trail it erodes is
+flat; the alley it fills gets sediment 0)."""
+
+
 @pytest.mark.parametrize("name, config, expected_gain", [
     ("rfd", {}, 3 * 0.25),  # three stuck drops, each deposits 0.25 on node 1
     ("rfd_star", {}, 3 * 0.25),
-    ("rfd_star", {"fill_blind_alleys": True}, 0.25),  # the alley {1} is filled once
+    ("rfd_star", STUCK_SWITCHES, 0.25),  # the alley {1} is filled once
 ])
 def test_one_step_where_every_drop_gets_stuck(name, config, expected_gain):
-    """1 x 4 map [start, ., #, goal]: every drop walks 0 -> 1 and is stuck (0 visited, 2
-    blocked). No drop arrived: no erosion, eq. 5 adds 0; node 1 gains the sediment; the blocked
-    node keeps its initial height 1, the goal 0."""
-    graph = grid(4, 1, blocked=[2])
-    task = make_task(graph, 0, 3)
-    swarm = make(name, num_agents=3, **config)
+    """The dead end: every drop walks 0 -> 1 and is stuck. No drop arrived and the trail 0 -> 1
+    is flat: no erosion, eq. 5 adds 0; node 1 gains the sediment; the blocked node keeps its
+    initial height 1, the goal 0."""
+    graph, task = dead_end()
+    swarm = make(name, num_agents=DROPS, **config)
     params = swarm.default_params._replace(**f32(sediment=0.25, initial_height=1.0,
                                                  erosion=1.0))
     state = swarm.init(jax.random.key(1), graph, task, params)
@@ -380,18 +407,19 @@ def test_one_step_where_every_drop_gets_stuck(name, config, expected_gain):
     assert np.asarray(state.altitude).tolist() == approx([1.0, 1.0 + expected_gain, 1.0, 0.0])
 
 
-@pytest.mark.parametrize("erode, expected", [
-    ("arrived", [1.0, 0.5, 1.0, 0.0]),  # no drop arrived: nothing erodes, eq. 5 adds 0
+@pytest.mark.parametrize("config, expected", [
+    # No drop arrived: nothing erodes, eq. 5 adds 0.
+    pytest.param({}, [1.0, 0.5, 1.0, 0.0], id="arrived"),
     # Every drop's trail 0 -> 1 (gradient 0.5) erodes: node 0 loses 3 drops * 0.1 * 0.5 = 0.15,
     # every node gains 0.15 / 3 = 0.05 (the blocked node too: eq. 5's "all nodes").
-    ("travelled", [1.0 - 0.15 + 0.05, 0.5 + 0.05, 1.0 + 0.05, 0.0]),
+    pytest.param(STUCK_SWITCHES, [1.0 - 0.15 + 0.05, 0.5 + 0.05, 1.0 + 0.05, 0.0],
+                 id="travelled"),
 ])
-def test_rfd_star_erodes_the_trails_of_stuck_drops_only_when_told(erode, expected):
-    """1 x 4 map [start, ., #, goal] at altitudes 1, 0.5, 1, 0: every drop walks 0 -> 1 and is
-    stuck, no sediment. N = 4, D = 3, E = 0.9: E / ((N-1) D) = 0.1."""
-    graph = grid(4, 1, blocked=[2])
-    task = make_task(graph, 0, 3)
-    swarm = make("rfd_star", num_agents=3, erode=erode)
+def test_rfd_star_erodes_the_trails_of_stuck_drops_only_when_told(config, expected):
+    """The dead end at altitudes 1, 0.5, 1, 0: every drop walks 0 -> 1 and is stuck, no
+    sediment. N = 4, D = 3, E = 0.9: E / ((N-1) D) = 0.1."""
+    graph, task = dead_end()
+    swarm = make("rfd_star", num_agents=DROPS, **config)
     params = swarm.default_params._replace(**f32(sediment=0.0, initial_height=1.0,
                                                  erosion=0.9))
     state = swarm.init(jax.random.key(1), graph, task, params)
@@ -522,21 +550,33 @@ def on_edges(edges, amount):
     return add
 
 
+@functools.partial(jax.jit, static_argnums=0)
+def first_step(swarm, key, graph, task, params, memory):
+    """``(state, info)`` of one step of ``swarm`` from fresh memory (``swarm.init``) with the
+    fields in ``memory`` (a dict of arrays) replaced: the init and the step in one program per
+    swarm, map shape and set of fields."""
+    state = dataclasses.replace(swarm.init(key, graph, task, params), **memory)
+    return swarm.step(state, graph, task, params)
+
+
+def best_so_far(graph, path, cost):
+    """The ``memory`` of :func:`first_step` that makes ``path`` (node list) of ``cost`` the best
+    path so far: -1 padded to N nodes (a walk's N - 1 moves and its start)."""
+    padded = np.full(graph.num_nodes, -1, np.int32)
+    padded[:len(path)] = path
+    return dict(best_path=jnp.asarray(padded), best_cost=jnp.float32(cost))
+
+
 def corridor_step(name, params, best=None, **config):
     """One step of an ant colony on the corridor from ``initial_pheromone``; ``best`` = (path,
     cost) replaces the best path so far first."""
     graph = grid(blocked=CORRIDOR_BLOCKED)
     task = make_task(graph, 0, 8)
     swarm = make(name, **config)
-    state = swarm.init(jax.random.key(2), graph, task, params)
-    state = dataclasses.replace(state, pheromone=jnp.asarray(initial_pheromone()))
+    memory = dict(pheromone=jnp.asarray(initial_pheromone()))
     if best is not None:
-        path, cost = best
-        padded = np.full(state.best_path.shape, -1, np.int32)
-        padded[:len(path)] = path
-        state = dataclasses.replace(state, best_path=jnp.asarray(padded),
-                                    best_cost=jnp.float32(cost))
-    state, info = step(swarm, state, graph, task, params)
+        memory.update(best_so_far(graph, *best))
+    state, info = first_step(swarm, jax.random.key(2), graph, task, params, memory)
     assert float(info.arrived) == 1.0 and float(info.iteration_cost) == approx(4.0)
     return np.asarray(state.pheromone)
 
@@ -597,13 +637,14 @@ MAX_MIN = dict(rho=0.5, q=3.0, tau_min=0.6, tau_max=10.0)
 
 
 @pytest.mark.parametrize("global_best, upper_bound, tau_max", [
-    (False, False, 10.0), (True, False, 10.0), (False, True, 1.2)])
+    (False, False, 10.0), (True, True, 10.0), (True, True, 1.2)])
 def test_max_min_update(global_best, upper_bound, tau_max):
     """Max-Min: tau <- max((1 - rho) tau, tau_min), then Q / f on the best path; with
     upper_bound, min(tau, tau_max). The best path so far is set to 0->1->2 claiming cost 2, so the
     ants (cost 4) do not replace it. Iteration-best: Q / 4 = 0.75 on the corridor, once (not per
     ant). global_best: Q / 2 = 1.5 on 0-1 and 1-2 only. rho 0.5, tau_min 0.6: every initial tau
-    below 1.2 is floored."""
+    below 1.2 is floored. The two switches are on together (one compiled step): a cap of 10
+    leaves every tau as it is, a cap of 1.2 lowers more than 5."""
     params = aco.DEFAULT_MAX_MIN._replace(**f32(**dict(MAX_MIN, tau_max=tau_max)))
     got = corridor_step("max_min_aco", params, best=([0, 1, 2], 2.0), num_agents=6,
                         global_best=global_best, upper_bound=upper_bound)
@@ -614,8 +655,9 @@ def test_max_min_update(global_best, upper_bound, tau_max):
     else:
         expected = expected + on_edges(CORRIDOR_EDGES, 0.75)
     if upper_bound:
-        expected = np.minimum(expected, 1.2)
-        assert (expected == 1.2).sum() > 5  # the cap matters here
+        capped = (expected > tau_max).sum()
+        assert capped > 5 if tau_max < 10 else capped == 0  # the cap matters at 1.2 only
+        expected = np.minimum(expected, tau_max)
     assert got.ravel().tolist() == approx(expected.ravel().tolist())
 
 
@@ -628,13 +670,9 @@ def test_improved_update_floors_then_adds_q_on_the_best_path_so_far():
     task = make_task(graph, 0, 8)
     params = aco.DEFAULT_IMPROVED._replace(**f32(rho=0.5, q=0.7, tau_min=0.6))
     swarm = make("improved_max_min_aco", num_agents=16)
-    state = swarm.init(jax.random.key(3), graph, task, params)
-    padded = np.full(state.best_path.shape, -1, np.int32)
-    padded[:3] = [0, 4, 8]
-    state = dataclasses.replace(state, pheromone=jnp.asarray(initial_pheromone()),
-                                best_path=jnp.asarray(padded),
-                                best_cost=jnp.float32(2) * jnp.float32(R2))
-    state, _ = step(swarm, state, graph, task, params)
+    memory = dict(pheromone=jnp.asarray(initial_pheromone()),
+                  **best_so_far(graph, [0, 4, 8], np.float32(2) * np.float32(R2)))
+    state, _ = first_step(swarm, jax.random.key(3), graph, task, params, memory)
     expected = (np.maximum(0.5 * initial_pheromone().astype(np.float64), 0.6)
                 + on_edges([(0, 4), (4, 8)], 0.7))
     assert np.asarray(state.pheromone).ravel().tolist() == approx(expected.ravel().tolist())
@@ -705,18 +743,26 @@ def test_carve_lowers_each_path_node_to_erosion_times_its_way_to_water():
 
 
 def test_one_graded_step_on_a_forced_corridor_carves_the_bed():
-    """rfd_graded on the 1 x 3 corridor (plateau 10, E = 1.5): every drop walks 0 -> 1 -> 2 (0 to
-    1 is flat, 1 to the goal forced) and arrives: no alley, no failed trail, nothing settles;
-    carving puts 1 at E * 1 and 0 at E * 2; the banks change nothing (0: 1.5 + 1.5 = 3)."""
-    graph = grid(3, 1)
+    """rfd_graded at the shared size (one iteration of the run test_conformance.py compiles) on
+    a corridor (0, 0) -> (1, 0) -> goal (2, 0) cut out of the shared map's shape, plateau 10,
+    E = 1.5: every drop walks 0 -> 1 -> 2 (0 to 1 is flat, 1 to the goal forced) and arrives: no
+    alley, no failed trail, nothing settles; carving puts 1 at E * 1 and 0 at E * 2; the banks
+    change nothing (0: 1.5 + 1.5 = 3); the blocked cells stay on the plateau."""
+    height, width = sizes.maze()[0].shape
+    graph = grid(width, height, blocked=range(3, width * height))
     task = make_task(graph, 0, 2)
-    swarm = make("rfd_graded", num_agents=4)
+    swarm = make("rfd_graded", **sizes.CONFIG)
     params = swarm.default_params._replace(**f32(initial_height=10.0, erosion=1.5))
-    state = swarm.init(jax.random.key(4), graph, task, params)
-    assert np.asarray(state.altitude).tolist() == approx([10.0, 10.0, 0.0])
-    state, info = step(swarm, state, graph, task, params)
-    assert float(info.arrived) == 1.0
-    assert np.asarray(state.altitude).tolist() == approx([3.0, 1.5, 0.0])
+    key = jax.random.key(4)
+    fresh, _ = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS,
+                   budget=0)  # no iteration: the memory swarm.init makes
+    bed = np.full(graph.num_nodes, 10.0)
+    bed[2] = 0.0
+    assert np.asarray(fresh.altitude).tolist() == approx(bed.tolist())
+    state, trace = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS, budget=1)
+    assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
+    bed[:2] = 3.0, 1.5
+    assert np.asarray(state.altitude).tolist() == approx(bed.tolist())
 
 
 def test_settle_raises_filled_pits_to_their_lowest_neighbour_plus_repose():
@@ -776,14 +822,16 @@ def alley_table(graph, banned=()):
 def test_blind_alleys_of_a_tiny_dead_end(banned, expected):
     """A drop walked 0 -> 1 -> 4 -> 7 and is stuck at 7 (4 visited). Back along its trail, 4's
     only moves lead back to 1 or into 7 (filled): filled. 1 has E to 2: the alley ends there,
-    unless the table bans 1 -> 2. A second drop that arrived 0 -> 1 -> 2 fills nothing, nor does
-    a drop that ran out of steps in the alley."""
+    unless the table bans 1 -> 2. A second drop that arrived 0 -> 1 -> 2 fills nothing, nor do
+    the same two walks when the first drop ran out of steps in the alley instead (two drops
+    both times: one compiled loop)."""
     graph = grid(blocked=ALLEY_BLOCKED)
     table = alley_table(graph, banned)
-    drops = fake_walk([[0, 1, 4, 7], [0, 1, 2]], 9, arrived=[False, True], stuck=[True, False])
+    paths = [[0, 1, 4, 7], [0, 1, 2]]
+    drops = fake_walk(paths, 9, arrived=[False, True], stuck=[True, False])
     got = np.flatnonzero(np.asarray(blind_alleys(graph, table, drops))).tolist()
     assert got == expected
-    not_stuck = fake_walk([[0, 1, 4, 7]], 9, arrived=[False], stuck=[False])
+    not_stuck = fake_walk(paths, 9, arrived=[False, True], stuck=[False, False])
     assert not np.asarray(blind_alleys(graph, table, not_stuck)).any()
 
 
@@ -791,19 +839,30 @@ def test_blind_alleys_of_a_tiny_dead_end(banned, expected):
 # The Improved Max-Min first ant (depth-first, never revisits)
 
 
+def in_the_shared_shape(free):
+    """``(graph, at)``: the 3 x 3 nodes ``free`` at the same cells in the corner of the shared
+    map's shape (``tests/sizes.py``), every other cell blocked, and ``at``, their numbers there:
+    the first ants' programs of the 20 x 20 maps below (and bug2's, test_bug2.py's)."""
+    height, width = sizes.maze()[0].shape
+    at = {v: node(*xy(v), width) for v in free}
+    graph = grid(width, height, blocked=sorted(set(range(width * height)) - set(at.values())))
+    return graph, at
+
+
 @pytest.mark.parametrize("greedy", [True, False])
 def test_first_ant_backs_out_of_a_dead_end(greedy):
-    """On the alley map, from 0 to 2 with 1 -> 4 made the most likely move: a greedy ant goes
-    0 1 4 7, is stuck, backs out to 4 (nothing new), to 1, and takes E to 2. The only path without
-    revisits is 0 1 2, so a weighted ant ends with it too, whatever it drew."""
-    graph = grid(blocked=ALLEY_BLOCKED)
+    """On the alley map (in the shared map's shape, its 3 x 3 nodes numbered there by ``at``),
+    from 0 to 2 with 1 -> 4 made the most likely move: a greedy ant goes 0 1 4 7, is stuck, backs
+    out to 4 (nothing new), to 1, and takes E to 2. The only path without revisits is 0 1 2, so
+    a weighted ant ends with it too, whatever it drew."""
+    graph, at = in_the_shared_shape([v for v in range(9) if v not in ALLEY_BLOCKED])
     table = np.asarray(alley_table(graph)).copy()
-    table[1, slot(1, 4)] = 5.0
+    table[at[1], slot(at[1], at[4], graph.shape[1])] = 5.0
     for seed in range(4 if not greedy else 1):
         path, cost, found = first_ant_path(jax.random.key(seed), graph, jnp.asarray(table),
-                                           0, 2, greedy=greedy)
+                                           at[0], at[2], greedy=greedy)
         assert bool(found)
-        assert np.asarray(path).tolist() == [0, 1, 2] + [-1] * 6
+        assert np.asarray(path).tolist() == [at[0], at[1], at[2]] + [-1] * (graph.num_nodes - 3)
         assert float(cost) == approx(2.0)
 
 
@@ -855,12 +914,13 @@ def test_first_ant_reaches_the_goal_without_revisits_on_random_path_maps(width, 
 
 def test_first_ant_reports_an_unreachable_goal():
     """Goal walled off: found False, path all -1, cost inf, as Dijkstra says. (a) a 20 x 20 path
-    map with the 8 edges of the goal closed; (b) a 3 x 3 grid with a wall down column 1 (the
-    alley tests' size: their program)."""
+    map with the 8 edges of the goal closed; (b) a 3 x 3 grid with a wall down column 1, in the
+    shared map's shape."""
     graph = path_map_graph(random_path_map(20, 20, 7, extra=0.3))
     goal = 210
     graph = close_edges(graph, jnp.full(8, goal), jnp.arange(8))
-    for g, start, end in [(graph, 0, goal), (grid(blocked=[1, 4, 7]), 0, 8)]:
+    walled, at = in_the_shared_shape([0, 2, 3, 5, 6, 8])
+    for g, start, end in [(graph, 0, goal), (walled, at[0], at[8])]:
         task = make_task(g, start, end)
         for seed in range(3):
             path, cost, found = first_ant_path(jax.random.key(seed), g,
