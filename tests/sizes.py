@@ -60,7 +60,7 @@ class SharedRun(NamedTuple):
 
 
 SEED = 0
-"""The key of a shared run (and of the first golden record of each swarm)."""
+"""The key of a shared run: the first golden record of each swarm (``tests/golden``)."""
 
 
 def shared_run(name: str) -> SharedRun:

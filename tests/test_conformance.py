@@ -17,7 +17,7 @@ import json
 import pytest
 import sizes
 from conformance import field, maze, world_of  # noqa: F401 (fixtures)
-from golden.swarms import GOLDEN, cases, is_shared_run, replay, summary
+from golden.swarms import GOLDEN, cases, replay
 
 from jaxswarm import swarm as swarms
 from jaxswarm.swarm import make
@@ -71,14 +71,11 @@ class Conformance:
         check_compiles_once(make(self.name, **SMALL), world, task, iterations=ITERATIONS,
                             runs=sizes.RUNS)
 
-    def test_replays_its_golden_records(self, swarm_run):
-        # Every leaf's digest, the best cost and the iterations it ran, bit for bit; the record
-        # of the shared run read from the session's.
+    def test_replays_its_golden_records(self):
+        # Every leaf's digest, the best cost and the iterations it ran, bit for bit.
         records = [r for r in RECORDS if r["swarm"] == self.name]
-        assert sum(map(is_shared_run, records)) == 1
         for record in records:
-            again = (summary(swarm_run.swarm, swarm_run.state, swarm_run.trace)
-                     if is_shared_run(record) else replay(record))
+            again = replay(record)
             described = f"{self.name} on {record['world']}, seed {record['seed']}"
             assert (again["ran"], again["best_cost"]) == (record["ran"], record["best_cost"]), (
                 described)
@@ -95,12 +92,6 @@ class Conformance:
 
 for _name in [*FIRST, *(n for n in swarms.registered() if n not in FIRST)]:
     globals()[f"TestSwarm_{_name}"] = type(f"TestSwarm_{_name}", (Conformance,), {"name": _name})
-
-
-def pytest_generate_tests(metafunc):
-    """A class's checks that read the shared run (``swarm_run``) read its swarm's."""
-    if "swarm_run" in metafunc.fixturenames:
-        metafunc.parametrize("swarm_run", [metafunc.cls.name], indirect=True)
 
 
 def test_every_registered_swarm_has_its_golden_records():

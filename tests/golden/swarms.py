@@ -56,17 +56,6 @@ def replay(record: dict) -> dict:
     swarm = make(record["swarm"], **record["config"])
     state, trace = run(swarm, jax.random.key(record["seed"]), graph, task, swarm.default_params,
                        iterations=record["iterations"], patience=record["patience"])
-    return summary(swarm, state, trace)
-
-
-def is_shared_run(record: dict) -> bool:
-    """Whether a record describes its swarm's shared run (:func:`sizes.shared_run`): the
-    conformance world at the shared size from key :data:`sizes.SEED`."""
-    return record["seed"] == sizes.SEED and record["world"] in (sizes.MAP, "plane6")
-
-
-def summary(swarm, state, trace) -> dict:
-    """A run as a record's ``digests``, ``best_cost`` and ``ran``."""
     leaves = jax.tree_util.tree_leaves_with_path(key_data((state, trace)))
     digests = {jax.tree_util.keystr(where): hashlib.sha256(
         np.ascontiguousarray(np.asarray(leaf)).tobytes()).hexdigest()[:16]
