@@ -5,10 +5,11 @@ not need sizes of its own takes these, and varies a run's length through ``run``
 from typing import Any, NamedTuple
 
 import jax
+import numpy as np
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import Swarm, Task, Trace, make, make_task, run
-from jaxswarm.world.graph import Graph
+from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.plane import Plane, make_plane
 
 MAP = "maze20"
@@ -23,6 +24,8 @@ RUNS = 3
 conformance checks of a swarm share that program."""
 CONFIG = dict(num_agents=AGENTS)
 """The swarm options of the shared size: ``make(name, **CONFIG)``."""
+SEED = 0
+"""The key of a shared run: the first golden record of each swarm (``tests/golden``)."""
 
 
 def maze() -> tuple[Graph, Task]:
@@ -31,6 +34,15 @@ def maze() -> tuple[Graph, Task]:
     chosen = paper_map(MAP)
     graph = chosen.graph()
     return graph, make_task(graph, chosen.start, chosen.goal)
+
+
+def cut_out(free) -> Graph:
+    """A grid of the shared map's shape whose only free cells are ``free`` (bool[h, w], set in its
+    top-left corner): a small hand-made map on which a swarm runs the shared size's programs."""
+    free = np.asarray(free, bool)
+    obstacles = np.ones(maze()[0].shape, bool)
+    obstacles[:free.shape[0], :free.shape[1]] = ~free
+    return grid_graph(obstacles)
 
 
 def plane() -> tuple[Plane, tuple[float, float], tuple[float, float]]:
@@ -57,10 +69,6 @@ class SharedRun(NamedTuple):
     task: Task
     state: Any
     trace: Trace
-
-
-SEED = 0
-"""The key of a shared run: the first golden record of each swarm (``tests/golden``)."""
 
 
 def shared_run(name: str) -> SharedRun:

@@ -9,16 +9,13 @@ from graphs import wandering_walk
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, run
 from jaxswarm.swarm.aco.ant_system import ant_system_update
-from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import is_valid_path, path_length
 
 
 def corridor():
     """A one-cell corridor (0,1)..(16,1) in a map of the shared shape (:data:`sizes.MAP`'s):
     every ant walks the same path of length 16."""
-    obstacles = np.ones(sizes.maze()[0].shape, bool)
-    obstacles[1, :17] = False
-    graph = grid_graph(obstacles)
+    graph = sizes.cut_out([[False] * 17, [True] * 17])
     return graph, make_task(graph, (0, 1), (16, 1))
 
 

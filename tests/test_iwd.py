@@ -346,9 +346,7 @@ def test_global_update_on_the_best_path():
 
 
 def test_iwd_finds_the_corridor_and_its_soil_falls_along_it():
-    obstacles = np.ones(sizes.maze()[0].shape, bool)
-    obstacles[0, :6] = False  # a corridor (0, 0) .. (5, 0) in the shared map's shape
-    graph = grid_graph(obstacles)
+    graph = sizes.cut_out([[True] * 6])  # a corridor (0, 0) .. (5, 0)
     swarm = make("iwd", **sizes.CONFIG)
     state, trace = run(swarm, jax.random.key(0), graph, make_task(graph, 0, 5),
                        swarm.default_params, iterations=sizes.ITERATIONS, budget=3)

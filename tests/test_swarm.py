@@ -86,9 +86,7 @@ def corridor():
     """A corridor from (0, 0) to (4, 0) in the shared map's shape, every other cell blocked:
     every drop walks the same four unit edges. N, the graph's node count, counts the blocked
     cells too."""
-    obstacles = np.ones(sizes.maze()[0].shape, bool)
-    obstacles[0, :5] = False
-    graph = grid_graph(obstacles)
+    graph = sizes.cut_out([[True] * 5])
     return graph, make_task(graph, (0, 0), (4, 0))
 
 
