@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-import jax.numpy as jnp
+import jax
 import numpy as np
 
 from jaxswarm.swarm.walking import Walk
@@ -82,9 +82,15 @@ def probabilities(row) -> dict[int, float]:
     return {k: weights[k] / weights.sum() for k in range(row.shape[0]) if finite[k]}
 
 
+_from_rows = jax.jit(from_rows, static_argnums=4)
+"""The library's log of whole rows, one program per walk shape (its few operations applied one
+by one outside jit would each be a program of their own)."""
+
+
 def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: int | None = None
               ) -> Walk:
-    """A Walk of the given node paths (one list per agent), slots and lengths computed here."""
+    """A Walk of the given node paths (one list per agent), slots and lengths computed here; its
+    fields are NumPy arrays but for the log, for the jitted functions under test to read."""
     longest = max(len(p) for p in paths)
     columns = (budget if budget is not None else longest - 1) + 1
     agents = len(paths)
@@ -100,12 +106,8 @@ def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: 
         for v in nodes:
             visited[a, v // 32] |= np.uint32(1 << (v % 32))
     moves = np.array([len(p) - 1 for p in paths], np.int32)
-    log = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), paths[0][0],
-                    columns - 1)
-    return Walk(log=log, length=jnp.asarray(lengths),
-                arrived=jnp.asarray(np.array(arrived, bool)),
-                stuck=jnp.asarray(np.array(stuck, bool)),
-                position=jnp.asarray(np.array([p[-1] for p in paths], np.int32)),
-                visited=jnp.asarray(visited),
-                moves=jnp.asarray(moves),
-                lane_steps=jnp.int32(agents * (longest - 1)))
+    log = _from_rows(path, slots, moves, paths[0][0], columns - 1)
+    return Walk(log=log, length=lengths, arrived=np.array(arrived, bool),
+                stuck=np.array(stuck, bool),
+                position=np.array([p[-1] for p in paths], np.int32), visited=visited,
+                moves=moves, lane_steps=np.int32(agents * (longest - 1)))

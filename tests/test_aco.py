@@ -1,6 +1,5 @@
 """Ant colonies: pheromone rules and quality on the paper maps."""
 import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 import sizes
@@ -8,8 +7,16 @@ from graphs import wandering_walk
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, run
-from jaxswarm.swarm.aco.ant_system import ant_system_update
+from jaxswarm.swarm.aco import ant_system, bug2
 from jaxswarm.world.paths import is_valid_path, path_length
+
+# The colonies' rules called alone, jitted: each is one program per map shape (and static
+# option), where outside jit each of its operations would be lowered and run as a program of its
+# own.
+ant_system_update = jax.jit(ant_system.ant_system_update)
+deposit = jax.jit(aco.deposit)
+transition_rule = jax.jit(aco.transition_rule, static_argnames=("direction", "goal_distance"))
+bug2_path = jax.jit(bug2.bug2_path)  # as test_bug2.py calls it
 
 
 def corridor():
@@ -22,11 +29,11 @@ def corridor():
 def test_ant_system_deposits_q_over_length_on_both_directions():
     graph, task = corridor()
     swarm = make("ant_system", **sizes.CONFIG)
-    params = swarm.default_params._replace(rho=jnp.float32(1.0), q=jnp.float32(2.0))
+    params = swarm.default_params._replace(rho=np.float32(1.0), q=np.float32(2.0))
     # One iteration (budget 1) of the run at the shared size.
     state, trace = run(swarm, jax.random.key(0), graph, task, params,
                        iterations=sizes.ITERATIONS, budget=1)
-    assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
+    assert int(trace.iterations) == 1 and np.asarray(trace.arrived)[0] == 1.0
     tau = np.asarray(state.pheromone)
     east, west, width = 0, 2, graph.shape[1]
     amount = sizes.AGENTS * 2.0 / 16  # every ant x Q / 16
@@ -43,10 +50,12 @@ def test_ants_that_did_not_arrive_leave_the_deposit_unchanged_and_do_not_widen_i
     pheromone = jax.random.uniform(jax.random.key(1), graph.nbr.shape, minval=0.5, maxval=2.0)
     params = aco.DEFAULT_ANT_SYSTEM
     got = ant_system_update(graph, pheromone, ants, None, None, None, params)
-    # Every ant's whole row, as before the cut: the same bits.
-    evaporated = jnp.maximum((1.0 - params.rho) * pheromone, aco.TAU_FLOOR)
-    amount = jnp.where(ants.arrived, params.q / ants.length, 0.0)
-    want = aco.deposit(graph, evaporated, ants.path[:, :-1], ants.slots, amount)
+    # Every ant's whole row, as before the cut: the same bits (eq. 9 and the amounts in NumPy's
+    # float32, rounded as XLA rounds them).
+    evaporated = np.maximum((1 - params.rho) * np.asarray(pheromone), aco.TAU_FLOOR)
+    arrived, length = np.asarray(ants.arrived), np.asarray(ants.length)
+    amount = np.where(arrived, params.q / length, np.float32(0))
+    want = deposit(graph, evaporated, np.asarray(ants.path)[:, :-1], ants.slots, amount)
     np.testing.assert_array_equal(np.asarray(got), np.asarray(want))
 
 
@@ -87,8 +96,8 @@ def test_pheromone_at_rho_09_never_becomes_impassable(name):
     assert int(trace.iterations) == sizes.ITERATIONS
     valid = np.asarray(graph.valid_edges())
     tau = np.asarray(state.pheromone)[valid]
-    table = np.asarray(aco.transition_rule(graph, task, state.pheromone, params,
-                                           goal_distance=name == "aco_star"))[valid]
+    table = np.asarray(transition_rule(graph, task, state.pheromone, params,
+                                       goal_distance=name == "aco_star"))[valid]
     assert tau.min() == aco.TAU_FLOOR and (tau == aco.TAU_FLOOR).sum() > valid.sum() // 2
     assert np.isfinite(table).all()
 
@@ -101,15 +110,13 @@ def test_bad_params_are_named():
                                   ("q", 0.0, "q must be positive")):
         with pytest.raises(ValueError, match=message):
             run(swarm, jax.random.key(0), graph, task,
-                swarm.default_params._replace(**{field: jnp.float32(value)}), iterations=2)
+                swarm.default_params._replace(**{field: np.float32(value)}), iterations=2)
     with pytest.raises(ValueError, match="unknown first_ant 'bug'; choose one of weighted"):
         make("improved_max_min_aco", first_ant="bug")
 
 
 @pytest.mark.parametrize("first_ant", ["weighted", "greedy"])
 def test_improved_max_min_starts_from_its_first_ants_path_and_keeps_the_floor(first_ant):
-    from jaxswarm.swarm.aco.bug2 import bug2_path
-
     chosen = paper_map("alley20")
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)

@@ -73,24 +73,27 @@ def test_ordered_sum_adds_halves_pairwise_whatever_the_batch():
 
 def test_ordered_cumsum_is_the_running_sum_whatever_the_batch():
     rows = np.random.default_rng(3).random((64, 50)).astype(np.float32)
-    batch = np.asarray(jax.jit(lambda r: ordered_cumsum(r, axis=1))(rows))
+    batch, backwards = jax.device_get(jax.jit(lambda r: (
+        ordered_cumsum(r, axis=1), ordered_cumsum(r, axis=1, reverse=True)))(rows))
     np.testing.assert_array_equal(batch, [np.asarray(jax.jit(ordered_cumsum)(r)) for r in rows])
     np.testing.assert_allclose(batch, np.cumsum(rows.astype(np.float64), axis=1), rtol=1e-6)
-    backwards = np.asarray(ordered_cumsum(rows, axis=1, reverse=True))
     np.testing.assert_allclose(backwards[:, 0], rows.astype(np.float64).sum(axis=1), rtol=1e-6)
     np.testing.assert_allclose(backwards[:, -1], rows[:, -1])
 
 
 def test_a_fingerprint_sees_every_bit_and_is_the_same_in_a_batch():
-    tree = {"cost": jnp.arange(5.0), "key": jax.random.key(0), "found": jnp.array([True, False]),
-            "slots": jnp.array([1, -1], jnp.int8)}
-    base = hex_fingerprint(jax.jit(fingerprint)(tree))
+    # Alone outside jit (as a replayed run is fingerprinted), in a batch jitted (as a sweep's).
+    tree = {"cost": np.arange(5, dtype=np.float32), "key": jax.random.key(0),
+            "found": np.array([True, False]), "slots": np.array([1, -1], np.int8)}
+    base = hex_fingerprint(fingerprint(tree))
     assert len(base) == 16
-    one_ulp = dict(tree, cost=tree["cost"].at[3].set(np.nextafter(np.float32(3), np.float32(4))))
-    flipped = dict(tree, found=jnp.array([False, False]))
+    one_ulp = dict(tree, cost=tree["cost"].copy())
+    one_ulp["cost"][3] = np.nextafter(np.float32(3), np.float32(4))
+    flipped = dict(tree, found=np.array([False, False]))
     other_key = dict(tree, key=jax.random.key(1))
     swapped = dict(tree, cost=tree["cost"][::-1])
     changed = {hex_fingerprint(fingerprint(t)) for t in (one_ulp, flipped, other_key, swapped)}
     assert base not in changed and len(changed) == 4
     stacked = jax.tree_util.tree_map(lambda x: jnp.stack([x, x, x]), tree)
-    assert {hex_fingerprint(f) for f in jax.vmap(fingerprint)(stacked)} == {base}
+    batch = np.asarray(jax.jit(jax.vmap(fingerprint))(stacked))
+    assert {hex_fingerprint(f) for f in batch} == {base}

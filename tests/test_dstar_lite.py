@@ -1,5 +1,8 @@
 """D* Lite: every answer after random edits, moves of the start and moves of the goal equals
 Dijkstra from scratch on the edited map."""
+import dataclasses
+
+import jax
 import numpy as np
 import pytest
 
@@ -7,8 +10,31 @@ from conftest import MOVINGAI
 from graphs import geometric_graph
 from jaxswarm.exact import astar, dijkstra, replanner
 from jaxswarm.maps.movingai import load_map
-from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.world.graph import grid_graph
+
+
+# The map edits of jaxswarm.world.edits, made in NumPy: outside jit, an edit compiles a few
+# operations for each new map shape, and nearly every map here has a shape of its own. The edits
+# themselves are checked in test_edits.py.
+def set_cells(graph, nodes, free: bool):
+    """``graph`` with ``free[nodes] = free`` (``block_cells``: False, ``unblock_cells``: True)."""
+    cells = np.array(graph.free)
+    cells[nodes] = free
+    return dataclasses.replace(graph, free=jax.device_put(cells))
+
+
+def set_edges(graph, nodes, slots, is_open: bool):
+    """``graph`` with each edge ``nodes[m] -> nbr[nodes[m], slots[m]]`` and its reverse open
+    (``open_edges``: True) or closed (``close_edges``: False); slots without a neighbour are left
+    alone."""
+    edges = np.array(graph.open)
+    nbr, rev = np.asarray(graph.nbr), np.asarray(graph.rev)
+    for node, slot in zip(nodes, slots):
+        if nbr[node, slot] >= 0:
+            edges[node, slot] = is_open
+            if rev[node, slot] >= 0:
+                edges[nbr[node, slot], rev[node, slot]] = is_open
+    return dataclasses.replace(graph, open=jax.device_put(edges))
 
 
 def check(solution, graph, start, goal):
@@ -35,16 +61,16 @@ def random_edits(rng, graph, planner, start, goal, steps):
         if kind == 0:
             candidates = np.setdiff1d(np.nonzero(free)[0], [start, goal])
             if candidates.size:
-                graph = block_cells(graph, rng.choice(candidates, min(candidates.size, 3),
-                                                      replace=False))
+                graph = set_cells(graph, rng.choice(candidates, min(candidates.size, 3),
+                                                    replace=False), False)
         elif kind == 1 and (~free).any():
-            graph = unblock_cells(graph, rng.choice(np.nonzero(~free)[0], 2))
+            graph = set_cells(graph, rng.choice(np.nonzero(~free)[0], 2), True)
         elif kind == 2:
             nodes = rng.integers(graph.num_nodes, size=3)
-            graph = close_edges(graph, nodes, rng.integers(graph.max_degree, size=3))
+            graph = set_edges(graph, nodes, rng.integers(graph.max_degree, size=3), False)
         elif kind == 3:
             nodes = rng.integers(graph.num_nodes, size=3)
-            graph = open_edges(graph, nodes, rng.integers(graph.max_degree, size=3))
+            graph = set_edges(graph, nodes, rng.integers(graph.max_degree, size=3), True)
         elif kind == 4:
             goal = int(rng.choice(np.nonzero(free)[0]))
             move["goal"] = goal
@@ -95,7 +121,7 @@ def test_repair_touches_less_than_a_fresh_search():
     first = planner.solve()
     assert first.stats.touched > 0 and first.stats.expanded > 0
     on_path = first.nodes()[len(first.nodes()) // 2]
-    edited = block_cells(graph, on_path)
+    edited = set_cells(graph, on_path, False)
     repaired = planner.update(edited)
     check(repaired, edited, 0, 59 * 60 + 59)
     assert 0 < repaired.stats.touched < first.stats.touched
@@ -121,7 +147,7 @@ def test_an_unreachable_goal_becomes_reachable():
     graph = grid_graph(obstacles)
     planner = replanner(graph, (0, 0), (4, 4))
     assert not planner.solve().found
-    opened = unblock_cells(graph, [2 * 5 + 2])
+    opened = set_cells(graph, [2 * 5 + 2], True)
     check(planner.update(opened), opened, 0, 24)
 
 
@@ -130,9 +156,9 @@ def test_bad_updates_are_named():
     graph = grid_graph(obstacles)
     planner = replanner(graph, (0, 0), (3, 3))
     with pytest.raises(ValueError, match="start .* is blocked"):
-        planner.update(block_cells(graph, [0]))
+        planner.update(set_cells(graph, [0], False))
     with pytest.raises(ValueError, match="goal .* is blocked"):
-        planner.update(block_cells(graph, [5]), goal=(1, 1))
+        planner.update(set_cells(graph, [5], False), goal=(1, 1))
     with pytest.raises(ValueError, match="same map"):
         planner.update(grid_graph(np.zeros((4, 5), bool)))
     with pytest.raises(ValueError, match="off the 4x4 map"):

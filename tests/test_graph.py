@@ -1,5 +1,6 @@
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -10,6 +11,13 @@ from jaxswarm.world.lattice import (DIRECTIONS, OPPOSITE, move_lengths, slot_len
                               total_length)
 from jaxswarm.world.relax import lowest_neighbour, relax
 from oracle import grid_adjacency
+
+# The functions under test, jitted: one program per map shape instead of each of their
+# operations applied on its own.
+total = jax.jit(total_length)
+per_move = jax.jit(move_lengths)
+cheapest = jax.jit(lowest_neighbour)
+settle = jax.jit(relax, static_argnames=("update", "max_sweeps", "sweeps_per_check"))
 
 
 def edges_of(graph):
@@ -78,11 +86,11 @@ def test_total_length_does_not_depend_on_the_order_of_the_moves():
     orders = np.stack([moves, rng.permutation(moves), np.sort(moves)])
     slots = np.concatenate([orders, np.full((3, 20), -1)], axis=1).astype(np.int16)
     nodes = np.zeros(slots.shape, np.int32)  # grid lengths do not depend on the node
-    lengths = np.asarray(total_length(graph, nodes, slots))
+    lengths = np.asarray(total(graph, nodes, slots))
     assert lengths[0] == lengths[1] == lengths[2]
     expected = np.sum((moves < 4) * 1.0 + (moves >= 4) * math.sqrt(2))
     assert lengths[0] == pytest.approx(expected, rel=1e-6)
-    np.testing.assert_allclose(np.asarray(move_lengths(graph, nodes, slots)).sum(axis=1), lengths,
+    np.testing.assert_allclose(np.asarray(per_move(graph, nodes, slots)).sum(axis=1), lengths,
                                rtol=1e-6)
 
 
@@ -93,7 +101,7 @@ def test_total_length_on_a_general_graph_sums_the_edge_costs():
     slot = {(u, int(v)): k for u in range(3) for k, v in enumerate(nbr[u]) if v >= 0}
     nodes = np.array([[0, 1, 2, 0]], np.int32)
     slots = np.array([[slot[0, 1], slot[1, 2], slot[2, 0], -1]], np.int16)
-    assert float(total_length(graph, nodes, slots)[0]) == pytest.approx(1.5 + 0.25 + 2.0)
+    assert float(np.asarray(total(graph, nodes, slots))[0]) == pytest.approx(1.5 + 0.25 + 2.0)
     with pytest.raises(ValueError, match="general graph"):
         slot_offsets(graph)
     with pytest.raises(ValueError, match="general graph"):
@@ -138,12 +146,18 @@ def test_lowest_neighbour_is_the_cheapest_valid_edge(make):
     rng = np.random.default_rng(11)
     graph = make(rng)
     values = rng.random(graph.num_nodes).astype(np.float32) * 10
-    lengths = jnp.where(graph.valid_edges(), graph.cost, jnp.inf)
+    lengths = np.where(np.asarray(graph.valid_edges()), np.asarray(graph.cost), np.inf)
     expected = np.full(graph.num_nodes, np.inf)
     for (u, v), length in edges_of(graph).items():
         expected[u] = min(expected[u], values[v] + length)
-    np.testing.assert_allclose(lowest_neighbour(graph, jnp.asarray(values), lengths), expected,
-                               rtol=1e-6)
+    np.testing.assert_allclose(cheapest(graph, values, lengths), expected, rtol=1e-6)
+
+
+def raise_pits(here, lowest):
+    """The update of RFD*'s settling: a node above 1 whose cheapest neighbour is higher rises to
+    it."""
+    pit = (here > 1) & (lowest > here) & jnp.isfinite(lowest)
+    return jnp.where(pit, lowest, here), pit
 
 
 @SMALL_MAPS
@@ -160,7 +174,8 @@ def test_relax_matches_jacobi_sweeps_over_the_edge_list(make, per_check):
     dense = graph.to_dense()
     _, part = csgraph.connected_components(np.isfinite(dense) & (dense > 0), directed=False)
     start[np.unique(part, return_index=True)[1]] = 0.5
-    rise = (jnp.where(graph.valid_edges(), graph.cost, jnp.inf) * 0.25).astype(jnp.float32)
+    rise = (np.where(np.asarray(graph.valid_edges()), np.asarray(graph.cost), np.inf)
+            * 0.25).astype(np.float32)
     edges = edges_of(graph)
 
     def python_sweeps(values, most):
@@ -174,25 +189,19 @@ def test_relax_matches_jacobi_sweeps_over_the_edge_list(make, per_check):
             values = np.where(pit, lowest, values)
         return values, most
 
-    def raise_pits(here, lowest):
-        pit = (here > 1) & (lowest > here) & jnp.isfinite(lowest)
-        return jnp.where(pit, lowest, here), pit
-
     expected, sweeps = python_sweeps(start, 10_000)
     assert sweeps >= 2  # some ground rose
-    settled, ran = relax(graph, jnp.asarray(start), rise, raise_pits, max_sweeps=10_000,
-                         sweeps_per_check=per_check)
+    settled, ran = settle(graph, start, rise, raise_pits, max_sweeps=10_000,
+                          sweeps_per_check=per_check)
     np.testing.assert_allclose(settled, expected, rtol=1e-6)
     raising = sweeps - 1  # the last Python sweep found nothing to raise
     assert int(ran) == (-(-raising // per_check) + 1) * per_check  # stops after a quiet check
-    capped, ran = relax(graph, jnp.asarray(start), rise, raise_pits, max_sweeps=2)
+    capped, ran = settle(graph, start, rise, raise_pits, max_sweeps=2)
     np.testing.assert_allclose(capped, python_sweeps(start, 2)[0], rtol=1e-6)
     assert int(ran) == 2
 
 
 def test_graph_is_a_pytree_with_static_shape():
-    import jax
-
     graph = grid_graph(np.zeros((3, 4), bool))
     leaves, treedef = jax.tree_util.tree_flatten(graph)
     assert len(leaves) == 7

@@ -31,10 +31,44 @@ def nodes(cells, width=6):
     return [y * width + x for x, y in cells]
 
 
+# The operators under test and the walks' edge table, each called from the tests through one
+# jitted wrapper: one program per shape, where called outside jit each of their JAX operations
+# is a program of its own.
+smooth = jax.jit(smooth_path)
+smooth_each = jax.jit(jax.vmap(smooth_path, in_axes=(None, 0)))
+remember_paths = jax.jit(remember)
+intersect_first = jax.jit(first_intersection)
+score = jax.jit(fuzzy.fuzzy_score)
+valid_table = jax.jit(edge_table)
+
+
+@jax.jit
+def intersect_second(graph, a, b, connection):
+    """:func:`closest_inner_pair` ``(i, j)`` of ``a`` and ``b``, and the children of
+    :func:`second_intersection` joined there by ``connection``."""
+    i, j = closest_inner_pair(graph, a, b)
+    return (i, j), second_intersection(graph, a, b, i, j, connection)
+
+
+@jax.jit
+def surgery(a, b, middle):
+    """:func:`join` of ``a``'s first 2 nodes and ``b`` from position 1, :func:`splice` of
+    ``middle`` into ``a`` from position 1 to 3, and :func:`reverse` of ``a``."""
+    return join(a, 2, b, 1), splice(a, 1, 3, middle), reverse(a)
+
+
+@jax.jit
+def sections(graph, paths):
+    """The lengths of each of ``paths`` in 4 sections along x (:func:`fuzzy.section_lengths`)
+    and their scores (:func:`fuzzy.section_scores`, every path present)."""
+    lengths = jax.vmap(lambda path: fuzzy.section_lengths(graph, path, 0, 4))(paths)
+    return lengths, fuzzy.section_scores(lengths, jnp.ones(paths.shape[0], bool))
+
+
 def test_smoothing_shortens_a_staircase_into_a_diagonal():
     graph = open_grid()
     stairs = nodes([(0, 0), (1, 0), (1, 1), (2, 1), (2, 2), (3, 2), (3, 3)])
-    smoothed = trim(smooth_path(graph, jnp.asarray(pad(stairs, L))))
+    smoothed = trim(smooth(graph, pad(stairs, L)))
     assert smoothed.tolist() == nodes([(0, 0), (1, 1), (2, 2), (3, 3)])
 
 
@@ -42,7 +76,7 @@ def test_smoothing_never_cuts_a_corner_or_crosses_a_block():
     graph = open_grid(blocked=[(1, 0)])
     # Around the block (1, 0): the diagonal (0, 0) -> (1, 1) would squeeze past it.
     around = nodes([(0, 0), (0, 1), (1, 1), (2, 1), (2, 0)])
-    smoothed = smooth_path(graph, jnp.asarray(pad(around, L)))
+    smoothed = smooth(graph, pad(around, L))
     assert bool(is_valid_path(graph, smoothed, around[0], around[-1]))
     assert float(path_length(graph, smoothed)) <= float(path_length(graph, pad(around, L)))
     assert 1 not in trim(smoothed).tolist()
@@ -51,7 +85,7 @@ def test_smoothing_never_cuts_a_corner_or_crosses_a_block():
 def test_smoothing_takes_two_straight_moves_for_two_diagonals():
     graph = open_grid()
     bump = nodes([(0, 2), (1, 1), (2, 2)])  # NE then SE: 2.83; E, E is 2
-    smoothed = trim(smooth_path(graph, jnp.asarray(pad(bump, L))))
+    smoothed = trim(smooth(graph, pad(bump, L)))
     assert smoothed.tolist() == nodes([(0, 2), (1, 2), (2, 2)])
 
 
@@ -64,9 +98,10 @@ def test_smoothed_drop_paths_stay_valid_and_never_get_longer():
     obstacles = np.random.default_rng(0).random((side, side)) < 0.25
     obstacles.flat[[0, goal]] = False
     graph = grid_graph(obstacles)
-    walks = walk(jax.random.key(1), graph, edge_table(graph, jnp.zeros(graph.nbr.shape)),
-                 jnp.int32(0), jnp.int32(goal), num_agents=64, max_steps=goal)
-    smoothed = jax.vmap(lambda p: smooth_path(graph, p))(walks.path)
+    table = valid_table(graph, np.zeros(graph.nbr.shape, np.float32))
+    walks = walk(jax.random.key(1), graph, table, np.int32(0), np.int32(goal), num_agents=64,
+                 max_steps=goal)
+    smoothed = smooth_each(graph, walks.path)
     shortened = 0
     for before, after in zip(np.asarray(walks.path), np.asarray(smoothed)):
         ends = trim(before)[[0, -1]]
@@ -86,32 +121,32 @@ def test_iwd_keeps_soil_on_every_edge(swarm_run):
 
 def test_memory_keeps_the_shortest_distinct_paths_best_first():
     memory = empty_memory(3, 6)
-    paths = jnp.asarray([pad([0, 1, 2], 6), pad([0, 3, 2], 6), pad([0, 1, 2], 6),
-                         pad([0, 4, 5, 2], 6)])
-    memory = remember(memory, paths, jnp.asarray([2.0, 2.5, 2.0, 3.0]))
+    paths = np.asarray([pad([0, 1, 2], 6), pad([0, 3, 2], 6), pad([0, 1, 2], 6),
+                        pad([0, 4, 5, 2], 6)])
+    memory = remember_paths(memory, paths, np.float32([2.0, 2.5, 2.0, 3.0]))
     assert np.asarray(memory.costs).tolist() == [2.0, 2.5, 3.0]
     assert [trim(p).tolist() for p in np.asarray(memory.paths)] == [[0, 1, 2], [0, 3, 2],
                                                                     [0, 4, 5, 2]]
-    memory = remember(memory, paths[:1], jnp.asarray([2.0]))  # already remembered
+    memory = remember_paths(memory, paths[:1], np.float32([2.0]))  # already remembered
     assert np.asarray(memory.costs).tolist() == [2.0, 2.5, 3.0]
-    memory = remember(memory, jnp.asarray([pad([0, 2], 6)]), jnp.asarray([1.0]))
+    memory = remember_paths(memory, np.asarray([pad([0, 2], 6)]), np.float32([1.0]))
     assert np.asarray(memory.costs).tolist() == [1.0, 2.0, 2.5]
 
 
 def test_join_splice_and_reverse_by_hand():
-    a, b = jnp.asarray(pad([1, 2, 3, 4], 8)), jnp.asarray(pad([7, 3, 8, 9], 8))
-    assert trim(join(a, 2, b, 1)).tolist() == [1, 2, 3, 8, 9]
-    middle = jnp.asarray(pad([2, 5, 6, 4], 8))
-    assert trim(splice(a, 1, 3, middle)).tolist() == [1, 2, 5, 6, 4]
-    assert trim(reverse(a)).tolist() == [4, 3, 2, 1]
+    a, b, middle = pad([1, 2, 3, 4], 8), pad([7, 3, 8, 9], 8), pad([2, 5, 6, 4], 8)
+    joined, spliced, backwards = surgery(a, b, middle)
+    assert trim(joined).tolist() == [1, 2, 3, 8, 9]
+    assert trim(spliced).tolist() == [1, 2, 5, 6, 4]
+    assert trim(backwards).tolist() == [4, 3, 2, 1]
 
 
 def test_first_intersection_exchanges_tails_at_the_best_shared_node():
     graph = open_grid()
     a = pad(nodes([(0, 0), (1, 0), (2, 0), (3, 1), (4, 2), (5, 3)]), L)  # long way round
     b = pad(nodes([(0, 0), (0, 1), (1, 2), (2, 1), (3, 1), (4, 1), (5, 2), (5, 3)]), L)
-    kids = first_intersection(graph, jnp.asarray(a), jnp.asarray(b))
-    for child, cost in zip(np.asarray(kids.paths), np.asarray(kids.costs)):
+    kids = jax.device_get(intersect_first(graph, a, b))
+    for child, cost in zip(kids.paths, kids.costs):
         assert bool(is_valid_path(graph, child, 0, nodes([(5, 3)])[0]))
         assert cost == pytest.approx(float(path_length(graph, child)))
     # a's head to (3, 1), then b's tail; b's head to (3, 1), then a's tail.
@@ -120,26 +155,24 @@ def test_first_intersection_exchanges_tails_at_the_best_shared_node():
     assert trim(kids.paths[1]).tolist() == nodes([(0, 0), (0, 1), (1, 2), (2, 1), (3, 1),
                                                   (4, 2), (5, 3)])
     apart = pad(nodes([(0, 0), (0, 1), (0, 2), (1, 3), (2, 4), (3, 4), (4, 4), (5, 3)]), L)
-    assert not np.isfinite(np.asarray(first_intersection(graph, jnp.asarray(a),
-                                                         jnp.asarray(apart)).costs)).any()
+    assert not np.isfinite(np.asarray(intersect_first(graph, a, apart).costs)).any()
 
 
 def test_second_intersection_joins_the_closest_inner_nodes():
     graph = open_grid()
-    a = jnp.asarray(pad(nodes([(0, 0), (1, 0), (2, 0), (3, 0), (4, 1), (5, 2)]), L))
-    b = jnp.asarray(pad(nodes([(0, 0), (0, 1), (1, 2), (2, 2), (3, 2), (4, 3), (5, 2)]), L))
-    i, j = closest_inner_pair(graph, a, b)
+    a = pad(nodes([(0, 0), (1, 0), (2, 0), (3, 0), (4, 1), (5, 2)]), L)
+    b = pad(nodes([(0, 0), (0, 1), (1, 2), (2, 2), (3, 2), (4, 3), (5, 2)]), L)
+    connection = pad(nodes([(1, 0), (0, 1)]), L)
+    (i, j), kids = jax.device_get(intersect_second(graph, a, b, connection))
     assert (int(i), int(j)) == (1, 1)  # (1, 0) and (0, 1), one diagonal apart (first in order)
-    connection = jnp.asarray(pad(nodes([(1, 0), (0, 1)]), L))
-    kids = second_intersection(graph, a, b, i, j, connection)
     assert trim(kids.paths[0]).tolist() == nodes([(0, 0), (1, 0), (0, 1), (1, 2), (2, 2), (3, 2),
                                                   (4, 3), (5, 2)])
     assert trim(kids.paths[1]).tolist() == nodes([(0, 0), (0, 1), (1, 0), (2, 0), (3, 0), (4, 1),
                                                   (5, 2)])
-    for child, cost in zip(np.asarray(kids.paths), np.asarray(kids.costs)):
+    for child, cost in zip(kids.paths, kids.costs):
         assert bool(is_valid_path(graph, child, 0, nodes([(5, 2)])[0]))
         assert cost == pytest.approx(float(path_length(graph, child)))
-    nothing = second_intersection(graph, a, b, i, j, jnp.full((L,), -1))
+    _, nothing = intersect_second(graph, a, b, np.full((L,), -1, np.int32))
     assert not np.isfinite(np.asarray(nothing.costs)).any()
 
 
@@ -166,21 +199,18 @@ def test_fuzzy_score_of_a_fixed_example_by_hand():
     shape = [max(min(strength[name], hand_membership(p)[k])
                  for k, name in enumerate(("low", "medium", "high"))) for p in points]
     want = float(np.dot(shape, points) / np.sum(shape))
-    assert float(fuzzy.fuzzy_score(jnp.float32(spl), jnp.float32(ospl))) == pytest.approx(
-        want, rel=1e-5)
+    assert float(score(np.float32(spl), np.float32(ospl))) == pytest.approx(want, rel=1e-5)
 
 
 def test_section_lengths_and_scores_of_three_paths():
     graph = open_grid()
     straight = pad(nodes([(x, 0) for x in range(6)]), L)  # along row 0: moves in every section
-    lengths = np.asarray(fuzzy.section_lengths(graph, jnp.asarray(straight), 0, 4))
-    assert lengths.sum() == pytest.approx(5.0) and (lengths > 0).all()
-    paths = jnp.asarray([straight,
-                         pad(nodes([(0, 0), (1, 1), (2, 2), (3, 1), (4, 1), (5, 0)]), L),
-                         pad(nodes([(0, 0), (0, 1), (0, 2), (0, 3), (1, 3), (2, 3), (3, 3),
-                                    (4, 3), (5, 3), (5, 2), (5, 1), (5, 0)]), L)])
-    all_lengths = jax.vmap(lambda p: fuzzy.section_lengths(graph, p, 0, 4))(paths)
-    scores = np.asarray(fuzzy.section_scores(all_lengths, jnp.ones(3, bool)))
+    paths = np.asarray([straight,
+                        pad(nodes([(0, 0), (1, 1), (2, 2), (3, 1), (4, 1), (5, 0)]), L),
+                        pad(nodes([(0, 0), (0, 1), (0, 2), (0, 3), (1, 3), (2, 3), (3, 3),
+                                   (4, 3), (5, 3), (5, 2), (5, 1), (5, 0)]), L)])
+    lengths, scores = jax.device_get(sections(graph, paths))
+    assert lengths[0].sum() == pytest.approx(5.0) and (lengths[0] > 0).all()
     assert ((scores >= 0) & (scores <= 1)).all()
     # The straight path is shortest everywhere: best in every section; the long detour worst.
     assert (scores[0] >= scores[1] - 1e-6).all() and (scores[1] >= scores[2] - 1e-6).all()

@@ -22,15 +22,32 @@ OPEN = grid_graph(np.zeros((SIDE, SIDE), bool))
 AGENTS, STEPS = 64, SIDE * SIDE - 1
 """The walkers of the tests' walks and logs, and their step budget: the sizes of
 ``test_walk.py``'s walks, so that a walk with the default room is one program for both files."""
+WIDTHS = (BLOCK - 1, 40, STEPS)
+"""The moves :func:`read` cuts a log's paths to: within one block, across blocks, the budget."""
 
 
 def _walk(log_moves):
     """AGENTS uniform walkers on OPEN for STEPS steps, their log with room for ``log_moves``
     moves an agent (one program a room); start and goal as i32[] (Python ints are weakly typed:
     a program of their own), the table as f32 (two Python floats would make it weakly typed)."""
-    table = jnp.where(OPEN.nbr >= 0, jnp.float32(0.0), -jnp.inf)
-    return walk(jax.random.key(0), OPEN, table, jnp.int32(0), jnp.int32(5 * SIDE + 5),
+    table = np.where(np.asarray(OPEN.nbr) >= 0, np.float32(0.0), np.float32(-np.inf))
+    return walk(jax.random.key(0), OPEN, table, np.int32(0), np.int32(5 * SIDE + 5),
                 num_agents=AGENTS, max_steps=STEPS, log_moves=log_moves)
+
+
+# The log's readers in a program each, shared by the tests: applied outside jit, each of their
+# operations is a program of its own (from_rows and all_same are a dozen, a read dozens).
+rows_log = jax.jit(from_rows, static_argnames="max_steps")
+same_moves = jax.jit(all_same)
+
+
+@jax.jit
+def read(log, picked, agents):
+    """``(cuts, (nodes, slots), agent_paths)``: :func:`paths` of ``log`` cut to each of
+    WIDTHS, its :func:`columns` ``picked`` (i32[AGENTS, k]) and the whole :func:`agent_path` of
+    each of ``agents`` (i32[n])."""
+    cuts = [paths(log, width) for width in WIDTHS]
+    return cuts, columns(log, picked), [agent_path(log, a, STEPS + 1) for a in agents]
 
 
 def test_a_log_without_room_says_so_and_its_size_changes_no_move():
@@ -59,25 +76,25 @@ def test_reading_the_log_gives_the_padded_rows_it_was_made_of():
         assert (slots[a, :moves[a]] >= 0).all() and (slots[a, moves[a]:] == -1).all()
     assert (path[:, 0] == 0).all()
     # The same rows through from_rows (another layout: a fixed stride per agent).
-    strided = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves), 0, STEPS)
+    strided = rows_log(path, slots, moves, np.int32(0), STEPS)
+    picked = np.random.default_rng(0).integers(-2, STEPS + 4, (AGENTS, 7)).astype(np.int32)
+    agents = np.array([0, 5, 11, AGENTS - 1], np.int32)
     for log in (walked.log, strided):
-        for width in (BLOCK - 1, 40, STEPS):
-            cut_path, cut_slots = paths(log, width)
+        cuts, (nodes, slot), agent_paths = jax.device_get(read(log, picked, agents))
+        for width, (cut_path, cut_slots) in zip(WIDTHS, cuts):
             np.testing.assert_array_equal(cut_path, path[:, :width + 1])
             np.testing.assert_array_equal(cut_slots, slots[:, :width])
-        picked = np.random.default_rng(0).integers(-2, STEPS + 4, (AGENTS, 7))
-        nodes, slot = columns(log, jnp.asarray(picked))
         padded_path = np.pad(path, ((0, 0), (0, 10)), constant_values=-1)
         padded_slots = np.pad(slots, ((0, 0), (0, 10)), constant_values=-1)
         inside = picked >= 0
-        np.testing.assert_array_equal(np.asarray(nodes)[inside],
+        np.testing.assert_array_equal(nodes[inside],
                                       np.take_along_axis(padded_path, picked, 1)[inside])
-        np.testing.assert_array_equal(np.asarray(slot)[inside],
+        np.testing.assert_array_equal(slot[inside],
                                       np.take_along_axis(padded_slots, picked, 1)[inside])
-        assert (np.asarray(nodes)[~inside] == -1).all()
-        for a in (0, 5, 11, AGENTS - 1):
-            np.testing.assert_array_equal(agent_path(log, jnp.int32(a), STEPS + 1), path[a])
-        assert not bool(all_same(log))
+        assert (nodes[~inside] == -1).all()
+        for a, agent_row in zip(agents, agent_paths):
+            np.testing.assert_array_equal(agent_row, path[a])
+        assert not bool(same_moves(log))
 
 
 def test_all_same_sees_one_different_move_anywhere():
@@ -87,8 +104,7 @@ def test_all_same_sees_one_different_move_anywhere():
     moves = np.full(AGENTS, 40, np.int32)
 
     def same(path, slots, moves):
-        return bool(all_same(from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves),
-                                       0, STEPS)))
+        return bool(same_moves(rows_log(path, slots, moves, np.int32(0), STEPS)))
 
     assert same(path, slots, moves)
     for agent, move in [(0, 0), (3, 17), (4, 39), (AGENTS - 1, 39)]:
@@ -114,7 +130,7 @@ def test_a_large_walks_log_does_not_grow_with_a_longer_possible_path():
     assert room_blocks(8, 600, BLOCK, budget) == 8  # a room asked for is the room given
 
     def own_bytes(max_steps):
-        compiled = walk.lower(jax.random.key(0), graph, table, jnp.int32(0), jnp.int32(1023),
+        compiled = walk.lower(jax.random.key(0), graph, table, np.int32(0), np.int32(1023),
                               num_agents=4096, max_steps=max_steps).compile()
         analysis = compiled.memory_analysis()
         return analysis.output_size_in_bytes + analysis.temp_size_in_bytes

@@ -18,6 +18,11 @@ def width_and_sum(moves, run, shared):
             ordered_cumsum(values, axis=1)[:, -1])
 
 
+whole = jax.jit(width_and_sum)
+"""width_and_sum on a run's whole columns in one program: the bits a cut must give (applied
+outside jit, ordered_sum and ordered_cumsum are dozens of operations of a program each)."""
+
+
 def walk_columns(moves, columns=1023, agents=4, seed=0):
     """f32[agents, columns] values, zero past each agent's ``moves``."""
     values = np.random.default_rng(seed).random((agents, columns)).astype(np.float32)
@@ -57,7 +62,7 @@ def test_one_walk_gets_the_narrowest_width_that_holds_its_moves_and_the_same_bit
     values = walk_columns(moves)
     width, total, running = cut_sum(moves, values, jnp.float32(2.0), jnp.float32(3.0))
     assert int(width) == 128
-    full = width_and_sum((values,), np.float32(2.0), np.float32(3.0))
+    full = whole((values,), np.float32(2.0), np.float32(3.0))
     np.testing.assert_array_equal(total, full[1])
     np.testing.assert_array_equal(running, full[2])
 
@@ -76,12 +81,13 @@ def test_agents_not_used_do_not_widen_the_cut():
 
 
 def test_a_batch_shares_one_width_at_any_nesting():
-    moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1], [1, 1, 1, 1]], jnp.int32)
-    values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])
-    runs = jnp.array([1.0, 2.0, 3.0])
-    (width, total, _), nested, _ = batches(moves, values, runs, jnp.ones(3))
+    moves = np.array([[3, 5, 0, 1], [3, 300, 2, 1], [1, 1, 1, 1]], np.int32)
+    values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(moves)])
+    runs = np.array([1.0, 2.0, 3.0], np.float32)
+    (width, total, _), nested, _ = jax.device_get(batches(moves, values, runs,
+                                                          np.ones(3, np.float32)))
     np.testing.assert_array_equal(width, [512, 512, 512])
-    alone = [cut_sum(m, v, r, jnp.float32(1.0)) for m, v, r in zip(moves, values, runs)]
+    alone = [cut_sum(m, v, r, np.float32(1.0)) for m, v, r in zip(moves, values, runs)]
     assert [int(a[0]) for a in alone] == [128, 512, 128]
     np.testing.assert_array_equal(total, np.stack([a[1] for a in alone]))
     np.testing.assert_array_equal(nested[0], np.full((3, 1), 512))
@@ -89,12 +95,12 @@ def test_a_batch_shares_one_width_at_any_nesting():
 
 
 def test_a_batched_shared_input_lets_each_run_pick_its_own_width():
-    moves = jnp.array([[3, 5, 0, 1], [3, 300, 2, 1], [700, 1, 0, 1]], jnp.int32)
-    values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(np.asarray(moves))])
-    shared = jnp.array([1.0, 2.0, 3.0])
-    width, total, _ = batches(moves, values, jnp.ones(3), shared)[2]
+    moves = np.array([[3, 5, 0, 1], [3, 300, 2, 1], [700, 1, 0, 1]], np.int32)
+    values = np.stack([walk_columns(m, seed=i) for i, m in enumerate(moves)])
+    shared = np.array([1.0, 2.0, 3.0], np.float32)
+    width, total, _ = batches(moves, values, np.ones(3, np.float32), shared)[2]
     np.testing.assert_array_equal(width, [128, 512, 1023])
-    want = np.asarray(shared)[:, None] * values.astype(np.float64).sum(2)
+    want = shared[:, None] * values.astype(np.float64).sum(2)
     np.testing.assert_allclose(total, want, rtol=1e-5)
 
 
@@ -104,7 +110,7 @@ def test_no_moves_and_a_whole_budget(moves):
     width, total, _ = cut_sum(jnp.array(moves, jnp.int32), values, jnp.float32(1.0),
                               jnp.float32(1.0))
     assert int(width) == (128 if max(moves) == 0 else 1023)
-    np.testing.assert_array_equal(total, ordered_sum(values, axis=1))
+    np.testing.assert_array_equal(total, whole((values,), np.float32(1.0), np.float32(1.0))[1])
 
 
 def weighted_sum(moves, run, shared):
@@ -122,10 +128,14 @@ def test_it_runs_inside_a_vmapped_cond_with_constants():
                 + on_moves(weighted_sum, moves, (values,), jnp.float32(1.0), jnp.float32(2.0)))
 
     values = np.stack([walk_columns([3, 9, 0, 1], seed=i) for i in range(3)])
-    got = jax.jit(jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(4), v)))(
-        values, jnp.array([True, False, True]))
+    batched = jax.jit(jax.vmap(lambda v, p: jax.lax.cond(p, branch, lambda v: jnp.zeros(4), v)))
+    got = np.asarray(batched(values, np.array([True, False, True])))
     np.testing.assert_array_equal(got[1], np.zeros(4))
     np.testing.assert_array_equal(got[2], branch(values[2]))
+
+
+rows_log = jax.jit(from_rows, static_argnames="max_steps")
+"""from_rows in one program (applied outside jit, a dozen operations of a program each)."""
 
 
 def random_log(moves, max_steps=1023, nodes=50, seed=0):
@@ -137,8 +147,7 @@ def random_log(moves, max_steps=1023, nodes=50, seed=0):
     slots = np.where(made, rng.integers(0, 8, (agents, width)), -1).astype(np.int8)
     path = np.concatenate([np.full((agents, 1), 7), np.where(
         made, rng.integers(0, nodes, (agents, width)), -1)], axis=1).astype(np.int32)
-    log = from_rows(jnp.asarray(path), jnp.asarray(slots), jnp.asarray(moves, jnp.int32), 7,
-                    max_steps)
+    log = rows_log(path, slots, np.asarray(moves, np.int32), np.int32(7), max_steps)
     return log, path, slots
 
 
@@ -198,9 +207,9 @@ def test_a_batch_of_folds_equals_each_run_alone_at_any_nesting():
     # Runs with 3, 0 and 5 used agents: the batch steps to the most, the others unchanged.
     moves = [[3, 5, 0, 1, 9], [3, 300, 2, 1, 4], [1, 1, 600, 1, 2]]
     logs = [random_log(m, seed=i) for i, m in enumerate(moves)]
-    log = jax.tree_util.tree_map(lambda *x: jnp.stack(x), *[entry[0] for entry in logs])
-    used = jnp.array([[1, 0, 1, 0, 1], [0] * 5, [1, 1, 0, 1, 1]], bool)
-    runs = jnp.array([1, 2, 3], jnp.int32)
+    log = jax.tree_util.tree_map(lambda *x: np.stack(x), *[entry[0] for entry in logs])
+    used = np.array([[1, 0, 1, 0, 1], [0] * 5, [1, 1, 0, 1, 1]], bool)
+    runs = np.array([1, 2, 3], np.int32)
 
     @jax.jit
     def fold_batches(log, used, runs):
@@ -212,12 +221,12 @@ def test_a_batch_of_folds_equals_each_run_alone_at_any_nesting():
             jax.tree_util.tree_map(lambda x: x[:, None], log), used[:, None], runs, four)
         return flat, nested, jax.vmap(fold)(log, used, runs, jnp.full(3, four))
 
-    batch, nested, shared = fold_batches(log, used, runs)
+    batch, nested, shared = jax.device_get(fold_batches(log, used, runs))
     for r, (_, path, slots) in enumerate(logs):
         alone = fold(jax.tree_util.tree_map(lambda x: x[r], log), used[r], runs[r], jnp.int32(4))
         for got, want in zip(batch, alone):
             np.testing.assert_array_equal(got[r], want)
-        want_turn, want_sums = expected_record(path, slots, np.asarray(used[r]), r + 1, 4)
+        want_turn, want_sums = expected_record(path, slots, used[r], r + 1, 4)
         np.testing.assert_array_equal(batch[1][r], want_turn)
         np.testing.assert_array_equal(batch[2][r], want_sums)
     np.testing.assert_array_equal(batch[3], [128, 0, 128])  # no run's used agent made 600 moves

@@ -4,6 +4,7 @@ import sys
 
 import jax
 import pytest
+import sizes
 from conformance import maze  # noqa: F401 (fixture)
 
 from jaxswarm.runtime import programs
@@ -16,10 +17,11 @@ linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's
 def test_a_compiled_program_holds_mappings_that_a_release_gives_back(maze):
     graph, task, _ = maze
     before = programs.mapped_regions()
-    # A swarm's run program, of an agent count no other test compiles.
-    swarm = make("aco_star", num_agents=3)
+    # A swarm's run at the shared size: compiled, or loaded from the persistent cache, it is
+    # new to this process (the compile ledger forgets programs between test files).
+    swarm = make("aco_star", **sizes.CONFIG)
     jax.block_until_ready(run(swarm, jax.random.key(0), graph, task, swarm.default_params,
-                              iterations=2))
+                              iterations=sizes.ITERATIONS))
     held = programs.mapped_regions()
     added = held - before
     assert added > 200  # hundreds a program (threads and allocators move a few dozen)

@@ -2,11 +2,11 @@
 that it never walks through a block, reaches the goal, never beats the full-knowledge optimum,
 batches under vmap, and names bad worlds."""
 import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.dynamic.events import apply_event, change, check_events, make_event
+from jaxswarm.dynamic import events
+from jaxswarm.dynamic.events import apply_event, check_events, make_event
 from jaxswarm.dynamic.robot import (check_world, dstar_robot, hidden_blocks, swarm_robot, walk_plan)
 from jaxswarm.exact import astar
 from jaxswarm.maps.paper import paper_map
@@ -20,6 +20,9 @@ SQRT2 = float(np.sqrt(2))
 SIDE = 5
 """The side of the maps walked here: the detour world's, so that every walk of a plan (a plan of
 ``SIDE ** 2`` nodes, as D* Lite's) is one program."""
+change = jax.jit(events.change, static_argnums=0)
+"""A change and a swarm's memory rule as one program (outside jit each of their operations would
+be a program of its own)."""
 
 
 def free_grid(height, width):
@@ -69,7 +72,7 @@ def test_a_hidden_thin_wall_is_seen_as_a_closed_passage():
     hidden = make_event(graph, close=[((1, 0), (2, 0))])
     task = make_task(graph, 0, 2)
     world = apply_event(hidden, graph, task)[0]
-    assert bool(graph.valid_edges()[1, 0]) and not bool(world.valid_edges()[1, 0])
+    assert np.asarray(graph.valid_edges())[1, 0] and not np.asarray(world.valid_edges())[1, 0]
     leg = walk_plan(world, graph, plan(0, 1, 2))
     assert int(leg.stop) == 1 and np.asarray(leg.seen.close).tolist() == [[1, 0]]
     assert np.all(np.asarray(leg.seen.block) == -1)
@@ -120,6 +123,7 @@ def test_swarm_robot_reaches_the_goal_without_crossing_a_block(name, memory):
     swarm = make(name, num_agents=32)
     walk = swarm_robot(swarm, jax.random.key(1), known, make_task(known, start, goal), hidden,
                        swarm.default_params, iterations=40, patience=10, memory=memory)
+    walk = jax.device_get(walk)  # read on the host
     assert bool(walk.reached) and int(walk.plans) >= 2
     robot_invariants(known, start, goal, hidden, walk)
     assert int(walk.iterations) > 0 and int(walk.moves) > 0
@@ -148,7 +152,7 @@ def test_improved_first_ant_walks_again_from_the_new_start():
     task = make_task(known, start, goal)
     params = swarm.default_params
     state = swarm.init(jax.random.key(0), known, task, params)
-    state = state.__class__(key=state.key, pheromone=state.pheromone * 3.0,
+    state = state.__class__(key=state.key, pheromone=np.asarray(state.pheromone) * 3.0,
                             best_path=state.best_path, best_cost=state.best_cost)
     moved = make_event(known, start=(1, 2), block=[(2, 3)])
     after_state, after, new_task = change(swarm, state, moved, known, task, params)
@@ -173,8 +177,8 @@ def test_vmap_over_keys_maps_and_hidden_blocks_equals_a_loop():
         return swarm_robot(swarm, key, known, task, hidden, swarm.default_params,
                            iterations=10, patience=5, max_plans=4)
 
-    stacked = jax.tree_util.tree_map(lambda *x: jnp.stack(x), *worlds)
-    batch = jax.vmap(one)(keys, *stacked)
+    stacked = jax.tree_util.tree_map(lambda *x: np.stack(x), *worlds)
+    batch = jax.device_get(jax.vmap(one)(keys, *stacked))  # read on the host
     for i, (known, task, hidden) in enumerate(worlds):
         single = one(keys[i], known, task, hidden)
         for got, want in zip(jax.tree_util.tree_leaves(batch), jax.tree_util.tree_leaves(single)):
@@ -216,10 +220,10 @@ def test_bad_worlds_are_named():
 
 def test_passage_events_are_checked():
     graph = free_grid(3, 3)
-    task = Task(start=jnp.int32(0), goal=jnp.int32(8))
+    task = Task(start=np.int32(0), goal=np.int32(8))
     with pytest.raises(ValueError, match=r"close: cells \(0, 0\) and \(2, 2\) are not neighbours"):
         make_event(graph, close=[((0, 0), (2, 2))])
-    assert int(graph.nbr[0, 7]) == -1  # no neighbour up-left of the corner cell
-    bad = make_event(graph, close=[(0, 1)])._replace(close=jnp.array([[0, 7]], jnp.int32))
+    assert np.asarray(graph.nbr)[0, 7] == -1  # no neighbour up-left of the corner cell
+    bad = make_event(graph, close=[(0, 1)])._replace(close=np.array([[0, 7]], np.int32))
     with pytest.raises(ValueError, match=r"close passage \(node 0, slot 7\) is not an edge"):
         check_events(graph, task, bad)

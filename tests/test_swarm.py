@@ -13,7 +13,7 @@ from conformance import maze  # noqa: F401 (fixture)
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.swarm import Swarm, make, make_task, run
+from jaxswarm.swarm import Swarm, make, make_task, rfd, run
 from jaxswarm.swarm.core import StepInfo, keep_best
 from jaxswarm.swarm.testing import (Compilations, batched_params, check_reproducible,
                                      check_valid_results, run_batch)
@@ -24,6 +24,14 @@ from jaxswarm.world.paths import Solution
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
+
+# The rules the tests apply outside a run, each one program that the tests share: applied
+# outside jit, each of their operations is a program of its own (a transition table is dozens,
+# from_rows a dozen), and each of their loops one.
+graded_transition = jax.jit(rfd.graded_transition)
+settle = jax.jit(rfd.settle)
+erode_banks = jax.jit(rfd.erode_banks)
+rows_log = jax.jit(from_rows, static_argnames="max_steps")
 
 
 @pytest.mark.slow  # about 25 s
@@ -68,8 +76,10 @@ def iterate(swarm, graph, task, params, state=None, budget=1, seed=0):
 
 def fresh_altitudes(graph, task, params):
     """A river swarm's altitudes in fresh memory, as its ``init`` sets them (without a program):
-    ``initial_height``, the goal at 0."""
-    return jnp.full((graph.num_nodes,), params.initial_height).at[task.goal].set(0.0)
+    ``initial_height``, the goal at 0 (f32[N], NumPy)."""
+    altitude = np.full(graph.num_nodes, float(params.initial_height), np.float32)
+    altitude[int(task.goal)] = 0.0
+    return altitude
 
 
 @pytest.mark.parametrize("law", ["linear", "exponential"])
@@ -95,7 +105,7 @@ def one_iteration(swarm, graph, task, state=None, **params):
     fresh memory or from ``state``, in which every drop arrived."""
     params = swarm.default_params._replace(**{k: jnp.float32(v) for k, v in params.items()})
     state, trace = iterate(swarm, graph, task, params, state)
-    assert float(trace.arrived[0]) == 1.0
+    assert np.asarray(trace.arrived)[0] == 1.0
     return state
 
 
@@ -151,33 +161,46 @@ def test_graded_carving_drains_into_a_river_without_arriving():
     params = swarm.default_params._replace(erosion=jnp.float32(0.5))
     plateau = float(params.initial_height)
     state = swarm.init(jax.random.key(0), graph, task, params)
-    state = dataclasses.replace(state, altitude=jnp.array([plateau] * 2 + [1.5, 1.0, 0.5, 0.0]))
+    state = dataclasses.replace(state, altitude=np.array([plateau] * 2 + [1.5, 1.0, 0.5, 0.0],
+                                                         np.float32))
     state, trace = iterate(swarm, graph, task, params, state)
-    assert float(trace.arrived[0]) == 0.0
+    assert np.asarray(trace.arrived)[0] == 0.0
     np.testing.assert_allclose(state.altitude, [2.5, 2.0, 1.5, 1.0, 0.5, 0.0])
+
+
+WALK_NODES = 10
+"""The nodes of a fake walk's path, -1 padded: one shape for every fake walk (the longest has 8
+cells), so one program of :func:`blind_alleys` for all of them."""
 
 
 def fake_walk(graph, cells, stuck=True):
     """A one-drop Walk along ``cells`` ((x, y) pairs) that stopped at the last one."""
     width = graph.shape[1]
     nodes = [y * width + x for x, y in cells]
-    path = np.full((1, len(nodes) + 2), -1, np.int32)
+    path = np.full((1, WALK_NODES), -1, np.int32)
     path[0, :len(nodes)] = nodes
     visited = np.zeros((1, (graph.num_nodes + 31) // 32), np.uint32)
     for node in nodes:
         visited[0, node // 32] |= np.uint32(1 << (node % 32))
-    log = from_rows(jnp.asarray(path), jnp.full((1, path.shape[1] - 1), -1, jnp.int16),
-                    jnp.array([len(nodes) - 1]), nodes[0], path.shape[1] - 1)
-    return Walk(log=log, length=jnp.zeros(1), arrived=jnp.zeros(1, bool), stuck=jnp.array([stuck]),
-                position=jnp.array([nodes[-1]]), visited=jnp.asarray(visited),
-                moves=jnp.array([len(nodes) - 1]), lane_steps=jnp.int32(len(nodes) - 1))
+    moves = np.array([len(nodes) - 1], np.int32)
+    log = rows_log(path, np.full((1, WALK_NODES - 1), -1, np.int16), moves, np.int32(nodes[0]),
+                   WALK_NODES - 1)
+    return Walk(log=log, length=np.zeros(1, np.float32), arrived=np.zeros(1, bool),
+                stuck=np.array([stuck]), position=np.array([nodes[-1]], np.int32),
+                visited=visited, moves=moves, lane_steps=np.int32(len(nodes) - 1))
+
+
+@jax.jit
+def blind_alleys(graph, task, altitude, walk_, params):
+    """bool[N]: :func:`rfd.blind_alleys` of ``walk_`` on rfd_graded's table for ``altitude``,
+    in one program."""
+    return rfd.blind_alleys(graph, rfd.graded_transition(graph, task, altitude, params), walk_)
 
 
 def filled_cells(graph, task, walk_):
-    from jaxswarm.swarm import rfd
     params = make("rfd_graded").default_params
-    table = rfd.graded_transition(graph, task, fresh_altitudes(graph, task, params), params)
-    filled = np.flatnonzero(np.asarray(rfd.blind_alleys(graph, table, walk_)))
+    filled = np.flatnonzero(np.asarray(blind_alleys(
+        graph, task, fresh_altitudes(graph, task, params), walk_, params)))
     return sorted((int(v) % graph.shape[1], int(v) // graph.shape[1]) for v in filled)
 
 
@@ -203,13 +226,12 @@ def test_a_drop_trapped_by_its_own_trail_fills_only_where_it_stopped():
 
 
 def test_graded_gradients_between_bed_and_plateau_are_clipped():
-    from jaxswarm.swarm import rfd
     graph = grid_graph(np.zeros((2, 3), bool))  # nodes 0 1 2 / 3 4 5, goal 2
     task = make_task(graph, (0, 0), (2, 0))
     params = make("rfd_graded").default_params
     plateau = float(params.initial_height)
-    altitude = jnp.array([2.0, 1.0, 0.0, plateau, plateau + 5, plateau], jnp.float32)
-    table = np.asarray(rfd.graded_transition(graph, task, altitude, params))
+    altitude = np.array([2.0, 1.0, 0.0, plateau, plateau + 5, plateau], np.float32)
+    table = np.asarray(graded_transition(graph, task, altitude, params))
     nbr = np.asarray(graph.nbr)
     log_p, alpha = math.log(float(params.p_base)), float(params.alpha)
 
@@ -242,16 +264,15 @@ def strip(free_cells: int, altitudes):
     obstacles[0, :free_cells] = False
     altitude = np.full(STRIP, 100.0, np.float32)
     altitude[:len(altitudes)] = altitudes
-    return grid_graph(obstacles), jnp.asarray(altitude)
+    return grid_graph(obstacles), altitude
 
 
 def test_settling_leaves_no_filled_pit():
-    from jaxswarm.swarm import rfd
     # A corridor (0, 0)..(5, 0), and (6, 0) joined to (5, 0) only.
     graph, altitude = strip(7, [101.0, 100.5, 101.0, 100.0, 99.0, 0.0, 102.0])
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
-    settled = np.asarray(rfd.settle(graph, altitude, params))[:7]
+    settled = np.asarray(settle(graph, altitude, params))[:7]
     # (1, 0) is a pit between two 101s: raised to 101.25, which makes (0, 0) a pit in turn.
     # (2, 0) drains to the unfilled (3, 0); unfilled and carved nodes and (6, 0), which drains
     # into the bed at (5, 0), keep their altitude.
@@ -259,30 +280,27 @@ def test_settling_leaves_no_filled_pit():
     # A filled node without any edge has nowhere to settle to and keeps its altitude.
     alone = np.ones((1, STRIP), bool)
     alone[0, 1] = False
-    lone = np.asarray(rfd.settle(grid_graph(alone), jnp.full((STRIP,), 101.0, jnp.float32),
-                                 params))
+    lone = np.asarray(settle(grid_graph(alone), np.full(STRIP, 101.0, np.float32), params))
     assert lone[1] == 101.0
 
 
 def test_sediment_settles_all_the_way_in_one_call():
     # Filled ground (101) along a 200-cell corridor drains only through its east end (100): it
     # settles to a slope of repose down to there, which takes about 200 sweeps.
-    from jaxswarm.swarm import rfd
     graph, altitude = strip(STRIP, [101.0] * (STRIP - 1))
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        repose=jnp.float32(0.25))
-    settled = np.asarray(rfd.settle(graph, altitude, params))
+    settled = np.asarray(settle(graph, altitude, params))
     np.testing.assert_allclose(settled[:199], 101.0 + 0.25 * (198 - np.arange(199)))
     assert settled[199] == 100.0
 
 
 def test_a_drop_erodes_the_banks_it_visits():
-    from jaxswarm.swarm import rfd
     graph, altitude = strip(5, [100.0, 7.0, 9.0, 0.5, 0.0])
     params = make("rfd_graded").default_params._replace(initial_height=jnp.float32(100.0),
                                                        erosion=jnp.float32(1.0))
-    visited = jnp.arange(STRIP) < 3
-    eroded = np.asarray(rfd.erode_banks(graph, altitude, visited, params))
+    visited = np.arange(STRIP) < 3
+    eroded = np.asarray(erode_banks(graph, altitude, visited, params))
     # (2, 0) sees the bed at (3, 0): 0.5 + 1. (1, 0) looks once, at the old 9 and the uncarved
     # plateau, and keeps its 7; the plateau nodes and the unvisited nodes are left alone.
     np.testing.assert_allclose(eroded[:5], [100.0, 7.0, 1.5, 0.5, 0.0])
@@ -299,7 +317,7 @@ def test_ground_explored_in_vain_rises_towards_the_frontier():
                                            sediment=jnp.float32(0.5), repose=jnp.float32(0.25))
     state = swarm.init(jax.random.key(0), graph, task, params)
     state, trace = iterate(swarm, graph, task, params, state)
-    assert float(trace.arrived[0]) == 0.0
+    assert np.asarray(trace.arrived)[0] == 0.0
     np.testing.assert_allclose(state.altitude, [101.0, 100.75, 100.5, 100.0, 100.0, 0.0])
 
 
@@ -313,7 +331,7 @@ def test_with_exact_altitudes_the_greedy_drop_walks_a_shortest_path():
     optimum = dijkstra(graph, chosen.start, chosen.goal).cost
     swarm = make("rfd_graded", num_agents=4, greedy_drops=1)
     params = swarm.default_params
-    field = distance_field(graph, task.goal) * params.erosion
+    field = np.asarray(distance_field(graph, task.goal)) * np.asarray(params.erosion)
     state = swarm.init(jax.random.key(0), graph, task, params)
     for seed in range(3):
         state = dataclasses.replace(state, altitude=field, key=jax.random.key(seed))
@@ -398,25 +416,29 @@ def test_a_run_stops_when_every_agent_followed_the_same_path(name, corridor):
     graph, task = corridor
     swarm = make(name, **SMALL)
     _, trace = iterate(swarm, graph, task, swarm.default_params, budget=ITERATIONS)
-    assert int(trace.iterations) == 1 and float(trace.arrived[0]) == 1.0
+    assert int(trace.iterations) == 1 and np.asarray(trace.arrived)[0] == 1.0
 
 
 def test_keep_best_calls_an_iteration_converged_only_on_one_path_of_all_agents():
-    def walked(paths, arrived):
-        paths = jnp.asarray(paths, jnp.int32)
+    @jax.jit
+    def kept(paths, arrived, best_path, best_cost):
+        """keep_best after a walk along ``paths`` (i32[A, L], -1 padded) in which ``arrived``
+        (bool[A]) arrived, in one program (applied outside jit, dozens of operations and a
+        program of its branch)."""
         moves = jnp.sum(paths >= 0, axis=1) - 1
         slots = jnp.where(paths[:, 1:] >= 0, paths[:, 1:], -1).astype(jnp.int16)  # one per node
-        return Walk(log=from_rows(paths, slots, moves, paths[0, 0], paths.shape[1] - 1),
-                    length=jnp.sum(paths >= 0, axis=1).astype(jnp.float32) - 1,
-                    arrived=jnp.asarray(arrived), stuck=~jnp.asarray(arrived),
-                    position=paths[:, -1], visited=jnp.zeros((len(paths), 1), jnp.uint32),
-                    moves=moves, lane_steps=jnp.int32(paths.size))
+        walk_ = Walk(log=from_rows(paths, slots, moves, paths[0, 0], paths.shape[1] - 1),
+                     length=jnp.sum(paths >= 0, axis=1).astype(jnp.float32) - 1,
+                     arrived=arrived, stuck=~arrived, position=paths[:, -1],
+                     visited=jnp.zeros((len(paths), 1), jnp.uint32), moves=moves,
+                     lane_steps=jnp.int32(paths.size))
+        return keep_best(walk_, best_path, best_cost)
 
-    best_path, best_cost = jnp.full((3,), -1, jnp.int32), jnp.float32(jnp.inf)
+    best_path, best_cost = np.full(3, -1, np.int32), np.float32(np.inf)
     same, other = [[0, 1, 2]] * 3, [[0, 1, 2], [0, 3, 2], [0, 1, 2]]
     for paths, arrived, converged in [(same, [True] * 3, True), (other, [True] * 3, False),
                                       (same, [True, False, True], False)]:
-        _, cost, info = keep_best(walked(paths, arrived), best_path, best_cost)
+        _, cost, info = kept(np.array(paths, np.int32), np.array(arrived), best_path, best_cost)
         assert bool(info.converged) == converged and float(cost) == 2.0
 
 
@@ -433,7 +455,7 @@ def test_patience_counts_iterations_without_gain_since_the_first_path(first_path
     state, trace = run(LATE, jax.random.key(0), graph, make_task(graph, (0, 0), (1, 1)), schedule,
                        iterations=40, patience=5)
     assert int(trace.iterations) == stops_after
-    assert float(trace.best_cost[stops_after - 1]) == 100.0 - len(improvements)
+    assert np.asarray(trace.best_cost)[stops_after - 1] == 100.0 - len(improvements)
 
 
 def test_a_patience_that_cannot_stop_a_run_is_none_and_shares_its_program():

@@ -109,7 +109,7 @@ def test_bad_specs_name_the_key(changes, message):
         spec_from_dict(tiny(**changes), source="study.toml")
 
 
-def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path):
+def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path, capsys):
     bad = tmp_path / "bad.toml"
     bad.write_text('[sweep]\nalgorithm = "rfd_star"\nmaps = = ["mosaic20"]\n')
     with pytest.raises(SpecError, match=r"bad.toml: not valid TOML: .*line 3"):
@@ -117,11 +117,10 @@ def test_bad_toml_names_the_line_and_fails_before_any_compute(tmp_path):
     unknown = tmp_path / "unknown.toml"
     unknown.write_text('[sweep]\nalgorithm = "rfd_star"\nmaps = ["atlantis"]\nseeds = 2\n')
     out = tmp_path / "results"
-    finished = subprocess.run(
-        [sys.executable, "-c", "from jaxswarm.cli import main; raise SystemExit(main())",
-         "sweep", str(unknown), "--out", str(out)], capture_output=True, text=True, timeout=120)
-    assert finished.returncode == 2
-    assert "unknown.toml: sweep.maps[0]: unknown map 'atlantis'" in finished.stderr
+    with pytest.raises(SystemExit) as exited:
+        cli.main(["sweep", str(unknown), "--out", str(out)])
+    assert exited.value.code == 2
+    assert "unknown.toml: sweep.maps[0]: unknown map 'atlantis'" in capsys.readouterr().err
     assert not out.exists()  # nothing was started
 
 

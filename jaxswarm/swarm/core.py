@@ -280,11 +280,13 @@ def _run_program(swarm, iterations: int, patience: int | None):
 @functools.lru_cache(maxsize=None)
 def _run_alone(swarm, iterations: int, patience: int | None):
     """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with these
-    statics, whose ``vmap`` runs the batch's members one after another."""
+    statics, whose ``vmap`` runs the batch's members one after another. Jitted, so that a run
+    called alone is traced once per shape (a ``custom_vmap`` function called outside ``jit`` is
+    traced again at every call)."""
     def run_one(key, world, task, params, state, budget):
         return _run(swarm, key, world, task, params, state, budget, iterations=iterations,
                     patience=patience)
-    return one_at_a_time(run_one)
+    return jax.jit(one_at_a_time(run_one))
 
 
 @functools.partial(jax.jit, static_argnames=("swarm", "iterations", "patience"))

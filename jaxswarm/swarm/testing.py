@@ -118,11 +118,12 @@ def key_data(tree):
 
 
 def outcome(result):
-    """A run's ``(state, trace)`` with its PRNG keys as data and without the trace's
-    ``lane_steps``: what the run decided, the same alone or in a batch (a batch's walks share one
-    loop, whose lane-steps each run reports)."""
+    """A run's ``(state, trace)`` as NumPy arrays, with its PRNG keys as data and without the
+    trace's ``lane_steps``: what the run decided, the same alone or in a batch (a batch's walks
+    share one loop, whose lane-steps each run reports). NumPy, so that picking a batch's row
+    and comparing are not JAX operations (each a program of its own outside ``jit``)."""
     state, trace = result
-    return key_data((state, dataclasses.replace(trace, lane_steps=None)))
+    return jax.device_get(key_data((state, dataclasses.replace(trace, lane_steps=None))))
 
 
 def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
@@ -139,11 +140,12 @@ def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: in
     assert leaves_equal(key_data(one[0]), key_data(again)), f"{swarm.name}: same key differs"
     batch = run_batch(swarm, split, graph, task, batched_params(params, runs),
                       iterations=iterations)
+    rows = outcome(batch)
     for i in range(keys):
-        assert leaves_equal(outcome(jax.tree_util.tree_map(lambda x: x[i], batch)),
-                            outcome(one[i])), f"{swarm.name}: vmap row {i} differs from run"
+        assert leaves_equal(jax.tree_util.tree_map(lambda x: x[i], rows), outcome(one[i])), (
+            f"{swarm.name}: vmap row {i} differs from run")
         if swarm.vmap_one_at_a_time:
-            assert np.array_equal(batch[1].lane_steps[i], one[i][1].lane_steps), (
+            assert np.array_equal(np.asarray(batch[1].lane_steps)[i], one[i][1].lane_steps), (
                 f"{swarm.name}: vmap row {i} did not walk alone")
     # Another key walks other agents: the memory or the share that arrived differs.
     assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
