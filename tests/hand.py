@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import math
 
-import jax
 import numpy as np
+from jitted import rows_log
 
 from jaxswarm.swarm.walking import Walk
-from jaxswarm.swarm.walking.log import from_rows
 
 # Slot order of the library's grids, written out by hand: E S W N SE SW NW NE, y grows down.
 SLOTS = [(1, 0), (0, 1), (-1, 0), (0, -1), (1, 1), (-1, 1), (-1, -1), (1, -1)]
@@ -82,9 +81,6 @@ def probabilities(row) -> dict[int, float]:
     return {k: weights[k] / weights.sum() for k in range(row.shape[0]) if finite[k]}
 
 
-_from_rows = jax.jit(from_rows, static_argnums=4)
-"""The library's log of whole rows, one program per walk shape (its few operations applied one
-by one outside jit would each be a program of their own)."""
 
 
 def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: int | None = None
@@ -106,7 +102,7 @@ def fake_walk(paths, num_nodes: int, *, arrived, stuck, width: int = 3, budget: 
         for v in nodes:
             visited[a, v // 32] |= np.uint32(1 << (v % 32))
     moves = np.array([len(p) - 1 for p in paths], np.int32)
-    log = _from_rows(path, slots, moves, paths[0][0], columns - 1)
+    log = rows_log(path, slots, moves, paths[0][0], columns - 1)
     return Walk(log=log, length=lengths, arrived=np.array(arrived, bool),
                 stuck=np.array(stuck, bool),
                 position=np.array([p[-1] for p in paths], np.int32), visited=visited,

@@ -4,19 +4,12 @@ import numpy as np
 import pytest
 import sizes
 from graphs import wandering_walk
+from jitted import ant_system_update, bug2_path, deposit, transition_rule
 
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.swarm import aco, make, make_task, run
-from jaxswarm.swarm.aco import ant_system, bug2
 from jaxswarm.world.paths import is_valid_path, path_length
 
-# The colonies' rules called alone, jitted: each is one program per map shape (and static
-# option), where outside jit each of its operations would be lowered and run as a program of its
-# own.
-ant_system_update = jax.jit(ant_system.ant_system_update)
-deposit = jax.jit(aco.deposit)
-transition_rule = jax.jit(aco.transition_rule, static_argnames=("direction", "goal_distance"))
-bug2_path = jax.jit(bug2.bug2_path)  # as test_bug2.py calls it
 
 
 def corridor():

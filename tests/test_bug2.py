@@ -1,16 +1,12 @@
-import jax
 import numpy as np
 import pytest
+from jitted import bug2_path
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_grid, random_path_map
-from jaxswarm.swarm.aco import bug2
 from jaxswarm.world.graph import grid_graph, path_map_graph
 from jaxswarm.world.paths import is_valid_path, path_length
 
-bug2_path = jax.jit(bug2.bug2_path)
-"""The ant under test as one program per map shape (its table and its walk): outside jit each
-operation of its table would be a program of its own. test_aco.py calls it so too."""
 
 
 @pytest.mark.parametrize("seed", range(8))

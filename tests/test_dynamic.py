@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sizes
 from graphs import solved_paper_map
+from jitted import apply_event, change
 from jaxswarm.dynamic import events as events_module
 from jaxswarm.dynamic.events import (check_events, first_iteration_at, make_event, memory_frames,
                                      replan)
@@ -16,14 +17,6 @@ from jaxswarm.swarm.testing import Compilations
 from jaxswarm.world.graph import grid_graph
 
 H0 = 1e4
-
-apply_event = jax.jit(events_module.apply_event)
-""":func:`~jaxswarm.dynamic.events.apply_event` as one program per map and event shape, rather
-than op by op."""
-change = jax.jit(events_module.change, static_argnums=0)
-""":func:`~jaxswarm.dynamic.events.change` as one program per swarm, map and event shape (the
-swarm static), rather than op by op: the memory rules on 3 x 3 maps. On the 20 x 20 maps the
-tests change op by op, with the operations that :func:`replan` applies outside jit."""
 
 
 def open_3x3():
@@ -164,6 +157,8 @@ def test_continuing_uses_the_given_key_and_events_do_not_recompile():
     for i, event in enumerate(events):  # the first change builds the change's own programs
         check_events(graph, task, event)
         with Compilations() as built:
+            # Outside jit, with the operations replan applies outside jit (the jitted change
+            # serves the memory rules on 3 x 3 maps).
             s, g, t = events_module.change(swarm, state, event, graph, task, params)
             run(swarm, jax.random.key(4), g, t, params, iterations=sizes.ITERATIONS, state=s)
         assert i == 0 or built.count == 0, f"a change of the map built {built.names}"

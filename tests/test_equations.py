@@ -24,12 +24,13 @@ import sizes
 from graphs import wandering_walk
 from hand import (E, N, NE, NW, R2, S, SE, SW, W, check_lattice, distance, fake_walk, moves,
                   node, probabilities, slot, step_length, xy)
+from jitted import (ant_system_update, deposit, erode_banks, graded_transition, settle,
+                    transition_rule)
 
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.random import random_path_map
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import aco, make, make_task, rfd, run
-from jaxswarm.swarm.aco import ant_system
 from jaxswarm.swarm.aco.bug2 import first_ant_path
 from jaxswarm.swarm.rfd import (DEFAULT_GRADED, RFDParams, RFDStarConfig, RFDStarParams,
                                 add_compensated, paper, river)
@@ -46,14 +47,8 @@ rfd_transition = jax.jit(rfd.rfd_transition)
 rfd_star_transition = jax.jit(rfd.rfd_star_transition, static_argnums=0)  # the config
 erosion_change = jax.jit(rfd.erosion_change)
 sediment_where_stuck = jax.jit(river.sediment_where_stuck, static_argnums=0)  # the node count
-graded_transition = jax.jit(rfd.graded_transition)
 carve = jax.jit(rfd.carve)
-settle = jax.jit(rfd.settle)
-erode_banks = jax.jit(rfd.erode_banks)
 blind_alleys = jax.jit(rfd.blind_alleys)
-transition_rule = jax.jit(aco.transition_rule, static_argnames=("direction", "goal_distance"))
-deposit = jax.jit(aco.deposit)
-ant_system_update = jax.jit(ant_system.ant_system_update)
 
 
 def approx(expected):

@@ -4,6 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 import sizes
+from jitted import rows_log
 
 from jaxswarm.dynamic.events import memory_frames
 from jaxswarm.dynamic.robot import hidden_blocks, swarm_robot
@@ -12,7 +13,7 @@ from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.testing import _run_batch, batched_params, outcome, run_batch
 from jaxswarm.swarm.walking import step_budget, walk
 from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same,
-                                        columns, default_log_moves, from_rows, log_blocks, paths,
+                                        columns, default_log_moves, log_blocks, paths,
                                         room_blocks)
 from jaxswarm.world.graph import grid_graph
 
@@ -35,9 +36,8 @@ def _walk(log_moves):
                 num_agents=AGENTS, max_steps=STEPS, log_moves=log_moves)
 
 
-# The log's readers in a program each, shared by the tests: applied outside jit, each of their
-# operations is a program of its own (from_rows and all_same are a dozen, a read dozens).
-rows_log = jax.jit(from_rows, static_argnames="max_steps")
+# all_same in one program, shared by the tests: applied outside jit, each of its operations is
+# a program of its own (a dozen).
 same_moves = jax.jit(all_same)
 
 

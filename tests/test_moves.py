@@ -4,9 +4,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
+from jitted import rows_log
 
 from jaxswarm.runtime.arithmetic import ordered_cumsum, ordered_sum
-from jaxswarm.swarm.walking.log import from_rows
 from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves
 
 
@@ -132,10 +132,6 @@ def test_it_runs_inside_a_vmapped_cond_with_constants():
     got = np.asarray(batched(values, np.array([True, False, True])))
     np.testing.assert_array_equal(got[1], np.zeros(4))
     np.testing.assert_array_equal(got[2], branch(values[2]))
-
-
-rows_log = jax.jit(from_rows, static_argnames="max_steps")
-"""from_rows in one program (applied outside jit, a dozen operations of a program each)."""
 
 
 def random_log(moves, max_steps=1023, nodes=50, seed=0):

@@ -5,7 +5,7 @@ import pytest
 import sizes
 
 from graphs import solved_paper_map
-from jaxswarm.dynamic import events as events_module
+from jitted import apply_event, change
 from jaxswarm.dynamic.events import check_events
 from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
                                          paper_scenario)
@@ -13,13 +13,6 @@ from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import PAPER_OPTIMA, paper_map
 from jaxswarm.swarm import make_task, run
 from jaxswarm.world.graph import grid_graph
-
-apply_event = jax.jit(events_module.apply_event)
-""":func:`~jaxswarm.dynamic.events.apply_event` as one program, rather than op by op: the
-scenarios' events are padded to one size, so every scenario of a 20 x 20 map shares it."""
-change = jax.jit(events_module.change, static_argnums=0)
-""":func:`~jaxswarm.dynamic.events.change` as one program (the swarm static), rather than op by
-op."""
 
 
 @pytest.mark.parametrize("name", [
@@ -32,6 +25,7 @@ def test_scenarios_change_the_optimum_as_described(name, table):
     chosen = paper_map(name)
     graph = chosen.graph()
     task = make_task(graph, chosen.start, chosen.goal)
+    # Padded to one size: every scenario of a 20 x 20 map shares one program of apply_event.
     event = scenario.event(graph, size=graph.num_nodes)
     check_events(graph, task, event)
     edited, new_task = apply_event(event, graph, task)

@@ -4,8 +4,8 @@ batches under vmap, and names bad worlds."""
 import jax
 import numpy as np
 import pytest
+from jitted import change
 
-from jaxswarm.dynamic import events
 from jaxswarm.dynamic.events import apply_event, check_events, make_event
 from jaxswarm.dynamic.robot import (check_world, dstar_robot, hidden_blocks, swarm_robot, walk_plan)
 from jaxswarm.exact import astar
@@ -20,9 +20,6 @@ SQRT2 = float(np.sqrt(2))
 SIDE = 5
 """The side of the maps walked here: the detour world's, so that every walk of a plan (a plan of
 ``SIDE ** 2`` nodes, as D* Lite's) is one program."""
-change = jax.jit(events.change, static_argnums=0)
-"""A change and a swarm's memory rule as one program (outside jit each of their operations would
-be a program of its own)."""
 
 
 def free_grid(height, width):

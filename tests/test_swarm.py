@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import sizes
 from conformance import maze  # noqa: F401 (fixture)
+from jitted import erode_banks, graded_transition, rows_log, settle
 
 from jaxswarm import swarm as swarms
 from jaxswarm.exact import dijkstra
@@ -25,13 +26,6 @@ from jaxswarm.world.paths import Solution
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
 
-# The rules the tests apply outside a run, each one program that the tests share: applied
-# outside jit, each of their operations is a program of its own (a transition table is dozens,
-# from_rows a dozen), and each of their loops one.
-graded_transition = jax.jit(rfd.graded_transition)
-settle = jax.jit(rfd.settle)
-erode_banks = jax.jit(rfd.erode_banks)
-rows_log = jax.jit(from_rows, static_argnames="max_steps")
 
 
 @pytest.mark.slow  # about 25 s
