@@ -16,6 +16,7 @@ import functools
 import jax
 import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
+from jax.extend.core import jaxpr_as_fun
 
 
 def one_at_a_time(fun):
@@ -23,12 +24,14 @@ def one_at_a_time(fun):
     applies it to the batch members one after the other (``lax.map``) rather than to all of
     them at once. Results are the same as ``vmap``'s; pays where members' loops run for very
     different numbers of iterations and one member's iteration already fills the machine.
-    Arguments not batched are shared by every member, not copied."""
+    Arguments not batched are shared by every member, not copied. ``fun`` is jitted and traced
+    once per argument signature, whether it runs alone or as a member inside the rule."""
+    member = _traced_once(fun)
 
     @custom_vmap
     @functools.wraps(fun)
     def mapped(*args):
-        return fun(*args)
+        return member(*args)
 
     @mapped.def_vmap
     def rule(axis_size, in_batched, *args):
@@ -47,6 +50,28 @@ def one_at_a_time(fun):
         return out, jax.tree_util.tree_map(lambda _: True, out)
 
     return mapped
+
+
+def _traced_once(fun):
+    """``fun``, jitted, and traced once per argument signature (pytree structure and each
+    leaf's shape, dtype and weak type) wherever it is called. JAX keys its tracing caches on
+    the context of a call too, and a ``vmap`` rule runs in ``vmap``'s axis context: a member
+    traced there would be traced again at every batch (seconds for a run loop). Each call
+    stages the kept jaxpr, a ``jit`` call of ``fun``."""
+    jitted = jax.jit(fun)
+    jaxprs = {}
+
+    @functools.wraps(fun)
+    def call(*args):
+        leaves, treedef = jax.tree_util.tree_flatten(args)
+        signature = (treedef, tuple(jax.typeof(leaf) for leaf in leaves))
+        if signature not in jaxprs:
+            jaxpr, shapes = jax.make_jaxpr(jitted, return_shape=True)(*args)
+            jaxprs[signature] = jaxpr, jax.tree_util.tree_structure(shapes)
+        jaxpr, out_tree = jaxprs[signature]
+        return jax.tree_util.tree_unflatten(out_tree, jaxpr_as_fun(jaxpr)(*leaves))
+
+    return call
 
 
 def runs_folded(fun):
