@@ -198,13 +198,14 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
         return SweepMap(label, grid_graph(grid.obstacles), grid.start, grid.goal)
     map_path = _find_movingai(entry["movingai"], base_dir)
     scenario_path = _scenario_file(map_path, entry.get("scenario_file"))
-    files = {"map": (str(map_path), _sha256(map_path)),
-             "scenario": (str(scenario_path), _sha256(scenario_path))}
+    paths = {"map": map_path, "scenario": scenario_path}
+    digests = {role: _sha256(path) for role, path in paths.items()}
     obstacles = movingai.read_map(map_path)
     scenarios = movingai.load_scenarios(scenario_path)
-    if {role: _sha256(Path(path)) for role, (path, _) in files.items()} != {
-            role: digest for role, (_, digest) in files.items()}:
+    # The digests vouch for the maps only if the files did not change while they were parsed.
+    if {role: _sha256(path) for role, path in paths.items()} != digests:
         raise ValueError(f"{map_path} or {scenario_path} changed while it was read; try again")
+    files = {role: (str(path), digests[role]) for role, path in paths.items()}
     row = entry["scenario"]
     if row >= len(scenarios):
         raise ValueError(f"{scenario_path}: scenario {row} out of range ({len(scenarios)} rows)")
