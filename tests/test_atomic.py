@@ -1,9 +1,13 @@
-"""Atomic writes: the target is replaced whole or not at all, and no temporary file stays."""
+"""Atomic writes: the target is replaced whole or not at all, no temporary file stays, and one
+a killed writer left behind is told from one being written."""
 import csv
+import os
+import subprocess
+import sys
 
 import pytest
 
-from jaxswarm.runtime.atomic import atomic_path, write_atomically, write_csv
+from jaxswarm.runtime.atomic import abandoned_temporaries, atomic_path, write_atomically, write_csv
 
 
 def test_a_write_replaces_the_file_and_leaves_nothing_behind(tmp_path):
@@ -32,3 +36,17 @@ def test_write_csv_keeps_the_column_order_and_leaves_no_temporary(tmp_path):
     with open(target, newline="", encoding="utf-8") as f:
         assert list(csv.reader(f)) == [["b", "a"], ["1", "x"], ["2", "y,z"]]
     assert [p.name for p in target.parent.iterdir()] == ["rows.csv"]
+
+
+def test_only_the_temporaries_of_writers_that_stopped_are_abandoned(tmp_path):
+    ended = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    dead = int(ended.stdout)
+    with atomic_path(tmp_path / "live.parquet") as live:
+        live.write_text("being written")
+        assert live.name.startswith(f".live.parquet.{os.getpid()}.")
+        for name in (f".killed.parquet.{dead}.0123456789ab.tmp",  # its writer ended
+                     ".old.parquet.0123456789ab.tmp"):  # no pid: nothing says it ended
+            (tmp_path / name).write_text("half")
+        assert [p.name for p in abandoned_temporaries(tmp_path)] == [
+            f".killed.parquet.{dead}.0123456789ab.tmp"]

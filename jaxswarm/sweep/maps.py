@@ -11,11 +11,14 @@ scenario file (``{ movingai = "mapf/maze-32-32-2.map", scenario = 5 }``, row 5 c
 a seeded thin-wall path map (``{ pathmap = "20x20", seed = 3 }``, see
 :func:`jaxswarm.maps.random.random_path_map`), top-left to bottom-right.
 A relative ``.map`` path is looked up beside the spec, then in the folder that the environment
-variable ``JAXSWARM_MOVINGAI`` names (e.g. ``shared/benchdata/movingai``).
+variable ``JAXSWARM_MOVINGAI`` names (e.g. ``shared/benchdata/movingai``). A resolved map keeps
+the SHA-256 of each file it was read from (:func:`file_digests`), so that a store can tell an
+edited file from the one its rows were computed on.
 """
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import os
 from pathlib import Path
 
@@ -50,12 +53,15 @@ class SweepMap:
         ``maze-32-32-2#5``, ``map1``, ``plane-s3-r40``).
       world: the map's Graph, or a Plane.
       start, goal: (x, y) cells of a graph, (x, y) points of a plane.
+      files: the files the map was read from, role (``map``, ``scenario``) -> ``(path,
+        SHA-256 hex digest of the bytes read)``; empty for a map made from its entry alone.
     """
 
     label: str
     world: Graph | Plane
     start: tuple
     goal: tuple
+    files: dict = dataclasses.field(default_factory=dict)
 
     @property
     def size(self) -> str:
@@ -191,16 +197,36 @@ def resolve_map(entry, base_dir: Path | None = None) -> SweepMap:
             label += f"-d{density:g}"
         return SweepMap(label, grid_graph(grid.obstacles), grid.start, grid.goal)
     map_path = _find_movingai(entry["movingai"], base_dir)
-    obstacles = movingai.read_map(map_path)
     scenario_path = _scenario_file(map_path, entry.get("scenario_file"))
+    paths = {"map": map_path, "scenario": scenario_path}
+    digests = {role: _sha256(path) for role, path in paths.items()}
+    obstacles = movingai.read_map(map_path)
     scenarios = movingai.load_scenarios(scenario_path)
+    # The digests vouch for the maps only if the files did not change while they were parsed.
+    if {role: _sha256(path) for role, path in paths.items()} != digests:
+        raise ValueError(f"{map_path} or {scenario_path} changed while it was read; try again")
+    files = {role: (str(path), digests[role]) for role, path in paths.items()}
     row = entry["scenario"]
     if row >= len(scenarios):
         raise ValueError(f"{scenario_path}: scenario {row} out of range ({len(scenarios)} rows)")
     scenario = scenarios[row]
     movingai.check_scenario(scenario, obstacles, scenario_path)
     return SweepMap(f"{map_path.stem}#{row}", grid_graph(obstacles), scenario.start,
-                    scenario.goal)
+                    scenario.goal, files)
+
+
+def file_digests(maps: list[SweepMap], key: str) -> dict:
+    """What the rows of ``maps`` (a spec's list at ``key``) depend on outside the spec: the
+    content of every file they were read from, ``"key[i].role"`` -> ``{"file": PATH, "sha256":
+    HEX}``, for a store to record and compare
+    (:class:`~jaxswarm.sweep.store.ResultsStore`'s ``depends_on``)."""
+    return {f"{key}[{i}].{role}": dict(file=path, sha256=digest)
+            for i, sweep_map in enumerate(maps) for role, (path, digest) in sweep_map.files.items()}
+
+
+def _sha256(path: Path) -> str:
+    """The SHA-256 hex digest of a file's bytes."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def resolve_maps(entries, key: str, source: str, base_dir: Path | None = None) -> list[SweepMap]:

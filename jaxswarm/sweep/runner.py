@@ -43,7 +43,7 @@ from tqdm.auto import tqdm
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
 from jaxswarm.sweep.batches import RunBatches, run_outcomes
-from jaxswarm.sweep.maps import SweepMap, resolve_maps
+from jaxswarm.sweep.maps import SweepMap, file_digests, resolve_maps
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
 
@@ -135,7 +135,8 @@ def _set_up(spec: SweepSpec, maps: list[SweepMap], out: Path,
     batches = RunBatches(spec.algorithm, spec.config, spec.iterations, spec.patience,
                          spec.chunk_size, spec.vmap_size, log)
     store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, batches.swarm,
-                                                        batches.group), writer=writer)
+                                                        batches.group),
+                         depends_on=file_digests(maps, "sweep.maps"), writer=writer)
     grid = spec.grid()
     seeds = np.asarray(spec.seeds)
     swept = {name: np.repeat([combination[name] for combination in grid], len(seeds))

@@ -6,8 +6,10 @@ static params), and the batch's rows go to the tune's results store
 (:class:`~jaxswarm.sweep.store.ResultsStore`, one Parquet file per batch, written atomically).
 A tuner is deterministic given its spec and its results, so a tune killed and started again
 asks for the same batches in the same order: a batch the store holds is read back instead of
-run (the store checks that it holds the same settings on the same instances), so nothing is
-lost or run twice.
+run (after checking that it holds the same settings, with the same param values, on the same
+instances), so nothing is lost or run twice. The store records what else the settings and rows
+follow from (:func:`tuner_record`: the tuner's version and sampler; the content of every map
+file, :func:`~jaxswarm.sweep.maps.file_digests`) and refuses a resume across a change of any.
 
 Per run, the objective is a loss (lower is better):
 
@@ -33,7 +35,7 @@ import pandas as pd
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
 from jaxswarm.sweep.batches import RunBatches, run_outcomes
-from jaxswarm.sweep.maps import resolve_maps
+from jaxswarm.sweep.maps import file_digests, resolve_maps
 from jaxswarm.sweep.runner import provenance
 from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.tune.spec import TuneSpec
@@ -41,6 +43,22 @@ from jaxswarm.tune.spec import TuneSpec
 TRAINING, HELD_OUT = "training", "held_out"
 """The two phases of a tune: the search, on training instances, and the rescoring of its best
 settings on held-out ones."""
+
+
+TUNER_VERSION = 1
+"""The version of the tuner's decisions: raise it when a tuner of the same spec, given the same
+results, asks for other settings or in another order (:mod:`jaxswarm.tune.race`,
+:mod:`jaxswarm.tune.search`, :mod:`jaxswarm.tune.space`), so that a store of the old tuner is
+not resumed."""
+
+
+def tuner_record() -> dict:
+    """What a tune's settings follow from besides its spec and results, as its store records
+    it: ``{"version": TUNER_VERSION, "sampler": "<bit generator> of numpy <major.minor>"}`` (a
+    NumPy feature release may change the streams of ``numpy.random.Generator``'s methods)."""
+    generator = type(np.random.default_rng(0).bit_generator).__name__
+    numpy_release = ".".join(np.__version__.split(".")[:2])
+    return dict(version=TUNER_VERSION, sampler=f"{generator} of numpy {numpy_release}")
 
 
 class StoreConflictError(ValueError):
@@ -98,7 +116,9 @@ class Evaluator:
 
         Raises:
           ValueError: a map cannot be resolved.
-          StoreMismatchError: ``out`` holds another tune or another definition of the swarm.
+          StoreMismatchError: ``out`` holds another tune, another definition of the swarm, runs
+            on another content of a map file or of another tuner (:func:`tuner_record`).
+          StoreBusyError: another process is writing ``out``.
         """
         self.spec = spec
         self.log = log
@@ -107,11 +127,14 @@ class Evaluator:
                                          base_dir)
                      for phase, instances in ((TRAINING, spec.training),
                                               (HELD_OUT, spec.held_out))}
-        self._optimum = {phase: [m.optimum() for m in maps] for phase, maps in self.maps.items()}
         self._batches: dict = {}
         swarm = self._batches_for({}).swarm
+        depends_on = {key: record for phase, maps in self.maps.items()
+                      for key, record in file_digests(maps, f"tune.{phase}.maps").items()}
         self.store = ResultsStore(Path(out), spec.as_dict(),
-                                  dict(provenance(), swarm=definition(swarm)))
+                                  dict(provenance(), swarm=definition(swarm)),
+                                  depends_on=dict(depends_on, tuner=tuner_record()))
+        self._optimum = {phase: [m.optimum() for m in maps] for phase, maps in self.maps.items()}
         self.runs_spent = 0
         self._next = 0
 
@@ -192,12 +215,23 @@ _COUNTS = ("iterations", "moves", "evaluations", "target_iterations", "target_ev
 
 
 def _check_same(rows: pd.DataFrame, settings, instances, phase, path) -> None:
-    """The stored batch ``rows`` holds ``settings`` on ``instances`` of ``phase``."""
-    want = [(setting.number, i) for setting in settings for i in range(len(instances))]
-    got = list(zip(rows["setting"], rows["instance"]))
-    seeds = [seed for _ in settings for _, seed in instances]
-    if got != want or list(rows["phase"]) != [phase] * len(want) or list(rows["seed"]) != seeds:
+    """The stored batch ``rows`` holds ``settings`` (their numbers and param values) on
+    ``instances`` of ``phase``.
+
+    Raises:
+      StoreConflictError: naming the batch's file and the first column that differs.
+    """
+    want = dict(setting=[setting.number for setting in settings for _ in instances],
+                instance=[i for _ in settings for i in range(len(instances))],
+                phase=[phase] * (len(settings) * len(instances)),
+                seed=[seed for _ in settings for _, seed in instances])
+    for name in settings[0].values if settings else ():
+        want[f"param.{name}"] = [float(setting.values[name]) for setting in settings
+                                 for _ in instances]
+    differs = [name for name, values in want.items()
+               if name not in rows or list(rows[name]) != values]
+    if differs:
         raise StoreConflictError(
-            f"{path} holds another batch than this tune asks for (a tune's batches follow from "
-            "its spec: was the store written by another version?); choose another --out or "
-            "delete it")
+            f"{path} holds another batch than this tune asks for (differs in: {differs[0]}; a "
+            "tune's batches follow from its spec and tuner: was the store written by another "
+            "version?); choose another --out or delete it")

@@ -78,9 +78,11 @@ def tune(spec: TuneSpec, out=None, *, log: Callable[[str], None] = print) -> Tun
       log: where one-line messages go (compiles).
 
     Raises:
-      ValueError: a map cannot be resolved (before any compute), or ``out`` holds another tune
+      ValueError: a map cannot be resolved (before any compute); ``out`` holds another tune,
+        runs on a map file that changed since, or batches of another tuner or sampler
         (:class:`~jaxswarm.sweep.store.StoreMismatchError`,
-        :class:`~jaxswarm.tune.evaluate.StoreConflictError`).
+        :class:`~jaxswarm.tune.evaluate.StoreConflictError`); another process is writing
+        ``out`` (:class:`~jaxswarm.sweep.store.StoreBusyError`).
     """
     out = Path(out) if out is not None else default_tune_out(spec)
     evaluator = Evaluator(spec, out, log)
