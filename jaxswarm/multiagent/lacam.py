@@ -25,12 +25,12 @@ from __future__ import annotations
 
 import collections
 import dataclasses
-import heapq
 import time
 
 import numpy as np
 
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
+from jaxswarm.multiagent.explored import NONE, Explored
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
@@ -50,18 +50,18 @@ class _Constraint:
         return len(self.who)
 
 
-@dataclasses.dataclass(eq=False)
-class _Configuration:
-    """A high-level node: a configuration, how it was reached and its constraint tree."""
+@dataclasses.dataclass
+class _Tree:
+    """A configuration's PIBT priorities (f64[A]), its agents by priority (i32[A]) and the
+    constraints of its tree not taken yet (breadth first)."""
 
-    nodes: np.ndarray
-    parent: "_Configuration | None"
     priorities: np.ndarray
     order: np.ndarray
-    cost: int
-    bound: int
-    tree: collections.deque
-    neighbours: list = dataclasses.field(default_factory=list)
+    constraints: collections.deque
+
+
+_UNBOUNDED = np.iinfo(np.int64).max
+"""The limit of the Dijkstra update before any solution is known."""
 
 
 def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: float = 0.0,
@@ -123,126 +123,111 @@ class _Search:
         self.swap = swap
         self.work = Workspace(moves, seed)
         self.rng = np.random.default_rng(seed)
-        self.explored: dict[bytes, _Configuration] = {}
+        self.explored = Explored(moves.goals)
+        self.trees: list[_Tree] = []
         self.began = time.perf_counter()
         self.first_soc: int | None = None
+        self.first_loss: int | None = None
+        self.loss: int | None = None
         self.optimal = False
 
     def stats(self, refining: bool) -> dict:
         """The search's statistics (see :func:`lacam`)."""
-        out = dict(configurations=len(self.explored),
+        out = dict(configurations=self.explored.size,
                    seconds=time.perf_counter() - self.began)
         if refining and self.first_soc is not None:
-            out |= dict(first_soc=self.first_soc, optimal=self.optimal)
+            out |= dict(first_soc=self.first_soc, first_sum_of_loss=self.first_loss,
+                        sum_of_loss=self.loss, optimal=self.optimal)
         return out
 
     def run(self, starts: np.ndarray, *, deadline: float, refine: float,
             max_configurations: int) -> tuple[list | None, str]:
         """``(configurations from the starts to the goals, "")``, or ``(None, why not)``."""
         goals = self.moves.goals
-        priorities = initial_priorities(self.moves, starts)
-        root = self._add(starts, None, priorities)
+        explored = self.explored
+        root = self._add(starts, NONE, initial_priorities(self.moves, starts))
         open_ = [root]
-        goal: _Configuration | None = None
+        goal = NONE
         while open_:
-            if time.perf_counter() > deadline or len(self.explored) >= max_configurations:
+            if time.perf_counter() > deadline or explored.size >= max_configurations:
                 break
             node = open_[-1]
-            if goal is not None and node.cost + node.bound >= goal.cost:
+            if not self._promising(node, goal):
                 open_.pop()
                 continue
-            if goal is None and np.array_equal(node.nodes, goals):
+            if goal == NONE and np.array_equal(explored.nodes[node], goals):
                 goal = node
-                self.first_soc = _soc(_backtrack(goal), goals)
+                self.first_soc = _soc(explored.way(goal), goals)
+                self.first_loss = int(explored.cost[goal])
                 if refine <= 0:
-                    return _backtrack(goal), ""
+                    return explored.way(goal), ""
                 deadline = time.perf_counter() + refine
                 continue
-            if not node.tree:
+            tree = self.trees[node]
+            if not tree.constraints:
                 open_.pop()
                 continue
-            constraint = node.tree.popleft()
-            if constraint.depth < len(node.nodes):
-                self._grow(node, constraint)
-            following = self._successor(node, constraint)
+            constraint = tree.constraints.popleft()
+            if constraint.depth < len(goals):
+                self._grow(node, tree, constraint)
+            following = self._successor(node, tree, constraint)
             if following is None:
                 continue
-            known = self.explored.get(following.tobytes())
-            if known is None:
+            known = explored.find(following)
+            if known == NONE:
                 child = self._add(following, node,
-                                  next_priorities(node.priorities, following == goals))
-                node.neighbours.append(child)
-                open_.append(child)
+                                  next_priorities(tree.priorities, following == goals))
+                if self._promising(child, goal):
+                    open_.append(child)
                 continue
-            node.neighbours.append(known)
             if refine > 0:
-                self._rewire(node)
-            open_.append(known)
-        if goal is not None:
+                limit = explored.cost[goal] if goal != NONE else _UNBOUNDED
+                again = explored.connect(node, known, limit)
+                if goal != NONE:
+                    open_.extend(again.tolist())
+            if self._promising(known, goal):
+                open_.append(known)
+        if goal != NONE:
             self.optimal = not open_
-            return _backtrack(goal), ""
+            self.loss = int(explored.cost[goal])
+            return explored.way(goal), ""
         if not open_:
             return None, ("no solution: every configuration reachable from the starts "
-                          f"({len(self.explored)}) was explored")
+                          f"({explored.size}) was explored")
         if time.perf_counter() > deadline:
-            return None, f"reached the time limit after {len(self.explored)} configurations"
+            return None, f"reached the time limit after {explored.size} configurations"
         return None, f"reached the limit of {max_configurations} configurations"
 
-    def _add(self, nodes: np.ndarray, parent: _Configuration | None,
-             priorities: np.ndarray) -> _Configuration:
-        goals = self.moves.goals
-        cost = 0 if parent is None else parent.cost + _step_cost(parent.nodes, nodes, goals)
-        bound = int(self.moves.fields[np.arange(len(nodes)), nodes].sum())
-        node = _Configuration(nodes=nodes, parent=parent, priorities=priorities,
-                              order=by_priority(priorities), cost=cost, bound=bound,
-                              tree=collections.deque([_Constraint((), ())]))
-        self.explored[nodes.tobytes()] = node
-        return node
+    def _promising(self, node: int, goal: int) -> bool:
+        """Whether ``node`` may still lead to a solution cheaper than ``goal``'s (always, while
+        no solution is known)."""
+        explored = self.explored
+        return goal == NONE or explored.cost[node] + explored.bound[node] < explored.cost[goal]
 
-    def _grow(self, node: _Configuration, constraint: _Constraint) -> None:
+    def _add(self, nodes: np.ndarray, parent: int, priorities: np.ndarray) -> int:
+        bound = int(self.moves.fields[np.arange(len(nodes)), nodes].sum())
+        self.trees.append(_Tree(priorities=priorities, order=by_priority(priorities),
+                                constraints=collections.deque([_Constraint((), ())])))
+        return self.explored.add(nodes, parent, bound)
+
+    def _grow(self, node: int, tree: "_Tree", constraint: _Constraint) -> None:
         """Add the children of ``constraint``: the next agent's candidates, keyed order."""
-        agent = int(node.order[constraint.depth])
-        here = int(node.nodes[agent])
+        agent = int(tree.order[constraint.depth])
+        here = int(self.explored.nodes[node, agent])
         moves = self.moves
         options = np.append(moves.heads[moves.indptr[here]:moves.indptr[here + 1]], here)
         for v in self.rng.permutation(options).tolist():
-            node.tree.append(_Constraint(constraint.who + (agent,), constraint.where + (v,)))
+            tree.constraints.append(_Constraint(constraint.who + (agent,),
+                                                constraint.where + (v,)))
 
-    def _successor(self, node: _Configuration, constraint: _Constraint) -> np.ndarray | None:
-        following = np.empty_like(node.nodes)
-        ok = configuration(self.moves, self.work, node.nodes, node.order,
+    def _successor(self, node: int, tree: "_Tree",
+                   constraint: _Constraint) -> np.ndarray | None:
+        current = self.explored.nodes[node]
+        following = np.empty_like(current)
+        ok = configuration(self.moves, self.work, current, tree.order,
                            np.array(constraint.who, np.int32),
                            np.array(constraint.where, np.int32), following, swap=self.swap)
         return following if ok else None
-
-    def _rewire(self, start: _Configuration) -> None:
-        """LaCAM*'s Dijkstra update from ``start`` over the known neighbours: every
-        configuration reached more cheaply through it takes it as parent."""
-        goals = self.moves.goals
-        queue = [(start.cost, id(start), start)]
-        while queue:
-            cost, _, node = heapq.heappop(queue)
-            if cost > node.cost:
-                continue
-            for other in node.neighbours:
-                through = node.cost + _step_cost(node.nodes, other.nodes, goals)
-                if through < other.cost:
-                    other.cost, other.parent = through, node
-                    heapq.heappush(queue, (through, id(other), other))
-
-
-def _step_cost(before: np.ndarray, after: np.ndarray, goals: np.ndarray) -> int:
-    """Agents not resting at their goals through one step (LaCAM*'s sum of loss)."""
-    return int(np.count_nonzero((before != goals) | (after != goals)))
-
-
-def _backtrack(node: _Configuration) -> list:
-    """The configurations from the starts to ``node``."""
-    out = []
-    while node is not None:
-        out.append(node.nodes)
-        node = node.parent
-    return out[::-1]
 
 
 def _soc(configurations: list, goals: np.ndarray) -> int:
