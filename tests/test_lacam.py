@@ -157,7 +157,7 @@ def test_a_limit_ends_lacam_cleanly_and_a_seed_replays():
     assert not limited.solved and limited.reason == "reached the limit of 2 configurations"
     again = [lacam(graph, starts, goals, seed=7).paths for _ in range(2)]
     assert np.array_equal(*again)
-    with pytest.raises(ValueError, match="refine at least 0"):
+    with pytest.raises(ValueError, match="refine must be at least 0, got -1"):
         lacam(graph, starts, goals, refine=-1)
 
 
@@ -203,6 +203,25 @@ def test_two_agents_head_on_in_a_corridor_swap_where_it_widens():
     assert plain.solved and swapped.solved and swapped.planner == "lacam_star"
     for plan in (plain, swapped):
         assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
+
+
+@pytest.mark.parametrize("option, value, error, message", [
+    ("time_limit", -1, ValueError, "time_limit must be positive, got -1"),
+    ("time_limit", float("nan"), ValueError, "time_limit must be positive, got nan"),
+    ("time_limit", "5", TypeError, "time_limit must be a number, got '5'"),
+    ("refine", float("nan"), ValueError, "refine must be at least 0, got nan"),
+    ("refine", None, TypeError, "refine must be a number, got None"),
+    ("max_configurations", 2.5, TypeError, "max_configurations must be an integer, got 2.5"),
+    ("max_configurations", 0, ValueError, "max_configurations must be at least 1, got 0"),
+    ("seed", -1, ValueError, "seed must be at least 0, got -1"),
+    ("seed", 1.5, TypeError, "seed must be an integer, got 1.5"),
+    ("swap", "yes", TypeError, "swap must be True or False, got 'yes'"),
+    ("restart_rate", 2, ValueError, "restart_rate must be between 0 and 1, got 2"),
+])
+def test_lacam_refuses_a_bad_option_naming_it_before_any_search(option, value, error, message):
+    graph, _ = grid(["...."])
+    with pytest.raises(error, match=f"^{message}$"):
+        lacam(graph, [(0, 0)], [(3, 0)], **{option: value})
 
 
 def sum_of_loss(paths, goals):

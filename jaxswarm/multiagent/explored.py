@@ -131,14 +131,10 @@ def _doubled(array: np.ndarray) -> np.ndarray:
     return grown
 
 
-@jit
-def _step_cost(before, after, goals):
-    """Agents not resting at their goals through one step (LaCAM*'s sum of loss)."""
-    count = 0
-    for a in range(goals.shape[0]):
-        if before[a] != goals[a] or after[a] != goals[a]:
-            count += 1
-    return count
+def _step_cost(before: np.ndarray, after: np.ndarray, goals: np.ndarray) -> int:
+    """Agents not resting at their goals through one step (LaCAM*'s sum of loss); i32[A] each.
+    Computed once per edge, when it is added."""
+    return int(np.count_nonzero((before != goals) | (after != goals)))
 
 
 @jit
