@@ -1,6 +1,6 @@
 """Multi-agent planning: prioritised planning on a MAPF benchmark instance, the batched JAX
 conflict check beside a pure-Python one on the same solutions, PIBT's step, LaCAM's solve
-times and CBSH-RTC's constraint-tree nodes per second.
+times, LaCAM*'s refinement over time and CBSH-RTC's constraint-tree nodes per second.
 
 What is measured
 ----------------
@@ -70,7 +70,19 @@ What is measured
    ``total s`` the call as users make it; the goal is the total within 10 s on one core.
    ``configurations`` counts LaCAM's high-level nodes, the useful work.
 
-4. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
+4. LaCAM*'s refinement. :func:`jaxswarm.multiagent.lacam` with ``swap`` and ``refine`` =
+   ``--refine`` seconds (default 10; 0 leaves this part out) on ``--refine-instances`` (default
+   100, 200 and 400 agents of random-32-32-20 and of room-64-64-8, ``random-1`` scenarios): one
+   warm-up call on 2 agents, then one call each. Printed: the first solution's sum of costs and
+   sum of loss (LaCAM*'s objective: agents not resting at their goals, summed over the steps),
+   then both for the best solution known 1, 2, 5 and 10 s after the first (from
+   ``stats["improvements"]``), and the configurations explored. Then the issue's check: five
+   100-agent instances of random-32-32-20 (rows 0-99, 100-199, 200-299 and 300-399 of
+   ``random-1``, the 100 rows of ``even-1``), each refined for ``--refine`` seconds; the goal is a
+   sum of loss below the first solution's on at least 4 of the 5. The search stops at a time,
+   not at a count of configurations, so these figures depend on the machine and its load.
+
+5. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
    ``--cbs`` (default ``room-32-32-4-even-1``, ``maze-32-32-2-even-1`` and
    ``maze-32-32-4-random-1``, the 32 x 32 files hardest for CBS), stopped after ``--cbs-nodes`` constraint-tree nodes (default
    2,000): one warm-up call on 3 agents, then ``--cbs-repeats`` calls (default 3). The search
@@ -85,7 +97,8 @@ Python check runs on one core too; see :mod:`jaxswarm.runtime.cpu`).
 
 How to run
 ----------
-From the repository root (defaults take about 30 s on 2 cores)::
+From the repository root (defaults take about 3 minutes on 2 cores, 2 of them LaCAM*'s
+refinement; ``--refine 0`` leaves it out)::
 
     python benchmarks/multiagent.py
     python benchmarks/multiagent.py --quick
@@ -123,6 +136,13 @@ PLAN_MAP = "random-32-32-10"
 GOAL_SPEEDUP = 20.0
 PIBT_MAP = "random-32-32-20"
 LACAM_INSTANCES = "random-32-32-20:400,random-64-64-10:400,room-64-64-8:400"
+REFINE_INSTANCES = ("random-32-32-20:100,random-32-32-20:200,random-32-32-20:400,"
+                    "room-64-64-8:100,room-64-64-8:200,room-64-64-8:400")
+REFINE_CHECKPOINTS = (1.0, 2.0, 5.0, 10.0)
+REFINE_CHECK = (("random-1", 0), ("random-1", 100), ("random-1", 200), ("random-1", 300),
+                ("even-1", 0))
+"""The refinement check's instances: 100 rows of a ``random-32-32-20`` scenario file from a row."""
+GOAL_REFINED = 4
 GOAL_STEP_MS = 1.0
 GOAL_LACAM_S = 10.0
 CBS_FILES = "room-32-32-4-even-1,maze-32-32-2-even-1,maze-32-32-4-random-1"
@@ -359,9 +379,66 @@ def _lacam_row(name: str, agents: int, plan, valid: bool, total: float, bound: i
             "met" if valid and total <= GOAL_LACAM_S else "NOT met")
 
 
+# --- 4. LaCAM*'s refinement ---------------------------------------------------------------------
+
+
+def refined_at(plan, seconds: float) -> tuple[int, int]:
+    """``(sum of costs, sum of loss)`` of the best solution LaCAM* knew ``seconds`` after its
+    first (``plan.stats`` of a call with ``refine``)."""
+    best = (plan.stats["first_soc"], plan.stats["first_sum_of_loss"])
+    for at, loss, soc in plan.stats["improvements"]:
+        if at <= seconds:
+            best = (soc, loss)
+    return best
+
+
+def bench_refinement(mapf: Path, instances: list[tuple[str, int]],
+                     refine: float) -> list[tuple]:
+    """Part 4, the table over time: one row per instance."""
+    rows = []
+    for name, agents in instances:
+        instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-random-1.scen", agents)
+        graph, starts, goals = instance.graph, instance.starts, instance.goals
+        lacam(graph, starts[:2], goals[:2], swap=True, refine=0.01)  # load the kernels
+        plan = lacam(graph, starts, goals, swap=True, refine=refine)
+        if not plan.solved:
+            rows.append((name, agents, f"NO: {plan.reason}") + ("-",) * 6)
+            continue
+        checkpoints = [refined_at(plan, at) for at in REFINE_CHECKPOINTS if at <= refine]
+        rows.append((name, agents, f"{plan.stats['first_soc']:,} / "
+                                   f"{plan.stats['first_sum_of_loss']:,}")
+                    + tuple(f"{soc:,} / {loss:,}" for soc, loss in checkpoints)
+                    + ("-",) * (len(REFINE_CHECKPOINTS) - len(checkpoints))
+                    + (f"{plan.stats['configurations']:,}",
+                       "yes" if plan.stats["optimal"] else "no"))
+    return rows
+
+
+def bench_refinement_check(mapf: Path, refine: float) -> tuple[list[tuple], int]:
+    """Part 4, the check: (rows, how many of the five instances improved their sum of loss)."""
+    name, agents = "random-32-32-20", 100
+    rows, improved = [], 0
+    for scenario, first_row in REFINE_CHECK:
+        instance = load_instance(mapf / f"{name}.map", mapf / f"{name}-{scenario}.scen",
+                                 first_row + agents)
+        graph = instance.graph
+        starts, goals = instance.starts[first_row:], instance.goals[first_row:]
+        plan = lacam(graph, starts, goals, swap=True, refine=refine)
+        if not plan.solved:
+            rows.append((f"{scenario} rows {first_row}-{first_row + agents - 1}",
+                         f"NO: {plan.reason}", "-", "-", "-"))
+            continue
+        first, loss = plan.stats["first_sum_of_loss"], plan.stats["sum_of_loss"]
+        improved += loss < first
+        rows.append((f"{scenario} rows {first_row}-{first_row + agents - 1}", f"{first:,}",
+                     f"{loss:,}", f"{plan.stats['configurations']:,}",
+                     "yes" if loss < first else "no"))
+    return rows, improved
+
+
 def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[list[tuple],
                                                                               bool]:
-    """Part 4: (table rows, whether every call of a file did the same work and every solved
+    """Part 5: (table rows, whether every call of a file did the same work and every solved
     plan is valid)."""
     rows, same = [], True
     for scenario in files:
@@ -385,6 +462,17 @@ def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[l
     return rows, same
 
 
+def instance_list(parser: argparse.ArgumentParser, option: str,
+                  text: str) -> list[tuple[str, int]]:
+    """``[(map, agents), ...]`` of ``"MAP:AGENTS,..."``; the parser's error naming ``option``
+    otherwise."""
+    try:
+        return [(name, int(count)) for name, count in
+                (entry.split(":") for entry in text.split(","))]
+    except ValueError:
+        parser.error(f"{option}: expected MAP:AGENTS,..., got {text!r}")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Parse the options, run both parts, print the tables; 1 if a result is wrong."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -405,6 +493,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--pibt-steps", type=int, default=200, help="PIBT steps timed")
     parser.add_argument("--lacam", default=LACAM_INSTANCES,
                         help="LaCAM's instances, MAP:AGENTS comma-separated (random-1 scenarios)")
+    parser.add_argument("--refine", type=float, default=10.0,
+                        help="seconds of LaCAM*'s refinement per instance in part 4 (0: skip)")
+    parser.add_argument("--refine-instances", default=REFINE_INSTANCES,
+                        help="part 4's instances, MAP:AGENTS comma-separated (random-1 "
+                             "scenarios)")
     parser.add_argument("--cbs", default=CBS_FILES,
                         help="CBSH-RTC's scenario files, comma-separated (first 20 rows each)")
     parser.add_argument("--cbs-nodes", type=int, default=2000,
@@ -422,11 +515,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.quick:
         args.repeats, args.check_repeats, args.check_agents, args.check_steps = 2, 2, 200, 200
         args.pibt_steps, args.lacam = 20, "random-32-32-20:100"
+        args.refine, args.refine_instances = 1.0, "random-32-32-20:100"
         args.cbs_nodes, args.cbs_repeats = 200, 2
     for name in ("agents", "repeats", "check_agents", "check_repeats", "threads", "pibt_agents",
                  "pibt_steps", "cbs_nodes", "cbs_repeats"):
         if getattr(args, name) < 1:
             parser.error(f"--{name.replace('_', '-')} must be at least 1")
+    if not args.refine >= 0:
+        parser.error(f"--refine must be at least 0, got {args.refine}")
     if args.check_steps < 2:
         parser.error("--check-steps must be at least 2")
     orders = args.orders.split(",")
@@ -478,11 +574,8 @@ def main(argv: list[str] | None = None) -> int:
                    [(args.pibt_agents, f"{1e6 * step:.0f}", f"{1 / step:,.0f}",
                      f"{arrived} of {args.pibt_agents}",
                      "met" if 1e3 * step < GOAL_STEP_MS else "NOT met")], "rrrrl"))
-    try:
-        instances = [(name, int(count)) for name, count in
-                     (entry.split(":") for entry in args.lacam.split(","))]
-    except ValueError:
-        parser.error(f"--lacam: expected MAP:AGENTS,..., got {args.lacam!r}")
+    instances = instance_list(parser, "--lacam", args.lacam)
+    refine_instances = instance_list(parser, "--refine-instances", args.refine_instances)
     rows, lacam_ok = bench_lacam(mapf, instances)
     print(f"\nLaCAM, one call per instance after a warm-up on 2 agents, {args.threads} XLA "
           f"thread(s)\n")
@@ -490,6 +583,21 @@ def main(argv: list[str] | None = None) -> int:
                     "configurations", "SoC/bound", f"{GOAL_LACAM_S:g} s goal"), rows,
                    "lrllrrrrrl"))
     plans_ok &= lacam_ok
+    if args.refine > 0:
+        rows = bench_refinement(mapf, refine_instances, args.refine)
+        print(f"\nLaCAM* (swap) refining for {args.refine:g} s after its first solution: sum of "
+              f"costs / sum of loss over time, one call per instance\n")
+        print(markdown(("map", "agents", "first solution") + tuple(
+            f"after {at:g} s" for at in REFINE_CHECKPOINTS) + ("configurations", "optimal"),
+            rows, "lrrrrrrrl"))
+        rows, improved = bench_refinement_check(mapf, args.refine)
+        print(f"\nLaCAM* (swap) on five 100-agent instances of random-32-32-20, {args.refine:g} s "
+              f"of refinement each: sum of loss\n")
+        print(markdown(("instance", "first", "refined", "configurations", "lower"), rows,
+                       "lrrrl"))
+        print(f"\nGoal: below the first solution's sum of loss on at least {GOAL_REFINED} of "
+              f"{len(REFINE_CHECK)}: {'met' if improved >= GOAL_REFINED else 'NOT met'} "
+              f"({improved} of {len(REFINE_CHECK)}).")
     rows, cbs_ok = bench_cbs(mapf, args.cbs.split(","), args.cbs_nodes, args.cbs_repeats)
     print(f"\nCBSH-RTC, stopped after {args.cbs_nodes:,} nodes: median of {args.cbs_repeats} "
           f"calls after a warm-up on 3 agents\n")

@@ -174,11 +174,13 @@ LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (give
           "pymapf lacam": "pymapf LaCAM",
           "pymapf cbs": "pymapf CBS"}
 PUBLISHED = (
-    ("LaCAM (Okumura, AAAI 2023; the lacam2 README)", "random-32-32-20", 400, "about 0.031 s"),
+    ("LaCAM* (Okumura, IJCAI 2023): its code's README, Kei18/lacam2, first solution on random "
+     "starts and goals", "random-32-32-20", 400, "about 0.031 s"),
     ("LaCAM* (Okumura, IJCAI 2023, arXiv 2305.03632)", "the MAPF benchmark", "up to 1,000",
      "99 % of instances solved within 10 s"),
 )
-"""Published LaCAM figures on the same benchmark (C++ implementations, their machines)."""
+"""Published LaCAM* figures on the same benchmark (C++ implementations, their machines), set
+beside our ``lacam_star`` (LaCAM*'s swap generator, its first solution)."""
 
 
 class InvalidPlan(RuntimeError):
@@ -568,16 +570,17 @@ def summary_markdown(summary: list[dict], rows: list[dict]) -> str:
 
 
 def published_markdown(rows: list[dict]) -> list[str]:
-    """The published LaCAM figures (:data:`PUBLISHED`) beside ours on the same instances."""
-    ours = [row for row in rows if row["planner"] == "lacam"]
+    """The published LaCAM* figures (:data:`PUBLISHED`) beside our ``lacam_star`` on the same
+    maps (on random-32-32-20, the 400 agents of its random scenario file)."""
+    ours = [row for row in rows if row["planner"] == "lacam_star"]
     dense = [row for row in ours if (row["map"], row["scenario"], row["agents"])
              == ("random-32-32-20", "random", 400)]
     first = "-" if not dense else (f"{dense[0]['seconds']:.2f} s"
                                    + ("" if dense[0]["solved"] else " (not solved)"))
     quick = sum(bool(row["solved"]) and row["seconds"] <= 10.0 for row in ours)
     second = f"{quick} of {len(ours)} runs solved within 10 s" if ours else "-"
-    return ["| published | instances | agents | published figure | ours (jaxswarm's LaCAM, "
-            "this run) |", "| --- | --- | --- | --- | --- |"] + [
+    return ["| published | instances | agents | published figure | ours (jaxswarm's "
+            "lacam_star, this run) |", "| --- | --- | --- | --- | --- |"] + [
         f"| {who} | {where} | {agents} | {figure} | {value} |"
         for (who, where, agents, figure), value in zip(PUBLISHED, (first, second))]
 

@@ -14,23 +14,29 @@ only after it has explored them all.
 
 LaCAM* (``refine``) keeps searching after the first solution, for a time budget: every
 configuration keeps its neighbours and its cost from the starts, where one step costs the number
-of agents not resting at their goals through it (the "sum of loss"); a configuration reached
-again by a cheaper way passes the saving on to everything found from it (a Dijkstra update), and
-configurations that cannot beat the best solution found are dropped. When the search runs out,
-the solution is optimal in that cost (``stats["optimal"]``). LaCAM*'s other change, its
-successor generator (``swap``: PIBT with the swap operation, which lets two agents meeting head
-on in a corridor trade places where it widens), is a switch of its own.
+of agents not resting at their goals through it (the "sum of loss");
+a configuration reached again by a cheaper way passes the saving on to everything found from it
+(a Dijkstra update, :mod:`jaxswarm.multiagent.explored`), and each configuration whose cost falls
+below the best solution's is searched again (pushed back on the open stack, as the reference
+implementation does), while configurations that cannot beat the best solution are dropped. With a
+small probability a configuration generated again is replaced on the stack by the starts' (the
+reference implementation's random restart). When the search runs out, no solution of a smaller
+sum of loss exists (``stats["optimal"]``); the sum of costs, which also counts the steps an agent
+rests at its goal before it leaves it again, may be above its least. LaCAM*'s other change,
+its successor generator (``swap``: PIBT with the swap operation, which lets two agents meeting
+head on in a corridor trade places where it widens), is a switch of its own.
 """
 from __future__ import annotations
 
 import collections
 import dataclasses
-import heapq
+import numbers
 import time
 
 import numpy as np
 
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
+from jaxswarm.multiagent.explored import NONE, Explored
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
@@ -50,22 +56,22 @@ class _Constraint:
         return len(self.who)
 
 
-@dataclasses.dataclass(eq=False)
-class _Configuration:
-    """A high-level node: a configuration, how it was reached and its constraint tree."""
+@dataclasses.dataclass
+class _Tree:
+    """A configuration's agents by priority (i32[A]) and the constraints of its tree not taken
+    yet (breadth first); made when the configuration is first expanded."""
 
-    nodes: np.ndarray
-    parent: "_Configuration | None"
-    priorities: np.ndarray
     order: np.ndarray
-    cost: int
-    bound: int
-    tree: collections.deque
-    neighbours: list = dataclasses.field(default_factory=list)
+    constraints: collections.deque
+
+
+_UNBOUNDED = np.iinfo(np.int64).max
+"""The limit of the Dijkstra update before any solution is known."""
 
 
 def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: float = 0.0,
-          swap: bool = False, max_configurations: int = 10_000_000, seed: int = 0) -> Plan:
+          swap: bool = False, max_configurations: int = 10_000_000, seed: int = 0,
+          restart_rate: float = 0.001) -> Plan:
     """LaCAM, and with ``refine`` and ``swap`` LaCAM*.
 
     Args:
@@ -78,7 +84,12 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
       swap: LaCAM*'s successor generator: PIBT with the swap operation
         (:func:`~jaxswarm.multiagent.pibt.configuration`), for corridors.
       max_configurations: give up after this many configurations.
-      seed: the key of PIBT's tie-breaks and of the constraint trees' order.
+      seed: the key of PIBT's tie-breaks and of the constraint trees' order (at least 0).
+      restart_rate: LaCAM*'s random restarts while refining: when a known configuration is
+        generated again, the starts' configuration is pushed in its place with this
+        probability (the reference implementation's ``--restart_rate``, Kei18/lacam2, and its
+        default), so that the search does not stay deep in one branch. The first solution is
+        found without restarts, as LaCAM's.
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``lacam``, or ``lacam_star``
@@ -86,14 +97,19 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
       agent's goal cannot be reached (naming it), when every configuration reachable from the
       starts was explored without reaching the goals (a proof that there is no solution), or at
       a limit. ``stats``: ``configurations`` (high-level nodes), ``field_seconds`` (the distance
-      fields), ``seconds`` (the search), ``first_soc`` and ``optimal`` (with ``refine``).
+      fields), ``seconds`` (the search); with ``refine``, ``first_soc`` and
+      ``first_sum_of_loss`` (the first solution's sum of costs and sum of loss),
+      ``sum_of_loss`` (the solution's), ``improvements`` (``(seconds after the first
+      solution, sum of loss, sum of costs)`` of every better solution, in order) and ``optimal``:
+      true only when the search ran out, so that no solution of a smaller sum of loss exists.
 
     Raises:
-      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or limit.
+      TypeError: a limit, ``seed`` or ``swap`` of the wrong type (naming it).
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or a
+        limit out of its range (naming it).
     """
-    if time_limit <= 0 or refine < 0 or max_configurations < 1:
-        raise ValueError("time_limit must be positive, refine at least 0 and max_configurations "
-                         f"at least 1; got {time_limit}, {refine}, {max_configurations}")
+    _check_options(time_limit=time_limit, refine=refine, swap=swap,
+                   max_configurations=max_configurations, seed=seed, restart_rate=restart_rate)
     name = "lacam_star" if swap else "lacam"
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
@@ -104,7 +120,7 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
     if blocked is not None:
         return Plan(*waiting, solved=False, planner=name, reason=blocked[1], agent=blocked[0],
                     stats=dict(stats, configurations=0, seconds=0.0))
-    search = _Search(Moves.build(graph, goal_nodes, fields), seed, swap)
+    search = _Search(Moves.build(graph, goal_nodes, fields), seed, swap, restart_rate)
     found, why = search.run(start_nodes, deadline=began + time_limit, refine=refine,
                             max_configurations=max_configurations)
     stats |= search.stats(refine > 0)
@@ -115,134 +131,157 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
                 stats=stats)
 
 
+def _check_options(*, time_limit, refine, swap, max_configurations, seed, restart_rate):
+    """Refuse, naming it, an option of :func:`lacam` of the wrong type or out of its range."""
+    for name, value in (("time_limit", time_limit), ("refine", refine),
+                        ("restart_rate", restart_rate)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real):
+            raise TypeError(f"{name} must be a number, got {value!r}")
+    for name, value in (("max_configurations", max_configurations), ("seed", seed)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            raise TypeError(f"{name} must be an integer, got {value!r}")
+    if not isinstance(swap, (bool, np.bool_)):
+        raise TypeError(f"swap must be True or False, got {swap!r}")
+    if not time_limit > 0:
+        raise ValueError(f"time_limit must be positive, got {time_limit}")
+    if not refine >= 0:
+        raise ValueError(f"refine must be at least 0, got {refine}")
+    if not 0 <= restart_rate <= 1:
+        raise ValueError(f"restart_rate must be between 0 and 1, got {restart_rate}")
+    if max_configurations < 1:
+        raise ValueError(f"max_configurations must be at least 1, got {max_configurations}")
+    if seed < 0:
+        raise ValueError(f"seed must be at least 0, got {seed}")
+
+
 class _Search:
     """One LaCAM (or LaCAM*) search over an instance's configurations."""
 
-    def __init__(self, moves: Moves, seed: int, swap: bool):
+    def __init__(self, moves: Moves, seed: int, swap: bool, restart_rate: float):
         self.moves = moves
         self.swap = swap
+        self.restart_rate = restart_rate
         self.work = Workspace(moves, seed)
         self.rng = np.random.default_rng(seed)
-        self.explored: dict[bytes, _Configuration] = {}
+        self.explored = Explored(moves.goals)
+        self.agents = np.arange(len(moves.goals))
+        self.priorities: list[np.ndarray] = []  # f64[A] of each configuration, by id
+        self.trees: list[_Tree | None] = []  # by id
         self.began = time.perf_counter()
         self.first_soc: int | None = None
+        self.first_loss: int | None = None
+        self.loss: int | None = None
+        self.improvements: list[tuple[float, int, int]] = []
         self.optimal = False
 
     def stats(self, refining: bool) -> dict:
         """The search's statistics (see :func:`lacam`)."""
-        out = dict(configurations=len(self.explored),
+        out = dict(configurations=self.explored.size,
                    seconds=time.perf_counter() - self.began)
         if refining and self.first_soc is not None:
-            out |= dict(first_soc=self.first_soc, optimal=self.optimal)
+            out |= dict(first_soc=self.first_soc, first_sum_of_loss=self.first_loss,
+                        sum_of_loss=self.loss, improvements=self.improvements,
+                        optimal=self.optimal)
         return out
 
     def run(self, starts: np.ndarray, *, deadline: float, refine: float,
             max_configurations: int) -> tuple[list | None, str]:
         """``(configurations from the starts to the goals, "")``, or ``(None, why not)``."""
         goals = self.moves.goals
-        priorities = initial_priorities(self.moves, starts)
-        root = self._add(starts, None, priorities)
+        explored = self.explored
+        root = self._add(starts, NONE, initial_priorities(self.moves, starts))
         open_ = [root]
-        goal: _Configuration | None = None
+        goal = NONE
+        found_at = 0.0
         while open_:
-            if time.perf_counter() > deadline or len(self.explored) >= max_configurations:
+            if time.perf_counter() > deadline or explored.size >= max_configurations:
                 break
             node = open_[-1]
-            if goal is not None and node.cost + node.bound >= goal.cost:
+            if not self._promising(node, goal):
                 open_.pop()
                 continue
-            if goal is None and np.array_equal(node.nodes, goals):
+            if goal == NONE and np.array_equal(explored.nodes[node], goals):
                 goal = node
-                self.first_soc = _soc(_backtrack(goal), goals)
+                self.first_soc = _soc(explored.way(goal), goals)
+                self.first_loss = int(explored.cost[goal])
                 if refine <= 0:
-                    return _backtrack(goal), ""
-                deadline = time.perf_counter() + refine
+                    return explored.way(goal), ""
+                found_at = time.perf_counter()
+                deadline = found_at + refine
                 continue
-            if not node.tree:
+            tree = self.trees[node]
+            if tree is None:
+                tree = self.trees[node] = _Tree(by_priority(self.priorities[node]),
+                                                collections.deque([_Constraint((), ())]))
+            if not tree.constraints:
                 open_.pop()
                 continue
-            constraint = node.tree.popleft()
-            if constraint.depth < len(node.nodes):
-                self._grow(node, constraint)
-            following = self._successor(node, constraint)
+            constraint = tree.constraints.popleft()
+            if constraint.depth < len(goals):
+                self._grow(node, tree, constraint)
+            following = self._successor(node, tree, constraint)
             if following is None:
                 continue
-            known = self.explored.get(following.tobytes())
-            if known is None:
+            known = explored.find(following)
+            if known == NONE:
                 child = self._add(following, node,
-                                  next_priorities(node.priorities, following == goals))
-                node.neighbours.append(child)
-                open_.append(child)
+                                  next_priorities(self.priorities[node], following == goals))
+                if self._promising(child, goal):
+                    open_.append(child)
                 continue
-            node.neighbours.append(known)
             if refine > 0:
-                self._rewire(node)
-            open_.append(known)
-        if goal is not None:
+                limit = explored.cost[goal] if goal != NONE else _UNBOUNDED
+                again = explored.connect(node, known, limit)
+                if goal != NONE:
+                    open_.extend(again.tolist())
+                    if explored.cost[goal] < limit:
+                        self.improvements.append((time.perf_counter() - found_at,
+                                                  int(explored.cost[goal]),
+                                                  _soc(explored.way(goal), goals)))
+                    if self.rng.random() < self.restart_rate:
+                        known = root
+            if self._promising(known, goal):
+                open_.append(known)
+        if goal != NONE:
             self.optimal = not open_
-            return _backtrack(goal), ""
+            self.loss = int(explored.cost[goal])
+            return explored.way(goal), ""
         if not open_:
             return None, ("no solution: every configuration reachable from the starts "
-                          f"({len(self.explored)}) was explored")
+                          f"({explored.size}) was explored")
         if time.perf_counter() > deadline:
-            return None, f"reached the time limit after {len(self.explored)} configurations"
+            return None, f"reached the time limit after {explored.size} configurations"
         return None, f"reached the limit of {max_configurations} configurations"
 
-    def _add(self, nodes: np.ndarray, parent: _Configuration | None,
-             priorities: np.ndarray) -> _Configuration:
-        goals = self.moves.goals
-        cost = 0 if parent is None else parent.cost + _step_cost(parent.nodes, nodes, goals)
-        bound = int(self.moves.fields[np.arange(len(nodes)), nodes].sum())
-        node = _Configuration(nodes=nodes, parent=parent, priorities=priorities,
-                              order=by_priority(priorities), cost=cost, bound=bound,
-                              tree=collections.deque([_Constraint((), ())]))
-        self.explored[nodes.tobytes()] = node
-        return node
+    def _promising(self, node: int, goal: int) -> bool:
+        """Whether ``node`` may still lead to a solution cheaper than ``goal``'s (always, while
+        no solution is known)."""
+        explored = self.explored
+        return goal == NONE or explored.cost[node] + explored.bound[node] < explored.cost[goal]
 
-    def _grow(self, node: _Configuration, constraint: _Constraint) -> None:
+    def _add(self, nodes: np.ndarray, parent: int, priorities: np.ndarray) -> int:
+        self.priorities.append(priorities)
+        self.trees.append(None)
+        return self.explored.add(nodes, parent, int(self.moves.fields[self.agents, nodes].sum()))
+
+    def _grow(self, node: int, tree: "_Tree", constraint: _Constraint) -> None:
         """Add the children of ``constraint``: the next agent's candidates, keyed order."""
-        agent = int(node.order[constraint.depth])
-        here = int(node.nodes[agent])
+        agent = int(tree.order[constraint.depth])
+        here = int(self.explored.nodes[node, agent])
         moves = self.moves
         options = np.append(moves.heads[moves.indptr[here]:moves.indptr[here + 1]], here)
         for v in self.rng.permutation(options).tolist():
-            node.tree.append(_Constraint(constraint.who + (agent,), constraint.where + (v,)))
+            tree.constraints.append(_Constraint(constraint.who + (agent,),
+                                                constraint.where + (v,)))
 
-    def _successor(self, node: _Configuration, constraint: _Constraint) -> np.ndarray | None:
-        following = np.empty_like(node.nodes)
-        ok = configuration(self.moves, self.work, node.nodes, node.order,
+    def _successor(self, node: int, tree: "_Tree",
+                   constraint: _Constraint) -> np.ndarray | None:
+        current = self.explored.nodes[node]
+        following = np.empty_like(current)
+        ok = configuration(self.moves, self.work, current, tree.order,
                            np.array(constraint.who, np.int32),
                            np.array(constraint.where, np.int32), following, swap=self.swap)
         return following if ok else None
-
-    def _rewire(self, start: _Configuration) -> None:
-        """LaCAM*'s Dijkstra update from ``start`` over the known neighbours: every
-        configuration reached more cheaply through it takes it as parent."""
-        goals = self.moves.goals
-        queue = [(start.cost, id(start), start)]
-        while queue:
-            cost, _, node = heapq.heappop(queue)
-            if cost > node.cost:
-                continue
-            for other in node.neighbours:
-                through = node.cost + _step_cost(node.nodes, other.nodes, goals)
-                if through < other.cost:
-                    other.cost, other.parent = through, node
-                    heapq.heappush(queue, (through, id(other), other))
-
-
-def _step_cost(before: np.ndarray, after: np.ndarray, goals: np.ndarray) -> int:
-    """Agents not resting at their goals through one step (LaCAM*'s sum of loss)."""
-    return int(np.count_nonzero((before != goals) | (after != goals)))
-
-
-def _backtrack(node: _Configuration) -> list:
-    """The configurations from the starts to ``node``."""
-    out = []
-    while node is not None:
-        out.append(node.nodes)
-        node = node.parent
-    return out[::-1]
 
 
 def _soc(configurations: list, goals: np.ndarray) -> int:
