@@ -181,6 +181,8 @@ def test_a_combination_is_the_grid_s_without_building_the_grid():
     values = spec.combination_values(np.arange(len(grid)))
     for name in spec.params:
         np.testing.assert_array_equal(values[name], [combination[name] for combination in grid])
+    unswept = spec_from_dict({**sweep_document(), "params": {}})
+    assert unswept.grid() == [{}] and unswept.combination_values(np.arange(3)) == {}
 
 
 @pytest.mark.parametrize("changes, message", [

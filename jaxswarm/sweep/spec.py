@@ -122,6 +122,8 @@ class SweepSpec:
     def combination_values(self, combinations: np.ndarray) -> dict[str, np.ndarray]:
         """Each swept param's value in combinations ``combinations`` (int[C], positions in
         :meth:`grid`), name -> f64[C], without building the grid."""
+        if not self.params:  # one combination, of no param (unravel_index takes no 0-d shape)
+            return {}
         places = np.unravel_index(np.asarray(combinations, np.int64),
                                   [len(values) for values in self.params.values()])
         return {name: np.asarray(values, np.float64)[place]
