@@ -45,6 +45,8 @@ from jaxswarm.multiagent import (ORDERS, PLANNERS, UNREACHABLE, load_instance, l
                                  validate)
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, registry, run
+from jaxswarm.sweep.spec import DEFAULT_MAX_RUNS
+from jaxswarm.tune.spec import HELD_OUT_SETTINGS
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, path_length
 
@@ -192,6 +194,24 @@ def _add_sweep_parser(subparsers) -> None:
     sweep.add_argument("--out", type=Path, help="results directory (default out/sweeps/NAME)")
     sweep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sweep.add_argument("--no-plots", action="store_true", help="write no figures")
+    _add_max_runs(sweep, "maps x param combinations x seeds")
+
+
+def _add_max_runs(command, counted: str) -> None:
+    """The ``--max-runs`` option of a command whose spec makes ``counted`` runs."""
+    command.add_argument("--max-runs", type=_positive_count, default=DEFAULT_MAX_RUNS,
+                         help=f"refuse a spec of more runs than this ({counted}; default "
+                              f"{DEFAULT_MAX_RUNS:,}), before anything is built")
+
+
+def _positive_count(text: str) -> int:
+    try:
+        count = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {count}")
+    return count
 
 
 def _add_tune_parser(subparsers) -> None:
@@ -206,6 +226,8 @@ def _add_tune_parser(subparsers) -> None:
                     "held_out.csv and best.json.")
     tune.add_argument("file", type=Path, help="the tune spec (TOML)")
     tune.add_argument("--out", type=Path, help="tune directory (default out/tune/NAME)")
+    _add_max_runs(tune, f"the budget and up to {HELD_OUT_SETTINGS} settings on each held-out "
+                        "instance")
 
 
 def _add_replay_parser(subparsers) -> None:
@@ -246,13 +268,15 @@ def run_replay(args: argparse.Namespace) -> int:
 def run_sweep_command(args: argparse.Namespace) -> int:
     """Check the spec (before any compute), run or resume the sweep, plot, print a summary."""
     from jaxswarm.sweep import default_out, load_spec, run_sweep
+    from jaxswarm.sweep.runner import check_folder
     from jaxswarm.plot.sweep import plot_sweep, summary
 
-    spec = load_spec(args.file)
+    spec = load_spec(args.file, max_runs=args.max_runs)
     out = args.out if args.out is not None else default_out(spec)
-    print(f"sweep {spec.name}: {spec.algorithm}, {len(spec.maps)} map(s) x {len(spec.grid())} "
-          f"param combination(s) x {len(spec.seeds)} seed(s) = {spec.num_runs * len(spec.maps)} "
-          f"runs -> {out}")
+    check_folder(out, "--out")
+    print(f"sweep {spec.name}: {spec.algorithm}, {len(spec.maps)} map(s) x "
+          f"{spec.num_combinations} param combination(s) x {len(spec.seeds)} seed(s) = "
+          f"{spec.num_runs * len(spec.maps)} runs -> {out}")
     frame = run_sweep(spec, out, progress=not args.no_progress)
     swept = list(spec.params)
     if swept and not args.no_plots:
@@ -271,10 +295,12 @@ def run_tune_command(args: argparse.Namespace) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
+    from jaxswarm.sweep.runner import check_folder
     from jaxswarm.tune import default_tune_out, load_tune_spec, tune
 
-    spec = load_tune_spec(args.file)
+    spec = load_tune_spec(args.file, max_runs=args.max_runs)
     out = args.out if args.out is not None else default_tune_out(spec)
+    check_folder(out, "--out")
     print(f"tune {spec.name}: {spec.algorithm} by {spec.method}, {len(spec.space.free)} "
           f"param(s), {spec.budget} training runs on {len(spec.training.pairs)} instance(s), "
           f"objective {spec.objective} -> {out}")

@@ -30,6 +30,7 @@ from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.fingerprint import run_fingerprint
 from jaxswarm.swarm.walking import LANES
 from jaxswarm.sweep.maps import SweepMap
+from jaxswarm.sweep.spec import SEED_LIMIT
 
 SUCCESS_GAP = 1e-4
 """A run succeeds when its relative gap to the optimum is below this."""
@@ -97,9 +98,10 @@ class RunBatches:
 
     def run(self, sweep_map: SweepMap, seeds: np.ndarray, params: dict[str, np.ndarray],
             optimum: float = np.inf) -> dict[str, np.ndarray]:
-        """Run ``seeds`` (i64[C]) with ``params`` (name -> f64[C]; params not named keep the
-        swarm's defaults) on ``sweep_map``, whose optimum is ``optimum``
-        (:meth:`~jaxswarm.sweep.maps.SweepMap.optimum`), ``chunk_size`` runs a call.
+        """Run ``seeds`` (int[C], each in ``[0, SEED_LIMIT)``) with ``params`` (name -> f64[C];
+        params not named keep the swarm's defaults) on ``sweep_map``, whose optimum is
+        ``optimum`` (:meth:`~jaxswarm.sweep.maps.SweepMap.optimum`), ``chunk_size`` runs a
+        call.
 
         Returns:
           name -> array[C]: ``cost`` (f64, inf without a path), ``iterations`` (i32, used),
@@ -109,7 +111,14 @@ class RunBatches:
           until the best cost was within :data:`SUCCESS_GAP` of ``optimum``, the rule of
           :func:`jaxswarm.dynamic.events.first_iteration_at`; -1 where it never was), and
           ``seconds`` (f64: the wall time of the call the run was part of, compile excluded).
+
+        Raises:
+          ValueError: a seed outside ``[0, SEED_LIMIT)``, where seeds give distinct keys.
         """
+        seeds = np.asarray(seeds)
+        if seeds.size and (seeds.min() < 0 or seeds.max() >= SEED_LIMIT):
+            raise ValueError(f"seeds must be integers from 0 to {SEED_LIMIT - 1} (2^32 - 1), "
+                             f"got {seeds.min()} to {seeds.max()}")
         count = len(seeds)
         stacked = _stacked_params(self.swarm.default_params, params, count)
         world, task = jax.device_put(
@@ -120,7 +129,7 @@ class RunBatches:
         for first in range(0, count, self.chunk_size):
             size = min(self.chunk_size, count - first)
             index = np.minimum(np.arange(first, first + self.call_size(size)), count - 1)
-            inputs = self._sharded((np.asarray(seeds)[index].astype(np.int32),
+            inputs = self._sharded((seeds[index].astype(np.uint32),
                                     jax.tree_util.tree_map(lambda leaf: leaf[index], stacked)))
             outputs, seconds = self._call(sweep_map, inputs, world, task, target)
             parts.append({name: value[:size] for name, value in outputs.items()}
@@ -142,7 +151,7 @@ class RunBatches:
 
     def _call(self, sweep_map: SweepMap, inputs, world, task,
               target) -> tuple[dict[str, np.ndarray], float]:
-        """One compiled call on ``inputs`` (seeds i32[C], params with leaves f32[C], sharded
+        """One compiled call on ``inputs`` (seeds u32[C], params with leaves f32[C], sharded
         over the runs axis): ``(outputs, seconds)``, :data:`OUTPUTS` as host arrays, made again
         with room for every move where a walk overflowed its log, and the call's wall time (the
         first compile for the map's shape excluded)."""
@@ -182,7 +191,7 @@ class RunBatches:
 
 
 def _program(swarm, iterations: int, patience: int | None, mesh: Mesh, group: int):
-    """The jitted call: ``(seeds i32[C], params with leaves f32[C], world, task, optimum f32[])
+    """The jitted call: ``(seeds u32[C], params with leaves f32[C], world, task, optimum f32[])
     -> {output: [C, ...]}`` (:data:`OUTPUTS` and ``overflowed``), C a multiple of the mesh
     size, the runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs
     ``group`` at a time."""

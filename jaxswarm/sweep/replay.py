@@ -9,13 +9,16 @@ rules). :func:`replay_row` runs the row once, alone, and compares its figures wi
 ones, bit for bit: for a store cost, iterations, moves, evaluations and the fingerprint of the
 final state and trace (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`); for a table cost and
 fingerprint. The replay holds the run's state, so its memory and best path can be drawn
-(:func:`jaxswarm.plot.sweep.plot_replay`); ``jaxswarm replay STORE ROW`` does both.
+(:func:`jaxswarm.plot.sweep.plot_replay`); ``jaxswarm replay STORE ROW`` does both. A row is
+checked before it runs: a tune's store, or a row whose figures are not a finished run's (NaN, a
+missing value), is refused with the store, the row and the column named.
 """
 from __future__ import annotations
 
 import dataclasses
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +31,7 @@ from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import Swarm, Task, Trace
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep.maps import SweepMap, resolve_map
-from jaxswarm.sweep.spec import spec_from_record
+from jaxswarm.sweep.spec import SEED_LIMIT, spec_from_record
 from jaxswarm.sweep.store import read_results
 
 CHECKED = ("cost", "iterations", "moves", "evaluations", "fingerprint")
@@ -86,20 +89,29 @@ def replay_row(store, row: int) -> Replayed:
         in ``runs.csv``.
 
     Raises:
-      ValueError: ``store`` is neither, ``row`` is not one of its rows, or a table's row has no
-        run record.
+      ValueError: ``store`` is neither (a tune's store among them), ``row`` is not one of its
+        rows, a table's row has no run record, or a figure or input of the row is not a
+        finished run's (NaN, missing); each before the run.
     """
     store = Path(store)
     if not (store / "metadata.json").is_file() and (store / "runs.csv").is_file():
         return _replay_table_row(store / "runs.csv", row)
     metadata_path = store / "metadata.json"
+    if not metadata_path.is_file():
+        raise ValueError(f"{store} is not a sweep store (it has no metadata.json), nor a "
+                         "results folder with a runs.csv")
+    record = _sweep_record(metadata_path)
     frame = read_results(store)
-    if not metadata_path.is_file() or frame.empty:
-        raise ValueError(f"{store} is not a sweep store with finished rows, nor a results "
-                         "folder with a runs.csv")
+    if frame.empty:
+        raise ValueError(f"{store} is a sweep store without finished rows yet")
     stored = _stored_row(frame, row, store)
-    spec = spec_from_record(json.loads(metadata_path.read_text())["spec"],
-                            source=str(metadata_path))
+    spec = spec_from_record(record, source=str(metadata_path))
+    source = f"{store} row {row}"
+    _check_integer(stored, "map_index", range(len(spec.maps)), source)
+    _check_integer(stored, "seed", range(SEED_LIMIT), source)
+    for name in spec.params:
+        _check_number(stored, name, source, finite=True)
+    _check_figures(stored, CHECKED, source)
     swarm = make(spec.algorithm, **spec.config)
     params = swarm.params_with(**{name: stored[name] for name in spec.params})
     return _replayed(stored, swarm, params, resolve_map(spec.maps[int(stored["map_index"])]),
@@ -117,8 +129,72 @@ def _replay_table_row(table: Path, row: int) -> Replayed:
                          "replayable")
     stored = _stored_row(frame, row, table)
     record = read_run_record(stored["run_record"], source=f"{table} row {row}")
+    _check_figures(stored, TABLE_CHECKED, f"{table} row {row}")
     return _replayed(stored, record.swarm, record.params, resolve_map(record.entry), record.key,
                      record.iterations, record.patience, TABLE_CHECKED)
+
+
+def _sweep_record(metadata_path: Path) -> dict:
+    """The sweep spec a store's ``metadata.json`` records, or a ValueError naming the file:
+    unreadable JSON, a tune's store (its spec names a method and training instances), or no
+    spec."""
+    try:
+        metadata = json.loads(metadata_path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise ValueError(f"{metadata_path}: cannot be read as JSON ({error})") from None
+    record = metadata.get("spec") if isinstance(metadata, dict) else None
+    if isinstance(record, dict) and "training" in record and "method" in record:
+        raise ValueError(f"{metadata_path.parent} is a tune's store (jaxswarm tune), not a "
+                         "sweep's: replay takes a sweep's store or a results folder with a "
+                         "runs.csv")
+    needed = ("name", "algorithm", "maps", "seeds", "iterations", "chunk_size", "config",
+              "params")
+    missing = [key for key in needed if not isinstance(record, dict) or key not in record]
+    if missing:
+        raise ValueError(f"{metadata_path}: holds no sweep spec (\"spec\" lacks "
+                         f"{', '.join(missing)})")
+    return record
+
+
+def _check_figures(stored: dict, checked: tuple[str, ...], source: str) -> None:
+    """The stored figures a replay compares are a finished run's: ``cost`` a number (inf for
+    no path, never NaN), the counts non-negative integers, the fingerprint 16 hex digits."""
+    for name in checked:
+        if name == "cost":
+            _check_number(stored, name, source, finite=False)
+        elif name == "fingerprint":
+            value = stored.get(name)
+            if not isinstance(value, str) or not re.fullmatch(r"[0-9a-f]{16}", value):
+                raise ValueError(f"{source}: {name} is {value!r}, not 16 hex digits: not a "
+                                 "finished run's figure, so the row cannot be replayed")
+        else:
+            _check_integer(stored, name, None, source)
+
+
+def _check_number(stored: dict, name: str, source: str, *, finite: bool) -> None:
+    """``stored[name]`` is a number, not NaN (and finite when ``finite``)."""
+    value = stored.get(name)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if math.isnan(number) or (finite and math.isinf(number)):
+        raise ValueError(f"{source}: {name} is {value!r}, not a finished run's value, so the "
+                         "row cannot be replayed")
+
+
+def _check_integer(stored: dict, name: str, allowed: range | None, source: str) -> None:
+    """``stored[name]`` is a non-negative integer (in ``allowed`` when given)."""
+    value = stored.get(name)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not number.is_integer() or number < 0 or (allowed is not None
+                                                 and int(number) not in allowed):
+        where = "" if allowed is None else f" in {allowed.start} to {allowed.stop - 1}"
+        raise ValueError(f"{source}: {name} is {value!r}, not an integer{where} of a finished "
+                         "run, so the row cannot be replayed")
 
 
 def _stored_row(frame: pd.DataFrame, row: int, source: Path) -> dict:

@@ -21,7 +21,9 @@ Each map's optimum is measured as the swarms measure their paths (Dijkstra's pat
 :func:`jaxswarm.exact.visibility.shortest_path`), so every row carries its optimality gap, never
 negative.
 Finished chunks go to the :class:`~jaxswarm.sweep.store.ResultsStore`; running the same spec again
-skips them.
+skips them. After the first chunk it runs, a sweep logs how long the rest will take at that
+chunk's pace. The param combinations are never built as a whole: a chunk's values are computed
+from its runs' numbers (:meth:`~jaxswarm.sweep.spec.SweepSpec.combination_values`).
 """
 from __future__ import annotations
 
@@ -46,7 +48,6 @@ from jaxswarm.sweep.batches import RunBatches, run_outcomes
 from jaxswarm.sweep.maps import SweepMap, file_digests, resolve_maps
 from jaxswarm.sweep.spec import SweepSpec
 from jaxswarm.sweep.store import ResultsStore, read_results
-
 
 
 def default_out(spec: SweepSpec) -> Path:
@@ -76,10 +77,12 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
       time of its own).
 
     Raises:
-      ValueError: a map cannot be resolved (before any compute), or ``out`` holds another spec
-        or another definition of the swarm (:class:`~jaxswarm.sweep.store.StoreMismatchError`).
+      ValueError: ``out`` is a file or lies in one, a map cannot be resolved (both before any
+        compute), or ``out`` holds another spec or another definition of the swarm
+        (:class:`~jaxswarm.sweep.store.StoreMismatchError`).
     """
     out = Path(out) if out is not None else default_out(spec)
+    check_folder(out, "out")
     base_dir = Path(spec.source).parent if spec.source != "<dict>" else None
     # Every entry checked before anything is written.
     maps = resolve_maps(spec.maps, "sweep.maps", spec.source, base_dir)
@@ -87,13 +90,67 @@ def run_sweep(spec: SweepSpec, out=None, *, progress: bool = True,
     todo, finished_runs = _unfinished_chunks(chunks, len(maps), out)
     bar = tqdm(total=chunks.num_runs * len(maps), unit="run", disable=not progress,
                desc=spec.name, initial=finished_runs)
+    pace = _Pace(sum(len(chunks_of_map) for chunks_of_map in todo), log)
     try:
         for m, sweep_map in enumerate(maps):
             if todo[m]:
-                _run_map(chunks, m, sweep_map, todo[m], bar)
+                _run_map(chunks, m, sweep_map, todo[m], bar, pace)
     finally:
         bar.close()
     return read_results(out)
+
+
+def check_folder(path: Path, argument: str) -> None:
+    """``path`` is a folder or can be made one: neither it nor a folder above it is a file.
+
+    Raises:
+      ValueError: naming ``argument`` and the file in the way.
+    """
+    for place in (path, *path.parents):
+        if place.exists():
+            if not place.is_dir():
+                what = "is a file" if place == path else f"lies in {place}, a file"
+                raise ValueError(f"{argument}: {path} {what}, not a folder; name a folder for "
+                                 "the results")
+            return
+
+
+@dataclasses.dataclass
+class _Pace:
+    """The estimate a sweep logs after the first chunk it runs: the rest at that chunk's pace.
+
+    Attributes:
+      chunks: the chunks this call of the sweep has to run.
+      log: where the estimate goes.
+      done: whether it was logged.
+    """
+
+    chunks: int
+    log: Callable[[str], None]
+    done: bool = False
+
+    def first_chunk(self, runs: int, seconds: float) -> None:
+        """Log the estimate once, after a first chunk of ``runs`` runs that took ``seconds``
+        (compile excluded)."""
+        if self.done:
+            return
+        self.done = True
+        rest = self.chunks - 1
+        if rest > 0:
+            self.log(f"first chunk: {runs} runs in {seconds:.1f} s; the {rest:,} chunk(s) left "
+                     f"take about {_duration(rest * seconds)} at its pace (plus a compile per "
+                     "other map shape)")
+
+
+def _duration(seconds: float) -> str:
+    """``seconds`` as a rounded duration: ``"40 s"``, ``"12 min"``, ``"3.5 h"``, ``"2.1 days"``."""
+    if seconds < 120:
+        return f"{seconds:.0f} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 172800:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.1f} days"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -102,10 +159,8 @@ class _SweepChunks:
 
     Attributes:
       spec: the sweep.
-      grid: its param combinations (``spec.grid()``), P of them.
       seeds: int[S] its seeds.
-      num_runs: runs per map, P * S.
-      swept: each swept param's value in every run, name -> f64[P * S] (run ``r``'s at ``r``).
+      num_runs: runs per map, P * S for P param combinations.
       batches: the swarm's compiled runs (:class:`~jaxswarm.sweep.batches.RunBatches`).
       store: the results store.
       writer: whether this process writes the store (process 0).
@@ -113,10 +168,8 @@ class _SweepChunks:
     """
 
     spec: SweepSpec
-    grid: list
     seeds: np.ndarray
     num_runs: int
-    swept: dict
     batches: RunBatches
     store: ResultsStore
     writer: bool
@@ -137,12 +190,9 @@ def _set_up(spec: SweepSpec, maps: list[SweepMap], out: Path,
     store = ResultsStore(out, spec.as_dict(), _metadata(spec, maps, batches.swarm,
                                                         batches.group),
                          depends_on=file_digests(maps, "sweep.maps"), writer=writer)
-    grid = spec.grid()
-    seeds = np.asarray(spec.seeds)
-    swept = {name: np.repeat([combination[name] for combination in grid], len(seeds))
-             for name in spec.params}
-    return _SweepChunks(spec=spec, grid=grid, seeds=seeds, num_runs=spec.num_runs, swept=swept,
-                        batches=batches, store=store, writer=writer, log=log)
+    return _SweepChunks(spec=spec, seeds=np.asarray(spec.seeds, np.int64),
+                        num_runs=spec.num_runs, batches=batches, store=store, writer=writer,
+                        log=log)
 
 
 def _unfinished_chunks(chunks: _SweepChunks, num_maps: int, out: Path) -> tuple[list, int]:
@@ -160,37 +210,37 @@ def _unfinished_chunks(chunks: _SweepChunks, num_maps: int, out: Path) -> tuple[
 
 
 def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: list[int],
-             bar) -> None:
-    """Run the chunks ``todo`` of one map, write each to the store as it finishes and advance
-    the progress bar."""
+             bar, pace: _Pace) -> None:
+    """Run the chunks ``todo`` of one map, write each to the store as it finishes, advance
+    the progress bar and tell ``pace`` the first chunk's time."""
     spec = chunks.spec
     best = sweep_map.optimum()
     for c in todo:
         first = c * spec.chunk_size
         runs = np.arange(first, first + _chunk_runs(c, spec.chunk_size, chunks.num_runs))
-        outputs = chunks.batches.run(sweep_map, chunks.seeds[runs % len(chunks.seeds)],
-                                     {name: values[runs] for name, values in chunks.swept.items()},
+        swept = spec.combination_values(runs // len(chunks.seeds))
+        outputs = chunks.batches.run(sweep_map, chunks.seeds[runs % len(chunks.seeds)], swept,
                                      best)
-        rows = _rows(spec, chunks.grid, chunks.seeds, sweep_map.label, map_index, c, runs,
-                     outputs, best)
+        rows = _rows(spec, swept, chunks.seeds, sweep_map.label, map_index, c, runs, outputs,
+                     best)
         if chunks.writer:
             chunks.store.write_chunk(map_index, c, rows)
         bar.update(len(runs))
+        pace.first_chunk(len(runs), float(outputs["seconds"][0]))
 
 
 def _chunk_runs(chunk: int, chunk_size: int, num_runs: int) -> int:
     return min(chunk_size, num_runs - chunk * chunk_size)
 
 
-def _rows(spec: SweepSpec, grid, seeds, label, map_index, chunk, runs, outputs, best) -> dict:
-    """A chunk's rows (see :func:`run_sweep`) from its runs' outputs
-    (:meth:`~jaxswarm.sweep.batches.RunBatches.run`)."""
+def _rows(spec: SweepSpec, swept, seeds, label, map_index, chunk, runs, outputs, best) -> dict:
+    """A chunk's rows (see :func:`run_sweep`) from its runs' swept values (name -> f64[C]) and
+    outputs (:meth:`~jaxswarm.sweep.batches.RunBatches.run`)."""
     count = len(runs)
     rows = dict(map=[label] * count, map_index=np.full(count, map_index, np.int32),
                 run=runs.astype(np.int64), algorithm=[spec.algorithm] * count,
                 seed=seeds[runs % len(seeds)].astype(np.int64))
-    for name in spec.params:
-        rows[name] = np.array([grid[r // len(seeds)][name] for r in runs], np.float64)
+    rows.update(swept)
     cost = np.asarray(outputs["cost"], np.float64)
     rows.update(cost=cost, optimum=np.full(count, best), **run_outcomes(cost, best),
                 iterations=np.asarray(outputs["iterations"], np.int32),

@@ -29,12 +29,15 @@ scenario file ``{ movingai = "PATH.map", scenario = ROW, scenario_file = "even" 
 :mod:`jaxswarm.sweep.maps`; a relative PATH is looked up beside the spec, then in the folder
 ``$JAXSWARM_MOVINGAI`` names). Every mistake raises :class:`SpecError` naming the file and the
 key; a map whose file, scenario row, start or goal is wrong is named with its entry when the
-sweep starts, before anything is written.
+sweep starts, before anything is written. Seeds run from 0 to ``SEED_LIMIT - 1``, and a sweep of
+more than ``max_runs`` runs (``DEFAULT_MAX_RUNS``, a million, unless told otherwise) is refused
+before its grid is built.
 """
 from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -48,6 +51,14 @@ SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size",
               "vmap_size"}
 DEFAULT_CHUNK_SIZE = 64
+
+SEED_LIMIT = 2**32
+"""Seeds run from 0 to ``SEED_LIMIT - 1``: ``jax.random.key`` keeps the low 32 bits of a seed
+(64-bit integers are off), so seeds ``s`` and ``s + 2**32`` would be one key and one run."""
+
+DEFAULT_MAX_RUNS = 1_000_000
+"""Runs a sweep or a tune may ask for unless told otherwise (``max_runs``, ``--max-runs``): a spec
+asking for more is refused before anything is built."""
 
 
 class SpecError(ValueError):
@@ -99,9 +110,24 @@ class SweepSpec:
         return [dict(zip(names, values)) for values in itertools.product(*self.params.values())]
 
     @property
+    def num_combinations(self) -> int:
+        """Combinations of the swept params (1 when nothing is swept), counted, not built."""
+        return math.prod(len(values) for values in self.params.values())
+
+    @property
     def num_runs(self) -> int:
         """Runs per map: combinations x seeds."""
-        return len(self.grid()) * len(self.seeds)
+        return self.num_combinations * len(self.seeds)
+
+    def combination_values(self, combinations: np.ndarray) -> dict[str, np.ndarray]:
+        """Each swept param's value in combinations ``combinations`` (int[C], positions in
+        :meth:`grid`), name -> f64[C], without building the grid."""
+        if not self.params:  # one combination, of no param (unravel_index takes no 0-d shape)
+            return {}
+        places = np.unravel_index(np.asarray(combinations, np.int64),
+                                  [len(values) for values in self.params.values()])
+        return {name: np.asarray(values, np.float64)[place]
+                for (name, values), place in zip(self.params.items(), places)}
 
     def as_dict(self) -> dict:
         """JSON-ready form of what decides the rows (the store's metadata and its resume
@@ -113,63 +139,106 @@ class SweepSpec:
                     params={k: list(v) for k, v in self.params.items()})
 
 
-def load_spec(path) -> SweepSpec:
+def load_spec(path, *, max_runs: int | None = DEFAULT_MAX_RUNS) -> SweepSpec:
     """Read and check a sweep file (see the module docstring).
 
+    Args:
+      path: the TOML file (UTF-8).
+      max_runs: the most runs the sweep may make (maps x combinations x seeds); None: no limit.
+
     Raises:
-      SpecError: unreadable TOML, unknown section/key/algorithm/param/config/map, empty grid,
-        bad numbers; the message names the file and the key (and the line for TOML syntax).
+      SpecError: unreadable or non-UTF-8 file, bad TOML, unknown section/key/algorithm/param/
+        config/map, empty grid, bad numbers, seeds outside ``[0, SEED_LIMIT)``, more than
+        ``max_runs`` runs; the message names the file and the key (and the line for TOML syntax
+        and encoding).
     """
     path = Path(path)
+    document = read_toml(path, "sweep", SpecError)
+    return spec_from_dict(document, source=str(path), max_runs=max_runs)
+
+
+def read_toml(path: Path, kind: str, error_type: type[ValueError]) -> dict:
+    """The TOML document in the file ``path``, or ``error_type`` naming the file (and the line
+    of a syntax error or of a byte that is not UTF-8); ``kind`` names the file in messages
+    ("sweep", "tune")."""
     try:
-        text = path.read_text()
+        data = path.read_bytes()
     except OSError as error:
-        raise SpecError(f"{path}: cannot read the sweep file ({error.strerror})") from None
+        raise error_type(f"{path}: cannot read the {kind} file ({error.strerror})") from None
     try:
-        document = tomllib.loads(text)
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        raise error_type(f"{path}: line {line}: not UTF-8 text (byte 0x{data[error.start]:02x}); "
+                         "a TOML file is UTF-8") from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        raise SpecError(f"{path}: not valid TOML: {error}") from None
-    return spec_from_dict(document, source=str(path))
+        raise error_type(f"{path}: not valid TOML: {error}") from None
 
 
-def spec_from_dict(document: dict, *, source: str = "<dict>") -> SweepSpec:
+def spec_from_dict(document: dict, *, source: str = "<dict>",
+                   max_runs: int | None = DEFAULT_MAX_RUNS) -> SweepSpec:
     """Check a parsed spec (the TOML document as a dict); see :func:`load_spec`.
 
     The checks go in the order a reader meets the spec: the sections and the [sweep] keys, the
     algorithm and name, the maps, the seeds, the run options, [config] (and whether the maps
-    are the swarm's world), [params], and last every combination's values; the first mistake
-    raises.
+    are the swarm's world), [params], the number of runs (counted, not built, against
+    ``max_runs``), and last every combination's values; the first mistake raises.
     """
     def fail(key: str, problem: str):
         raise SpecError(f"{source}: {key}: {problem}")
 
+    check_max_runs(max_runs)
     sweep = _sweep_table(document, fail)
     algorithm, name = algorithm_and_name(sweep, fail)
     maps = check_maps(sweep["maps"], fail)
-    seeds = check_seeds(sweep["seeds"], fail)
+    seeds = check_seeds(sweep["seeds"], fail, most=max_runs)
     options = _run_options(sweep, fail)
     config = document.get("config", {})
     swarm = configured_swarm(algorithm, config, fail)
     check_map_worlds(maps, swarm, algorithm, fail)
     params = document.get("params", {})
-    checked = _params(params, swarm, algorithm, fail)
+    checked = _params(params, swarm, algorithm, fail, max_runs)
     spec = SweepSpec(name=name, algorithm=algorithm, maps=tuple(maps), seeds=seeds, **options,
                      config=dict(config), params=checked, source=source,
                      log_scale=frozenset(k for k, v in params.items()
                                          if isinstance(v, dict) and v.get("log", False)))
+    runs = len(spec.maps) * spec.num_runs
+    if max_runs is not None and runs > max_runs:
+        fail("sweep", f"{len(spec.maps)} map(s) x {spec.num_combinations:,} param "
+             f"combination(s) x {len(spec.seeds):,} seed(s) = {runs:,} runs, "
+             f"{too_many(max_runs)}")
     _check_grid(spec, swarm, fail)
     return spec
 
 
+def check_max_runs(max_runs: Any) -> None:
+    """``max_runs`` is a positive integer or None; else a TypeError or ValueError naming it."""
+    if max_runs is None:
+        return
+    if isinstance(max_runs, bool) or not isinstance(max_runs, int):
+        raise TypeError(f"max_runs must be an integer or None, got {max_runs!r}")
+    if max_runs < 1:
+        raise ValueError(f"max_runs must be at least 1, got {max_runs}")
+
+
+def too_many(max_runs: int) -> str:
+    """The end of a message refusing more runs than ``max_runs``: what to do if meant."""
+    return (f"more than the limit of {max_runs:,} runs; if that is meant, raise the limit "
+            "(--max-runs N on the command line, max_runs=N in Python)")
+
+
 def spec_from_record(record: dict, *, source: str) -> SweepSpec:
     """The spec a store recorded (:meth:`SweepSpec.as_dict`, in its ``metadata.json``), checked
-    again as :func:`spec_from_dict` checks a document; ``source`` names the record in errors."""
+    again as :func:`spec_from_dict` checks a document (no limit on its runs: it was run);
+    ``source`` names the record in errors."""
     sweep = {key: record[key] for key in ("name", "algorithm", "maps", "seeds", "iterations",
                                           "chunk_size")}
     if record.get("patience") is not None:
         sweep["patience"] = record["patience"]
     return spec_from_dict({"sweep": sweep, "config": record["config"],
-                           "params": record["params"]}, source=source)
+                           "params": record["params"]}, source=source, max_runs=None)
 
 
 def _sweep_table(document: dict, fail) -> dict:
@@ -257,8 +326,10 @@ def check_map_worlds(maps: list, swarm, algorithm: str, fail, key: str = "sweep.
                  f"is a {entry_world(entry).__name__}")
 
 
-def _params(params: Any, swarm, algorithm: str, fail) -> dict[str, tuple[float, ...]]:
-    """The [params] table checked: param name -> its values, for params the swarm knows."""
+def _params(params: Any, swarm, algorithm: str, fail,
+            most: int | None) -> dict[str, tuple[float, ...]]:
+    """The [params] table checked: param name -> its values (at most ``most`` each), for params
+    the swarm knows."""
     if not isinstance(params, dict):
         fail("[params]", "must be a table")
     known = swarm.default_params._fields
@@ -266,14 +337,22 @@ def _params(params: Any, swarm, algorithm: str, fail) -> dict[str, tuple[float, 
     for key, value in params.items():
         if key not in known:
             fail(f"params.{key}", f"unknown param of {algorithm}; known: {', '.join(known)}")
-        checked[key] = _values(value, f"params.{key}", fail)
+        checked[key] = _values(value, f"params.{key}", fail, most)
     return checked
 
 
 def _check_grid(spec: SweepSpec, swarm, fail) -> None:
     """Every combination of the grid is a valid set of params for the swarm, so an
     out-of-range value fails here, before any compute; the error names the param when the
-    swarm's message starts with it."""
+    swarm's message starts with it. The swarms' checks take arrays, so the whole grid is
+    checked at once; only a grid that fails is gone through combination by combination, to
+    name the first that does."""
+    every = spec.combination_values(np.arange(spec.num_combinations))
+    try:
+        swarm.check_params(swarm.params_with(**every))
+        return
+    except ValueError:
+        pass
     for combination in spec.grid():
         try:
             swarm.check_params(swarm.params_with(**combination))
@@ -282,19 +361,33 @@ def _check_grid(spec: SweepSpec, swarm, fail) -> None:
             fail(f"params.{key}" if key in combination else key, str(error))
 
 
-def check_seeds(value: Any, fail, key: str = "sweep.seeds") -> tuple[int, ...]:
-    """The seeds at ``key``: a count (``range(count)``) or an explicit list of distinct
-    non-negative integers."""
+def check_seeds(value: Any, fail, key: str = "sweep.seeds",
+                most: int | None = None) -> tuple[int, ...]:
+    """The seeds at ``key``: a count (``range(count)``, at most ``most`` seeds) or an explicit
+    list of distinct integers, each in ``[0, SEED_LIMIT)`` (where seeds give distinct keys)."""
+    seed_range = f"seeds are integers from 0 to {SEED_LIMIT - 1:,} (2^32 - 1)"
     if isinstance(value, int) and not isinstance(value, bool):
         if value < 1:
             fail(key, f"must be at least 1, got {value}")
+        if value > SEED_LIMIT:
+            fail(key, f"{value:,} seeds run past the last seed: {seed_range}, beyond which "
+                 "jax.random.key repeats its keys")
+        if most is not None and value > most:
+            fail(key, f"{value:,} seeds, {too_many(most)}")
         return tuple(range(value))
     if isinstance(value, list) and value and all(
-            isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value):
+            isinstance(s, int) and not isinstance(s, bool) for s in value):
+        outside = [s for s in value if not 0 <= s < SEED_LIMIT]
+        if outside:
+            fail(key, f"seed {outside[0]} is out of range: {seed_range}, beyond which "
+                 "jax.random.key repeats its keys (seed s + 2^32 is seed s)")
         if len(set(value)) != len(value):
             fail(key, "repeats a seed")
+        if most is not None and len(value) > most:
+            fail(key, f"{len(value):,} seeds, {too_many(most)}")
         return tuple(value)
-    fail(key, f"must be a count or a non-empty list of non-negative integers, got {value!r}")
+    fail(key, f"must be a count or a non-empty list of integers from 0 to {SEED_LIMIT - 1:,}, "
+         f"got {value!r}")
 
 
 def positive_int(value: Any, key: str, fail) -> int:
@@ -304,8 +397,9 @@ def positive_int(value: Any, key: str, fail) -> int:
     return value
 
 
-def _values(value: Any, key: str, fail) -> tuple[float, ...]:
-    """A param's values: a number, a list of numbers, or a range table."""
+def _values(value: Any, key: str, fail, most: int | None = None) -> tuple[float, ...]:
+    """A param's values: a number, a list of numbers, or a range table of at most ``most``
+    values (counted before they are made)."""
     if is_number(value):
         return (float(value),)
     if isinstance(value, list):
@@ -315,11 +409,11 @@ def _values(value: Any, key: str, fail) -> tuple[float, ...]:
             fail(key, f"values must be numbers, got {value!r}")
         return tuple(float(v) for v in value)
     if isinstance(value, dict):
-        return _range(value, key, fail)
+        return _range(value, key, fail, most)
     fail(key, f"must be a number, a list or a range table, got {value!r}")
 
 
-def _range(table: dict, key: str, fail) -> tuple[float, ...]:
+def _range(table: dict, key: str, fail, most: int | None) -> tuple[float, ...]:
     allowed = {"start", "stop", "num", "step", "log"}
     unknown = set(table) - allowed
     if unknown:
@@ -336,6 +430,8 @@ def _range(table: dict, key: str, fail) -> tuple[float, ...]:
         num = table["num"]
         if isinstance(num, bool) or not isinstance(num, int) or num < 1:
             fail(key, f"num must be a positive integer, got {num!r}")
+        if most is not None and num > most:
+            fail(key, f"num = {num:,} values make at least {num:,} runs, {too_many(most)}")
         if table.get("log", False):
             if start <= 0 or stop <= 0:
                 fail(key, "a log range needs positive start and stop")
@@ -346,6 +442,9 @@ def _range(table: dict, key: str, fail) -> tuple[float, ...]:
         step = table["step"]
         if not is_number(step) or step == 0 or (stop - start) / step < 0:
             fail(key, f"step {step!r} does not lead from {start} to {stop}")
+        count = (stop - start) / step  # np.arange makes ceil(count) values
+        if most is not None and count > most:
+            fail(key, f"about {count:,.0f} values make as many runs, {too_many(most)}")
         values = np.arange(start, stop, step)
     if len(values) == 0:
         fail(key, "the range is empty: a sweep needs at least one value")

@@ -26,13 +26,13 @@ every parent (a simplification, documented).
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pandas as pd
 
 from jaxswarm.tune.evaluate import Evaluator, Setting, instance_order
 from jaxswarm.tune.space import Choice, Space, from_unit, to_unit
+from jaxswarm.tune.spec import race_iterations
 from jaxswarm.tune.stats import race_step, ranks
 
 
@@ -66,8 +66,7 @@ def iterated_race(evaluator: Evaluator, space: Space, baseline: dict,
     spec = evaluator.spec
     order = instance_order(spec.training.pairs, rng)
     dimension = max(len(space.free), 1)
-    iterations = int(2 + math.log2(dimension))
-    survivors = int(2 + math.log2(dimension))
+    iterations = survivors = race_iterations(dimension)
     made: dict[int, Setting] = {}
     losses: dict[tuple[int, int], float] = {}  # (setting, place in the order) -> loss
     choice_probabilities: dict[int, dict] = {}

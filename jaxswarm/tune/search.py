@@ -55,7 +55,7 @@ def grid_search(evaluator: Evaluator, space: Space, rng: np.random.Generator) ->
     """The grid (see the module docstring)."""
     spec = evaluator.spec
     order = instance_order(spec.training.pairs, rng)
-    points = spec.grid_points or _most_points(space, spec.budget // spec.first_test)
+    points = spec.grid_points or space.most_points(spec.budget // spec.first_test)
     grid = space.grid(points)
     count = min(len(order), max(1, spec.budget // len(grid)))
     return _best_of(evaluator, _numbered(grid, space), order[:count])
@@ -106,14 +106,3 @@ def _best_of(evaluator: Evaluator, settings: list[Setting], instances: list) -> 
     ranked = np.argsort(losses.mean(axis=1), kind="stable")
     return SearchResult(best=[settings[i] for i in ranked],
                         settings={s.number: s for s in settings})
-
-
-def _most_points(space: Space, most_settings: int) -> int:
-    """The most points per numeric param whose grid has at most ``most_settings`` settings
-    (at least 2)."""
-    if not space.numeric:
-        return 2
-    points = 2
-    while len(space.grid(points + 1)) <= most_settings:
-        points += 1
-    return points

@@ -116,6 +116,34 @@ class Space:
     def grid(self, points: int) -> list[dict]:
         """Every combination of ``points`` values evenly spaced over each numeric param (on its
         scale; fewer for an integer range with fewer values) and every value of each choice."""
+        return [self.complete(dict(zip(self.free, combination)))
+                for combination in itertools.product(*self._axes(points))]
+
+    def grid_size(self, points: int) -> int:
+        """``len(self.grid(points))``, counted from the axes without building the grid."""
+        return math.prod(len(axis) for axis in self._axes(points))
+
+    def most_points(self, most_settings: int) -> int:
+        """The most points per numeric param whose grid has at most ``most_settings`` settings
+        (at least 2), by bisection over the grids' sizes (counted, not built), which grow with
+        the points; past the values an integer range holds they stay, and so do the points."""
+        if not self.numeric:
+            return 2
+        ranges = [self.domains[name] for name in self.numeric]
+        useful = (most_settings if any(isinstance(d, Real) for d in ranges)
+                  else max(d.high - d.low + 1 for d in ranges))
+        fits, over = 2, max(useful, 2) + 1  # grid_size(fits) <= most_settings < grid_size(over)
+        while over - fits > 1:
+            middle = (fits + over) // 2
+            if self.grid_size(middle) <= most_settings:
+                fits = middle
+            else:
+                over = middle
+        return fits
+
+    def _axes(self, points: int) -> list[list]:
+        """Each free param's grid values: ``points`` values evenly spaced over a numeric param
+        (on its scale; the distinct ones for an integer range), every value of a choice."""
         axes = []
         for name in self.free:
             domain = self.domains[name]
@@ -126,8 +154,7 @@ class Space:
                 if isinstance(domain, Integer):
                     values = sorted({int(round(v)) for v in values})
                 axes.append(values)
-        return [self.complete(dict(zip(self.free, combination)))
-                for combination in itertools.product(*axes)]
+        return axes
 
 
 def to_unit(domain: Real | Integer, value: float) -> float:

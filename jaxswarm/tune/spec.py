@@ -46,19 +46,23 @@ the budget), ``es_pairs``, ``es_sigma`` and ``es_learning_rate`` (method es), an
 the paths these swarms find). A ``[tune.baseline]`` pins the setting a calibration started
 from once its best setting has become the swarm's default, so the study still runs as it ran
 (each value inside its param's range, or one of its choices). Every
-mistake raises :class:`TuneSpecError` naming the file and the key.
+mistake raises :class:`TuneSpecError` naming the file and the key, among them a budget too small
+for the method (:func:`smallest_budget`), a grid larger than the budget, and a tune of more
+than ``max_runs`` runs (training and held-out; ``DEFAULT_MAX_RUNS``, a million, unless told
+otherwise), all before anything is built.
 """
 from __future__ import annotations
 
 import dataclasses
 import itertools
-import tomllib
+import math
 from pathlib import Path
 from typing import Any
 
-from jaxswarm.sweep.spec import (DEFAULT_CHUNK_SIZE, algorithm_and_name, check_map_worlds,
-                                 check_maps, check_seeds, configured_swarm, is_number,
-                                 positive_int)
+from jaxswarm.sweep.spec import (DEFAULT_CHUNK_SIZE, DEFAULT_MAX_RUNS, algorithm_and_name,
+                                 check_map_worlds, check_maps, check_max_runs, check_seeds,
+                                 configured_swarm, is_number, positive_int, read_toml,
+                                 too_many)
 from jaxswarm.swarm import registry as swarm_registry
 from jaxswarm.tune.space import Choice, Integer, Real, Space, Tied
 
@@ -74,6 +78,9 @@ TUNE_KEYS = {"name", "algorithm", "method", "budget", "objective", "iterations",
 RACE_KEYS = {"first_test", "alpha"}
 INSTANCE_KEYS = {"maps", "seeds"}
 DOMAIN_KEYS = {"low", "high", "log", "integer", "choices", "tied"}
+
+HELD_OUT_SETTINGS = 4
+"""The most settings a tune rescores on each held-out instance: the baseline and three best."""
 
 
 class TuneSpecError(ValueError):
@@ -138,28 +145,31 @@ class TuneSpec:
         return record
 
 
-def load_tune_spec(path) -> TuneSpec:
+def load_tune_spec(path, *, max_runs: int | None = DEFAULT_MAX_RUNS) -> TuneSpec:
     """Read and check a tune file (see the module docstring).
 
+    Args:
+      path: the TOML file (UTF-8).
+      max_runs: the most runs the tune may make (its budget and its held-out runs); None: no
+        limit.
+
     Raises:
-      TuneSpecError: unreadable TOML, an unknown section or key, a bad value; the message names
-        the file and the key.
+      TuneSpecError: unreadable or non-UTF-8 file, bad TOML, an unknown section or key, a bad
+        value, a budget too small for the method, more than ``max_runs`` runs; the message
+        names the file and the key (and the line for TOML syntax and encoding).
     """
     path = Path(path)
-    try:
-        document = tomllib.loads(path.read_text())
-    except OSError as error:
-        raise TuneSpecError(f"{path}: cannot read the tune file ({error.strerror})") from None
-    except tomllib.TOMLDecodeError as error:
-        raise TuneSpecError(f"{path}: not valid TOML: {error}") from None
-    return tune_spec_from_dict(document, source=str(path))
+    document = read_toml(path, "tune", TuneSpecError)
+    return tune_spec_from_dict(document, source=str(path), max_runs=max_runs)
 
 
-def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
+def tune_spec_from_dict(document: dict, *, source: str = "<dict>",
+                        max_runs: int | None = DEFAULT_MAX_RUNS) -> TuneSpec:
     """Check a parsed tune spec (the TOML document as a dict); see :func:`load_tune_spec`."""
     def fail(key: str, problem: str):
         raise TuneSpecError(f"{source}: {key}: {problem}")
 
+    check_max_runs(max_runs)
     for section in document:
         if section not in ("tune", "config", "params"):
             fail(section, "unknown section; expected tune, config, params")
@@ -172,8 +182,8 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
     objective = _one_of(tune.get("objective", "success"), OBJECTIVES, "tune.objective", fail)
     config, static = _config(document.get("config", {}), algorithm, fail)
     swarm = configured_swarm(algorithm, config, fail)
-    training = _instances(tune["training"], "tune.training", swarm, algorithm, fail)
-    held_out = _instances(tune["held_out"], "tune.held_out", swarm, algorithm, fail)
+    training = _instances(tune["training"], "tune.training", swarm, algorithm, fail, max_runs)
+    held_out = _instances(tune["held_out"], "tune.held_out", swarm, algorithm, fail, max_runs)
     shared = [(entry, seed) for entry in held_out.maps for seed in held_out.seeds
               if entry in training.maps and seed in training.seeds]
     if shared:
@@ -184,10 +194,7 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
     space = Space({**domains, **static})
     if not space.free:
         fail("[params]", "nothing to tune: give at least one range or choice")
-    race = _table(tune.get("race", {}), "tune.race", RACE_KEYS, fail)
-    alpha = race.get("alpha", 0.05)
-    if not is_number(alpha) or not 0 < alpha < 1:
-        fail("tune.race.alpha", f"must be a number in (0, 1), got {alpha!r}")
+    first_test, alpha = _race_keys(tune.get("race", {}), method, training, fail)
     patience = tune.get("patience")
     spec = TuneSpec(
         name=name, algorithm=algorithm, method=method,
@@ -198,8 +205,7 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
         chunk_size=positive_int(tune.get("chunk_size", DEFAULT_CHUNK_SIZE), "tune.chunk_size",
                                 fail),
         training=training, held_out=held_out, config=config, fixed=fixed, space=space,
-        first_test=positive_int(race.get("first_test", 5), "tune.race.first_test", fail),
-        alpha=float(alpha),
+        first_test=first_test, alpha=alpha,
         grid_points=(None if "grid_points" not in tune
                      else positive_int(tune["grid_points"], "tune.grid_points", fail)),
         es_pairs=positive_int(tune.get("es_pairs", 4), "tune.es_pairs", fail),
@@ -208,8 +214,64 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>") -> TuneSpec:
                                    fail),
         unsolved_gap=_positive(tune.get("unsolved_gap", 10.0), "tune.unsolved_gap", fail),
         baseline=_baseline(tune.get("baseline", {}), space, fail), source=source)
+    _check_runs(spec, fail, max_runs)
     _check_corners(spec, fail)
     return spec
+
+
+def race_iterations(free: int) -> int:
+    """irace's ``N_iter = floor(2 + log2 d)`` for ``d = free`` params (at least one): the
+    iterations of a race, and the most settings one iteration keeps."""
+    return int(2 + math.log2(max(free, 1)))
+
+
+def smallest_budget(spec: TuneSpec) -> int:
+    """The least budget with which ``spec``'s method searches at all.
+
+    race: the first iteration (a ``1 / N_iter`` share of the budget) races the baseline and one
+    drawn setting, each at ``first_test + 1`` runs (:mod:`jaxswarm.tune.race`); es: one step,
+    ``2 es_pairs first_test`` runs; random: the baseline and one drawn setting; grid: every
+    setting of its grid once (at ``grid_points``, else at 2 points per param).
+    """
+    if spec.method == "race":
+        return race_iterations(len(spec.space.free)) * 2 * (spec.first_test + 1)
+    if spec.method == "es":
+        return 2 * spec.es_pairs * spec.first_test
+    if spec.method == "random":
+        return 2
+    return spec.space.grid_size(spec.grid_points or 2)
+
+
+def _check_runs(spec: TuneSpec, fail, max_runs: int | None) -> None:
+    """The budget pays for the method's search (:func:`smallest_budget`), and the budget and the
+    held-out runs together are at most ``max_runs``; counted, not built."""
+    least = smallest_budget(spec)
+    if spec.budget < least:
+        if spec.method == "grid":
+            points = spec.grid_points or 2
+            fail("tune.grid_points" if spec.grid_points else "tune.budget",
+                 f"a grid of {points:,} points per param has {least:,} settings, more than the "
+                 f"budget of {spec.budget:,} runs; the smallest budget for it is {least:,}"
+                 + (" (or fewer grid_points)" if spec.grid_points else ""))
+        fail("tune.budget", f"a budget of {spec.budget:,} runs is too small for method "
+             f"{spec.method}: the smallest is {least:,} ({_why_least(spec)})")
+    held_out = HELD_OUT_SETTINGS * len(spec.held_out.pairs)
+    if max_runs is not None and spec.budget + held_out > max_runs:
+        fail("tune.budget", f"{spec.budget:,} training runs and up to {held_out:,} held-out "
+             f"runs ({HELD_OUT_SETTINGS} settings on {len(spec.held_out.pairs):,} instances) are "
+             f"{spec.budget + held_out:,} runs, {too_many(max_runs)}")
+
+
+def _why_least(spec: TuneSpec) -> str:
+    """Why :func:`smallest_budget` is what it is for ``spec``'s method, in a few words."""
+    if spec.method == "race":
+        return (f"{race_iterations(len(spec.space.free))} iterations, the first racing the "
+                f"baseline and one drawn setting at first_test + 1 = {spec.first_test + 1} runs "
+                "each")
+    if spec.method == "es":
+        return (f"one step: {spec.es_pairs} antithetic pairs on first_test = {spec.first_test} "
+                "instances")
+    return "the baseline and one drawn setting"
 
 
 def _table(value: Any, key: str, allowed: set, fail) -> dict:
@@ -221,6 +283,24 @@ def _table(value: Any, key: str, allowed: set, fail) -> dict:
             fail(f"{key.strip('[]')}.{name}",
                  f"unknown key; expected one of {', '.join(sorted(allowed))}")
     return value
+
+
+def _race_keys(table: Any, method: str, training: Instances, fail) -> tuple[int, float]:
+    """``(first_test, alpha)`` of the ``[tune.race]`` table: the instances before the first test,
+    at least 2 (the tests compare settings on two instances or more) and, for a race, at most
+    the training instances; the tests' level, in (0, 1)."""
+    race = _table(table, "tune.race", RACE_KEYS, fail)
+    alpha = race.get("alpha", 0.05)
+    if not is_number(alpha) or not 0 < alpha < 1:
+        fail("tune.race.alpha", f"must be a number in (0, 1), got {alpha!r}")
+    first_test = positive_int(race.get("first_test", 5), "tune.race.first_test", fail)
+    if first_test < 2:
+        fail("tune.race.first_test", f"must be at least 2 (the tests after an instance compare "
+             f"settings on two instances or more), got {first_test}")
+    if method == "race" and first_test > len(training.pairs):
+        fail("tune.race.first_test", f"{first_test} is more than the {len(training.pairs)} "
+             "training instances: no test would ever drop a setting")
+    return first_test, float(alpha)
 
 
 def _one_of(value: Any, allowed: tuple, key: str, fail) -> str:
@@ -241,15 +321,17 @@ def _positive(value: Any, key: str, fail) -> float:
     return float(value)
 
 
-def _instances(table: Any, key: str, swarm, algorithm: str, fail) -> Instances:
-    """The instances at ``key``: maps of the swarm's world and seeds."""
+def _instances(table: Any, key: str, swarm, algorithm: str, fail,
+               most: int | None) -> Instances:
+    """The instances at ``key``: maps of the swarm's world and seeds (at most ``most``)."""
     table = _table(table, key, INSTANCE_KEYS, fail)
     for name in INSTANCE_KEYS:
         if name not in table:
             fail(f"{key}.{name}", "missing")
     maps = check_maps(table["maps"], fail, f"{key}.maps")
     check_map_worlds(maps, swarm, algorithm, fail, f"{key}.maps")
-    return Instances(maps=tuple(maps), seeds=check_seeds(table["seeds"], fail, f"{key}.seeds"))
+    return Instances(maps=tuple(maps),
+                     seeds=check_seeds(table["seeds"], fail, f"{key}.seeds", most))
 
 
 def _config(config: Any, algorithm: str, fail) -> tuple[dict, dict]:
