@@ -19,7 +19,7 @@ from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.runner import _Pace
 from jaxswarm.sweep.spec import SEED_LIMIT
 from jaxswarm.sweep.store import ResultsStore
-from jaxswarm.tune import TuneSpecError, load_tune_spec, tune_spec_from_dict
+from jaxswarm.tune import TuneSpecError, load_tune_spec, tune, tune_spec_from_dict
 from jaxswarm.tune.space import Choice, Integer, Real, Space
 
 LIMIT_NAMED = "seeds are integers from 0 to 4,294,967,295"
@@ -309,11 +309,15 @@ def test_out_naming_a_file_is_refused_and_the_file_kept(tmp_path, capsys, comman
     assert file.read_text() == "mine"
 
 
-def test_run_sweep_refuses_out_naming_a_file(tmp_path):
+@pytest.mark.parametrize("command", ["sweep", "tune"])
+def test_the_python_entry_points_refuse_out_naming_a_file(tmp_path, command):
     file = tmp_path / "results.txt"
     file.write_text("mine")
     with pytest.raises(ValueError, match=f"out: {file} is a file, not a folder"):
-        run_sweep(spec_from_dict(sweep_document()), file, progress=False)
+        if command == "sweep":
+            run_sweep(spec_from_dict(sweep_document()), file, progress=False)
+        else:
+            tune(tune_spec_from_dict(tune_document()), file)
     assert file.read_text() == "mine"
 
 

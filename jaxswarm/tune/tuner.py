@@ -29,6 +29,7 @@ import pandas as pd
 
 from jaxswarm.runtime.atomic import write_atomically
 from jaxswarm.swarm import registry as swarm_registry
+from jaxswarm.sweep.runner import check_folder
 from jaxswarm.tune.evaluate import HELD_OUT, Evaluator, Setting, reported
 from jaxswarm.tune.figures import race_figure
 from jaxswarm.tune.race import iterated_race
@@ -78,13 +79,15 @@ def tune(spec: TuneSpec, out=None, *, log: Callable[[str], None] = print) -> Tun
       log: where one-line messages go (compiles).
 
     Raises:
-      ValueError: a map cannot be resolved (before any compute); ``out`` holds another tune,
-        runs on a map file that changed since, or batches of another tuner or sampler
+      ValueError: a map cannot be resolved or ``out`` is a file (before any compute); ``out``
+        holds another tune, runs on a map file that changed since, or batches of another
+        tuner or sampler
         (:class:`~jaxswarm.sweep.store.StoreMismatchError`,
         :class:`~jaxswarm.tune.evaluate.StoreConflictError`); another process is writing
         ``out`` (:class:`~jaxswarm.sweep.store.StoreBusyError`).
     """
     out = Path(out) if out is not None else default_tune_out(spec)
+    check_folder(out, "out")
     evaluator = Evaluator(spec, out, log)
     rng = np.random.default_rng(spec.seed)
     baseline = baseline_values(spec)
