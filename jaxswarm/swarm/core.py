@@ -113,7 +113,8 @@ class Swarm:
       best: ``(state) -> Solution``: the best path found so far (on a plane: waypoints
         f32[L, 2], NaN padded).
       default_params: Params that work on the paper maps.
-      check_params: ``(params) -> None``, host-side; raises ValueError naming a bad value.
+      check_params: ``(params) -> None``, host-side; raises :class:`ParamError` (a
+        ValueError) whose ``field`` names the bad param.
       memory: ``(state) -> f32[...]``: what persists between iterations, for figures: the
         memory per node (f32[N]: altitude, pheromone) of a graph swarm, the trajectory so far
         (f32[L, 2]) of the bees' vehicle.
@@ -413,11 +414,33 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False, paths=None, len
     return jnp.where(better, path, best_path), jnp.where(better, cost, best_cost), info
 
 
+class ParamError(ValueError):
+    """A param's value out of range, raised by a swarm's ``check_params``.
+
+    Attributes:
+      field: the param's name (the Params field); the message starts with it.
+    """
+
+    def __init__(self, field: str, problem: str):
+        super().__init__(f"{field} {problem}")
+        self.field = field
+
+
 def check_positive(name: str, value, *, allow_zero: bool = False) -> None:
-    """Host-side check of a scalar (or array) param: finite and positive (or non-negative)."""
+    """Host-side check of a scalar (or array) param: finite and positive (or non-negative).
+
+    Raises:
+      ParamError: naming ``name`` and the value as NumPy prints it.
+    """
     array = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise ParamError(name, f"must be finite, got {shown(value)}")
     if np.any(array < 0) or (not allow_zero and np.any(array == 0)):
         bound = "non-negative" if allow_zero else "positive"
-        raise ValueError(f"{name} must be {bound}, got {value!r}")
+        raise ParamError(name, f"must be {bound}, got {shown(value)}")
+
+
+def shown(value) -> str:
+    """A param's value as a message shows it: ``-0.5`` for ``np.float32(-0.5)``, ``[1. 2.]``
+    for an array."""
+    return str(np.asarray(value))
