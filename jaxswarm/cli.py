@@ -425,6 +425,7 @@ def run_mapf(args: argparse.Namespace) -> int:
     for kind, path in (("MAP", args.map), ("SCEN", args.scen)):
         if not path.is_file():
             raise ValueError(f"{kind} {path}: no such file")
+    _check_file_out("--gif", args.gif)
     instance = load_instance(args.map, args.scen, args.agents)
     graph = instance.graph
     height, width = graph.shape
@@ -503,7 +504,21 @@ def _run_swarm(swarm, graph, start, goal, args):
 
 
 def _load(args) -> NamedMap:
-    return named_map(args.map, seed=args.seed, start=args.start, goal=args.goal)
+    """The map, start and goal of ``demo`` or ``robot``; ValueError when the start is the goal
+    (there is nothing to plan) or ``--out`` names a folder."""
+    _check_file_out("--out", args.out)
+    loaded = named_map(args.map, seed=args.seed, start=args.start, goal=args.goal)
+    if as_node(loaded.graph, loaded.start) == as_node(loaded.graph, loaded.goal):
+        raise ValueError(f"--start {loaded.start} and --goal {loaded.goal} are the same cell: "
+                         "there is nothing to plan")
+    return loaded
+
+
+def _check_file_out(option: str, path: Path | None) -> None:
+    """ValueError when the file ``option`` names to write is a folder (checked before any
+    planning, so that no work is lost to a path that cannot be written)."""
+    if path is not None and path.is_dir():
+        raise ValueError(f"{option} {path} is a folder: name the file to write in it")
 
 
 def _swarm_names(text: str) -> tuple[str, ...]:

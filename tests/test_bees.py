@@ -386,7 +386,7 @@ def test_bad_params_are_named(field, value, message):
 def test_bad_sizes_are_named():
     with pytest.raises(ValueError, match="cabc needs num_agents >= 2"):
         make("cabc", num_agents=1)
-    with pytest.raises(ValueError, match="cabc needs max_steps"):
+    with pytest.raises(TypeError, match="max_steps of cabc must be an integer, got None"):
         make("cabc", max_steps=None)
 
 

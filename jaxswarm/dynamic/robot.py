@@ -315,9 +315,11 @@ def hidden_blocks(known: Graph, start, goal, *, count: int, seed: int,
       of ``count`` entries.
 
     Raises:
-      ValueError: fewer than ``count`` places keep the goal reachable.
+      ValueError: the goal cannot be reached from the start on ``known`` itself, or fewer than
+        ``count`` places keep the goal reachable.
     """
     task = make_task(known, start, goal)
+    given = start, goal
     start, goal = int(task.start), int(task.goal)
     if passages is None:
         passages = bool(np.all(np.asarray(known.free)))
@@ -326,6 +328,9 @@ def hidden_blocks(known: Graph, start, goal, *, count: int, seed: int,
     world = known
     for placed in range(count):
         nodes = astar(world, start, goal).nodes()
+        if placed == 0 and not len(nodes):
+            raise ValueError(f"the goal {given[1]} cannot be reached from the start {given[0]} "
+                             "on the map itself, before any hidden block")
         for t in rng.permutation(np.arange(1, len(nodes) - 1)):
             a, b = int(nodes[t]), int(nodes[t + 1])
             trial = make_event(known, block=cells + [b] * (not passages),

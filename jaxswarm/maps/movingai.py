@@ -59,9 +59,13 @@ class Scenario:
 
 
 def read_map(path) -> np.ndarray:
-    """bool[H, W] obstacles (True = blocked) of a ``.map`` file, indexed ``[y, x]``."""
-    with open(path, encoding="ascii", errors="replace") as f:
-        lines = f.read().splitlines()
+    """bool[H, W] obstacles (True = blocked) of a ``.map`` file, indexed ``[y, x]``.
+
+    Raises:
+      MovingAIFormatError: a malformed file (a byte that is not ASCII, a bad header, a row of
+        the wrong length, an unknown terrain); the message names the file and line.
+    """
+    lines = _ascii_lines(path)
     header = {}
     for number, expected in enumerate(("type", "height", "width", "map"), start=1):
         if len(lines) < number:
@@ -117,8 +121,7 @@ def load_scenarios(path, obstacles: np.ndarray | None = None) -> list[Scenario]:
         from the map's, whose start or goal lies outside its own size, or on an obstacle; the
         message names the file and line.
     """
-    with open(path, encoding="ascii", errors="replace") as f:
-        lines = f.read().splitlines()
+    lines = _ascii_lines(path)
     if not lines or not lines[0].startswith("version"):
         raise MovingAIFormatError(path, 1, "expected a 'version ...' first line")
     scenarios = []
@@ -161,6 +164,24 @@ def check_scenario(scenario: Scenario, obstacles: np.ndarray, path) -> None:
                                       f"row's {width}x{height} map")
         if obstacles[y, x]:
             raise MovingAIFormatError(path, scenario.line, f"{name} ({x}, {y}) is an obstacle")
+
+
+def _ascii_lines(path) -> list[str]:
+    """The lines of the Moving AI file ``path``, which is plain ASCII.
+
+    Raises:
+      MovingAIFormatError: the first byte that is not ASCII, with its line and column.
+    """
+    with open(path, "rb") as f:
+        data = f.read()
+    try:
+        return data.decode("ascii").splitlines()
+    except UnicodeDecodeError as error:
+        at = error.start
+        line_start = data.rfind(b"\n", 0, at) + 1
+        raise MovingAIFormatError(path, data.count(b"\n", 0, at) + 1,
+                                  f"byte 0x{data[at]:02x} at column {at - line_start + 1} is not "
+                                  "ASCII (Moving AI files are plain ASCII)") from None
 
 
 def _positive_int(text: str, path, line: int, name: str) -> int:

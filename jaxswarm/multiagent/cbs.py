@@ -47,6 +47,7 @@ from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
 from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, reservations,
                                              resting_on, split_collision)
 from jaxswarm.multiagent.corridor import Corridors
+from jaxswarm.multiagent.limits import check_count, check_seconds
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.rectangle import Rectangles
 from jaxswarm.multiagent.spacetime import occupancy, search
@@ -87,8 +88,13 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       least sum of costs plus heuristic left (the optimum when solved), ``seconds``.
 
     Raises:
+      TypeError, ValueError: a limit that is not a positive number (``time_limit``) or a whole
+        number of at least 1 (``max_nodes``, ``max_expansions``), naming it.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
+    check_seconds("time_limit", time_limit)
+    check_count("max_nodes", max_nodes)
+    check_count("max_expansions", max_expansions)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     agents = len(start_nodes)

@@ -29,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import heapq
 import itertools
+import numbers
 import time
 
 import numpy as np
@@ -37,6 +38,7 @@ from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.constraints import Constraints, earliest_collision, forbid
+from jaxswarm.multiagent.limits import check_count, check_seconds
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import occupancy
 from jaxswarm.world.graph import Graph
@@ -67,7 +69,10 @@ def eecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_0
       ``cost_error`` and ``collision_error`` (e_h and e_d as learnt), ``seconds``.
 
     Raises:
-      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or w < 1.
+      TypeError, ValueError: a ``w`` that is not a number of at least 1, a ``time_limit`` that
+        is not a positive number or a ``max_nodes`` that is not a whole number of at least 1,
+        naming it.
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     return _bounded(graph, starts, goals, w, max_nodes, time_limit, explicit=True)
 
@@ -75,8 +80,12 @@ def eecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_0
 def _bounded(graph: Graph, starts, goals, w: float, max_nodes: int, time_limit: float, *,
              explicit: bool) -> Plan:
     """ECBS, or with ``explicit`` EECBS (see :func:`eecbs`)."""
+    if not isinstance(w, numbers.Real) or isinstance(w, bool):
+        raise TypeError(f"w must be a number, got {w!r}")
     if not w >= 1.0:
         raise ValueError(f"w must be at least 1, got {w}")
+    check_seconds("time_limit", time_limit)
+    check_count("max_nodes", max_nodes)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began,

@@ -113,7 +113,9 @@ class Swarm:
       best: ``(state) -> Solution``: the best path found so far (on a plane: waypoints
         f32[L, 2], NaN padded).
       default_params: Params that work on the paper maps.
-      check_params: ``(params) -> None``, host-side; raises ValueError naming a bad value.
+      check_params: ``(params) -> None``, host-side; raises
+        :class:`~jaxswarm.swarm.core.ParamError` (a ValueError) whose ``field`` names the bad
+        param.
       memory: ``(state) -> f32[...]``: what persists between iterations, for figures: the
         memory per node (f32[N]: altitude, pheromone) of a graph swarm, the trajectory so far
         (f32[L, 2]) of the bees' vehicle.
@@ -225,8 +227,10 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
       trace says so (``Trace.overflowed``).
 
     Raises:
-      ValueError: a world of the wrong kind, or concrete params out of range (checked on the
-        host, outside jit).
+      TypeError: params that are not the swarm's Params, or a param that is not a real number.
+      ValueError: a world of the wrong kind, a param of another shape than its default's (a
+        scalar: a batch of runs maps ``run`` over params), or concrete params out of range
+        (checked on the host, outside jit).
     """
     if iterations < 1:
         raise ValueError(f"iterations must be at least 1, got {iterations}")
@@ -235,6 +239,7 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
     if patience is not None and patience >= iterations:
         patience = None
     require_world(swarm, world)
+    check_params_form(swarm, params)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
     budget = jnp.int32(iterations if budget is None else budget)
@@ -242,6 +247,40 @@ def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
         lambda swarm: _run_program(swarm, iterations, patience)(key, world, task, params, state,
                                                                budget),
         swarm, lambda result: result[1].overflowed)
+
+
+def check_params_form(swarm: Swarm, params) -> None:
+    """Host-side: raise unless ``params`` has the form of ``swarm.default_params``: the same
+    type and fields, every field a real number of its default's shape (f32[] for every
+    registered swarm's param: one run's). Checks types and shapes only, so traced params (a run
+    under ``vmap`` or ``jit``) are checked too. A swarm built by hand without default params
+    declares no form, and its params are not checked.
+
+    Raises:
+      TypeError: another type than the swarm's Params (a dict, another swarm's Params), or a
+        field that is not a real number; the message names the field.
+      ValueError: a field of another shape; the message names the field and the shape expected.
+    """
+    default = swarm.default_params
+    if default is None:
+        return
+    if type(params) is not type(default):
+        raise TypeError(f"params of {swarm.name} must be {type(default).__name__}, got "
+                        f"{type(params).__name__}: pass swarm.default_params or "
+                        "swarm.params_with(name=value, ...)")
+    # One level down: each field whole (a list or None in a field is named, not flattened).
+    fields = jax.tree_util.tree_flatten_with_path(params, is_leaf=lambda x: x is not params)[0]
+    defaults = jax.tree_util.tree_leaves(default, is_leaf=lambda x: x is not default)
+    for (path, value), wanted in zip(fields, defaults):
+        field = f"params{jax.tree_util.keystr(path)}"
+        dtype = value.dtype if hasattr(value, "dtype") else np.asarray(value).dtype
+        if not (np.issubdtype(dtype, np.floating) or np.issubdtype(dtype, np.integer)):
+            raise TypeError(f"{field} of {swarm.name} must be a real number, got {value!r}")
+        if np.shape(value) != np.shape(wanted):
+            scalar = " (a scalar)" if np.shape(wanted) == () else ""
+            raise ValueError(f"{field} of {swarm.name} has shape {np.shape(value)}, expected "
+                             f"{np.shape(wanted)}{scalar} for a single run; a batch of runs "
+                             "maps run over params (jax.vmap)")
 
 
 def again_with_room(call: Callable, swarm: Swarm, overflowed: Callable):
@@ -413,11 +452,33 @@ def keep_best(walk, best_path, best_cost, *, ties: bool = False, paths=None, len
     return jnp.where(better, path, best_path), jnp.where(better, cost, best_cost), info
 
 
+class ParamError(ValueError):
+    """A param's value out of range, raised by a swarm's ``check_params``.
+
+    Attributes:
+      field: the param's name (the Params field); the message starts with it.
+    """
+
+    def __init__(self, field: str, problem: str):
+        super().__init__(f"{field} {problem}")
+        self.field = field
+
+
 def check_positive(name: str, value, *, allow_zero: bool = False) -> None:
-    """Host-side check of a scalar (or array) param: finite and positive (or non-negative)."""
+    """Host-side check of a scalar (or array) param: finite and positive (or non-negative).
+
+    Raises:
+      ParamError: naming ``name`` and the value as NumPy prints it.
+    """
     array = np.asarray(value, dtype=np.float64)
     if not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
+        raise ParamError(name, f"must be finite, got {shown(value)}")
     if np.any(array < 0) or (not allow_zero and np.any(array == 0)):
         bound = "non-negative" if allow_zero else "positive"
-        raise ValueError(f"{name} must be {bound}, got {value!r}")
+        raise ParamError(name, f"must be {bound}, got {shown(value)}")
+
+
+def shown(value) -> str:
+    """A param's value as a message shows it: ``-0.5`` for ``np.float32(-0.5)``, ``[1. 2.]``
+    for an array."""
+    return str(np.asarray(value))

@@ -1,14 +1,17 @@
 """The registry of swarms: each name, its static Config and the function that builds it.
 
 A registered name is a paper's algorithm as the paper writes it; an algorithm of this project is
-registered under its own name (``rfd_graded``). ``make(name, **config)`` checks the options by
-building the Config (whose defaults are the only ones), and equal Configs return the same Swarm,
-so they share compiled code.
+registered under its own name (``rfd_graded``). ``make(name, **config)`` checks each option's
+type against its Config field's annotation, then its range by building the Config (whose
+defaults are the only ones), and equal Configs return the same Swarm, so they share compiled
+code.
 """
 from __future__ import annotations
 
 import dataclasses
 import functools
+import numbers
+import typing
 from typing import Callable, NamedTuple
 
 import numpy as np
@@ -66,14 +69,54 @@ def make(name: str, **config) -> Swarm:
     """The registered swarm ``name`` built with ``config`` (see its Config class for options).
 
     Raises:
+      TypeError: an option of the wrong type (an integer option given 8.5 or "8"); the message
+        names the swarm and the option.
       ValueError: unknown name (the message lists the registered ones), unknown option (the
-        message lists the known ones) or a bad value.
+        message lists the known ones) or a value out of range (naming the swarm and the
+        option).
     """
     options = config_options(name)
     unknown = sorted(set(config) - set(options))
     if unknown:
         raise ValueError(f"unknown option {unknown[0]!r} of {name}; known: {', '.join(options)}")
-    return _build(name, REGISTRY[name].config(**config))
+    kinds = typing.get_type_hints(REGISTRY[name].config)
+    checked = {option: _typed(name, option, kinds[option], value)
+               for option, value in config.items()}
+    try:
+        built = REGISTRY[name].config(**checked)
+    except ValueError as error:
+        raise ValueError(f"{error} (a config option of {name})") from None
+    return _build(name, built)
+
+
+_KINDS = {int: ("an integer",
+                lambda v: isinstance(v, numbers.Integral) and not isinstance(v, bool), int),
+          float: ("a number",
+                  lambda v: isinstance(v, numbers.Real) and not isinstance(v, bool), float),
+          bool: ("True or False", lambda v: isinstance(v, (bool, np.bool_)), bool),
+          str: ("a string", lambda v: isinstance(v, str), str)}
+"""A Config field's type -> (what the message asks for, whether a value is of it, the Python
+type the Config holds: NumPy scalars become Python ones, so equal options give equal Configs and
+a config record stays JSON)."""
+
+
+def _typed(name: str, option: str, annotation, value):
+    """``value`` of ``option`` as its Config field's type (``int``, ``float``, ``bool``, ``str``,
+    or one of them ``| None``).
+
+    Raises:
+      TypeError: a value of another type (a bool is no number here), naming swarm and option.
+    """
+    kinds = [kind for kind in typing.get_args(annotation) or (annotation,)
+             if kind is not type(None)]
+    optional = len(kinds) < len(typing.get_args(annotation))
+    if value is None and optional:
+        return None
+    wanted, accepts, convert = _KINDS[kinds[0]]
+    if not accepts(value):
+        raise TypeError(f"{option} of {name} must be {wanted}{' or None' * optional}, got "
+                        f"{value!r} ({type(value).__name__})")
+    return convert(value)
 
 
 @functools.lru_cache(maxsize=None)

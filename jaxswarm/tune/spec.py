@@ -452,4 +452,7 @@ def _check_corners(spec: TuneSpec, fail) -> None:
             try:
                 swarm.check_params(swarm.params_with(**setting))
             except ValueError as error:
+                field = getattr(error, "field", name)  # a fixed param's value may be at fault
+                if field != name:
+                    fail(f"params.{field}", str(error))
                 fail(f"params.{name}", f"{bound} is not a valid value: {error}")

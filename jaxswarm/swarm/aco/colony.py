@@ -21,7 +21,8 @@ import numpy as np
 
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.aco.bug2 import direction_cosine
-from jaxswarm.swarm.core import Swarm, Task, best_solution, check_positive, keep_best
+from jaxswarm.swarm.core import (ParamError, Swarm, Task, best_solution, check_positive, keep_best,
+                                 shown)
 from jaxswarm.swarm.walking import (FORCED, edge_table, goal_log_distance, heads, step_budget,
                                      walk)
 from jaxswarm.world.graph import Graph
@@ -184,12 +185,13 @@ def check_params(params) -> None:
     """Host-side check of a colony's Params: every value finite and in range.
 
     Raises:
-      ValueError: naming the bad value.
+      ParamError: naming the bad value.
     """
     for name, value in params._asdict().items():
         check_positive(name, value, allow_zero=_RULES[name] == "non-negative")
     if np.any(np.asarray(params.rho) > 1):
-        raise ValueError(f"rho must be at most 1, got {params.rho}")
+        raise ParamError("rho", f"must be at most 1, got {shown(params.rho)}")
     if "tau_max" in params._fields and np.any(np.asarray(params.tau_min)
                                               > np.asarray(params.tau_max)):
-        raise ValueError(f"tau_min ({params.tau_min}) exceeds tau_max ({params.tau_max})")
+        raise ParamError("tau_min", f"({shown(params.tau_min)}) exceeds tau_max "
+                                    f"({shown(params.tau_max)})")

@@ -32,7 +32,8 @@ import numpy as np
 
 from jaxswarm.swarm.bees.colony import Best, search
 from jaxswarm.swarm.bees.guided import check_turn_unit, constraint_violations, guided, revisits
-from jaxswarm.swarm.core import StepInfo, Swarm, SwarmConfig, Task, check_positive, default_params
+from jaxswarm.swarm.core import (ParamError, StepInfo, Swarm, SwarmConfig, Task, check_positive,
+                                 default_params, shown)
 from jaxswarm.world.paths import Solution
 from jaxswarm.world.plane import Plane, crossings, trajectory_length
 
@@ -129,7 +130,7 @@ def check_cabc(params: CABCParams) -> None:
     window and tolerance positive.
 
     Raises:
-      ValueError: naming the param.
+      ParamError: naming the param.
     """
     for name in ("w1", "w2", "w3", "w4"):
         check_positive(name, getattr(params, name), allow_zero=True)
@@ -138,7 +139,7 @@ def check_cabc(params: CABCParams) -> None:
     for name, low in (("inner_iterations", 0), ("limit", 1)):
         value = np.asarray(getattr(params, name), np.float64)
         if not np.all(np.isfinite(value) & (value == np.round(value)) & (value >= low)):
-            raise ValueError(f"{name} must be a whole number >= {low}, got {value!r}")
+            raise ParamError(name, f"must be a whole number >= {low}, got {shown(value)}")
 
 
 def trajectory(state: CABCState) -> Solution:

@@ -26,8 +26,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.runtime.arithmetic import ordered_sum
-from jaxswarm.swarm.core import (Swarm, SwarmConfig, Task, best_solution, check_positive,
-                                 default_params, keep_best)
+from jaxswarm.swarm.core import (ParamError, Swarm, SwarmConfig, Task, best_solution,
+                                 check_positive, default_params, keep_best, shown)
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update,
                                      choice_log_weights, global_update, goal_log_desirability,
                                      walked_soil)
@@ -159,7 +159,7 @@ def check_iwd(params: IWDParams) -> None:
     """Host-side check of IWD's Params: every value finite and in range.
 
     Raises:
-      ValueError: naming the bad value.
+      ParamError: naming the bad value.
     """
     for name in ("alpha", "beta", "a_v", "c_v", "a_s", "c_s", "initial_soil"):
         check_positive(name, getattr(params, name), allow_zero=True)
@@ -168,7 +168,7 @@ def check_iwd(params: IWDParams) -> None:
     check_positive("rho_iwd", params.rho_iwd, allow_zero=True)
     for name in ("rho_n", "rho_iwd"):
         if np.any(np.asarray(getattr(params, name)) > 1):
-            raise ValueError(f"{name} must be at most 1, got {getattr(params, name)}")
+            raise ParamError(name, f"must be at most 1, got {shown(getattr(params, name))}")
 
 
 def initial_soil(graph: Graph, params: IWDParams) -> jax.Array:
