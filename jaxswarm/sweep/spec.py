@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from jaxswarm.swarm import registry as swarm_registry
+from jaxswarm.swarm.core import ParamError
 from jaxswarm.sweep.maps import check_map_entry, entry_world
 
 SECTIONS = {"sweep", "config", "params"}
@@ -343,8 +344,8 @@ def _params(params: Any, swarm, algorithm: str, fail,
 
 def _check_grid(spec: SweepSpec, swarm, fail) -> None:
     """Every combination of the grid is a valid set of params for the swarm, so an
-    out-of-range value fails here, before any compute; the error names the param when the
-    swarm's message starts with it. The swarms' checks take arrays, so the whole grid is
+    out-of-range value fails here, before any compute; the error names the param the swarm's
+    check names (:class:`~jaxswarm.swarm.core.ParamError`). The swarms' checks take arrays, so the whole grid is
     checked at once; only a grid that fails is gone through combination by combination, to
     name the first that does."""
     every = spec.combination_values(np.arange(spec.num_combinations))
@@ -356,9 +357,10 @@ def _check_grid(spec: SweepSpec, swarm, fail) -> None:
     for combination in spec.grid():
         try:
             swarm.check_params(swarm.params_with(**combination))
+        except ParamError as error:
+            fail(f"params.{error.field}", str(error))
         except ValueError as error:
-            key = next((k for k in combination if str(error).startswith(k)), "[params]")
-            fail(f"params.{key}" if key in combination else key, str(error))
+            fail("[params]", str(error))
 
 
 def check_seeds(value: Any, fail, key: str = "sweep.seeds",
