@@ -63,7 +63,7 @@ def _tune(training_maps):
 def no_runs(monkeypatch):
     """Sweeps and tunes that run nothing: a sweep's map writes a stand-in row per chunk, and a
     map's optimum is not measured."""
-    def stand_in(chunks, map_index, sweep_map, todo, bar):
+    def stand_in(chunks, map_index, sweep_map, todo, bar, pace):
         for chunk in todo:
             chunks.store.write_chunk(map_index, chunk, {"map": [sweep_map.label],
                                                         "map_index": [map_index], "run": [0]})

@@ -209,17 +209,10 @@ class _Search:
                 found_at = time.perf_counter()
                 deadline = found_at + refine
                 continue
-            tree = self.trees[node]
-            if tree is None:
-                tree = self.trees[node] = _Tree(by_priority(self.priorities[node]),
-                                                collections.deque([_Constraint((), ())]))
-            if not tree.constraints:
+            exhausted, following = self._next_of(node)
+            if exhausted:
                 open_.pop()
                 continue
-            constraint = tree.constraints.popleft()
-            if constraint.depth < len(goals):
-                self._grow(node, tree, constraint)
-            following = self._successor(node, tree, constraint)
             if following is None:
                 continue
             known = explored.find(following)
@@ -230,16 +223,8 @@ class _Search:
                     open_.append(child)
                 continue
             if refine > 0:
-                limit = explored.cost[goal] if goal != NONE else _UNBOUNDED
-                again = explored.connect(node, known, limit)
-                if goal != NONE:
-                    open_.extend(again.tolist())
-                    if explored.cost[goal] < limit:
-                        self.improvements.append((time.perf_counter() - found_at,
-                                                  int(explored.cost[goal]),
-                                                  _soc(explored.way(goal), goals)))
-                    if self.rng.random() < self.restart_rate:
-                        known = root
+                again, known = self._rewire(node, known, goal, found_at, root)
+                open_.extend(again)
             if self._promising(known, goal):
                 open_.append(known)
         if goal != NONE:
@@ -252,6 +237,40 @@ class _Search:
         if time.perf_counter() > deadline:
             return None, f"reached the time limit after {explored.size} configurations"
         return None, f"reached the limit of {max_configurations} configurations"
+
+    def _next_of(self, node: int) -> tuple[bool, np.ndarray | None]:
+        """``(exhausted, configuration)``: the configuration that ``node``'s next constraint
+        leads to (None where PIBT finds none under it), or ``exhausted`` when ``node`` has no
+        constraint left; its constraint tree is made on first use."""
+        tree = self.trees[node]
+        if tree is None:
+            tree = self.trees[node] = _Tree(by_priority(self.priorities[node]),
+                                            collections.deque([_Constraint((), ())]))
+        if not tree.constraints:
+            return True, None
+        constraint = tree.constraints.popleft()
+        if constraint.depth < len(self.moves.goals):
+            self._grow(node, tree, constraint)
+        return False, self._successor(node, tree, constraint)
+
+    def _rewire(self, node: int, known: int, goal: int, found_at: float,
+                root: int) -> tuple[list[int], int]:
+        """``(again, next)`` when the search meets ``known`` from ``node`` while refining: the
+        step joins the explored graph and the Dijkstra update lowers costs through it;
+        ``again`` the configurations whose cost fell below the best solution's (searched
+        again), ``next`` the configuration to search on (``known``, or the starts' after a
+        random restart). Records an improvement of the best solution."""
+        explored = self.explored
+        limit = explored.cost[goal] if goal != NONE else _UNBOUNDED
+        again = explored.connect(node, known, limit)
+        if goal == NONE:
+            return [], known
+        if explored.cost[goal] < limit:
+            self.improvements.append((time.perf_counter() - found_at, int(explored.cost[goal]),
+                                      _soc(explored.way(goal), self.moves.goals)))
+        if self.rng.random() < self.restart_rate:
+            known = root
+        return again.tolist(), known
 
     def _promising(self, node: int, goal: int) -> bool:
         """Whether ``node`` may still lead to a solution cheaper than ``goal``'s (always, while
