@@ -20,8 +20,11 @@ a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The 
   the seeds, are timed and the loop's wall time is extrapolated to all runs; the output says so.
 * the speed-up (loop wall / sweep wall, compile excluded on both sides) against the goal (5x for
   16 agents, 1.5x for 64), the peak memory against 4 GiB, the moves per second of each (the
-  agents' moves of all runs, counted by the runs' traces), and a correctness check: the sweep's
-  cost (bit for bit, float32) and moves equal the loop's for every run measured in both.
+  agents' moves of all runs, counted by the runs' traces), and a correctness check (``same
+  result``): the sweep's row of every run measured in both equals the loop's run, its cost (bit
+  for bit, float32), its moves and its fingerprint (the whole final state and trace,
+  :func:`jaxswarm.swarm.fingerprint.run_fingerprint`, taken after the timed loop). A run that
+  differs is listed below the table with its seed and params.
 
 Run from the repository root::
 
@@ -46,6 +49,7 @@ import numpy as np
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
+from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep import run_sweep, spec_from_dict
 from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
 
@@ -123,8 +127,8 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
     def one(r: int):
         state, trace = run(swarm, jax.random.key(seeds[r % len(seeds)]), graph, task,
                            params_of(r), iterations=spec.iterations)
-        return jax.block_until_ready((swarm.best(state).cost, trace.iterations,
-                                      jnp.sum(trace.moves)))
+        return jax.block_until_ready((swarm.best(state).cost, jnp.sum(trace.moves), state,
+                                      trace))
 
     began = time.perf_counter()
     one(runs[0])  # warm-up: the loop's only compile
@@ -134,9 +138,12 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
     for r in runs:
         results[r] = one(r)
     wall = time.perf_counter() - began
-    costs = {r: np.float32(cost) for r, (cost, _, _) in results.items()}
-    moves = {r: int(made) for r, (_, _, made) in results.items()}
-    return dict(costs=costs, moves=moves, wall=wall, compile=compile_seconds)
+    fingerprint = jax.jit(run_fingerprint)
+    return dict(costs={r: np.float32(result[0]) for r, result in results.items()},
+                moves={r: int(result[1]) for r, result in results.items()},
+                fingerprints={r: hex_fingerprint(fingerprint(*result[2:]))
+                              for r, result in results.items()},
+                wall=wall, compile=compile_seconds)
 
 
 def measure(args, agents: int) -> dict:
@@ -150,9 +157,10 @@ def measure(args, agents: int) -> dict:
     runs = loop_runs(total, len(spec.grid()), len(spec.seeds), args.loop_runs)
     loop = time_loop(spec, args.map, runs)
     by_run = sweep["frame"].set_index("run")
-    mismatches = [r for r in runs
+    mismatches = [by_run.loc[r] for r in runs
                   if not np.array_equal(np.float32(by_run["cost"].loc[r]), loop["costs"][r])
-                  or by_run["moves"].loc[r] != loop["moves"][r]]
+                  or by_run["moves"].loc[r] != loop["moves"][r]
+                  or by_run["fingerprint"].loc[r] != loop["fingerprints"][r]]
     sweep_wall = sweep["wall"] - sweep["compile"]
     loop_wall = loop["wall"] * total / len(runs)
     return dict(total=total, sweep_wall=sweep_wall, loop_wall=loop_wall,
@@ -200,6 +208,9 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['measured']:<5} {r['iterations']:>10.1f} "
               f"{r['moves'] / r['sweep_wall'] / 1e6:>12.2f} / {r['moves'] / r['loop_wall'] / 1e6:<7.2f}",
               flush=True)
+        for row in r["mismatches"]:
+            print(f"  differs from the loop: run {row.name}, seed {int(row.seed)}, "
+                  f"p_base {float(row.p_base)!r}, alpha {float(row.alpha)!r}", flush=True)
     print("* loop extrapolated from --loop-runs runs" if args.loop_runs else "")
     print(f"goals: speed-up {', '.join(f'{v}x at {k} agents' for k, v in GOAL_SPEEDUP.items())}; "
           f"peak memory below {GOAL_MEMORY / GiB:.0f} GiB and flat in the number of runs")

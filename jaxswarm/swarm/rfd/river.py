@@ -137,9 +137,14 @@ def gradients(graph: Graph, altitude: jax.Array) -> tuple[jax.Array, jax.Array]:
     """``(heads i32[K, N], gradient f32[K, N])``, slot-major (see
     :func:`~jaxswarm.swarm.walking.tables.neighbour_slots`; transpose the finished table once):
     each slot's neighbour (0 where there is none) and the RFD paper's eq. 2,
-    ``(altitude(i) - altitude(j)) / distance(i, j)``."""
+    ``(altitude(i) - altitude(j)) / distance(i, j)``, computed as the drop times the reciprocal
+    of the distance."""
     drop = altitude - neighbour_slots(graph, altitude)
-    return heads(graph).T, drop / jnp.where(graph.nbr >= 0, graph.cost, 1.0).T
+    # Not a division: under vmap the map's distances are one operand shared by the batch, and
+    # XLA rewrites a division by a broadcast operand as a multiplication by its reciprocal
+    # (up to 1.5 ulp away from the quotient), so a run alone and the same run in a sweep drew
+    # from different tables. Multiplying by the reciprocal is what every program computes.
+    return heads(graph).T, drop * (1.0 / jnp.where(graph.nbr >= 0, graph.cost, 1.0).T)
 
 
 def sediment_where_stuck(num_nodes: int, drops: Walk, sediment) -> jax.Array:
