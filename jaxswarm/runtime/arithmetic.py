@@ -10,7 +10,11 @@ arithmetic, each measured on x86-64 with jax 0.10.2:
   option turns contraction off, but without FMA instructions there is nothing to contract to:
   :data:`ISA_FLAG` caps XLA's vector instructions at AVX, whose multiplies and adds each round
   once. Every elementwise chain of IEEE operations (``+ - * /``, ``sqrt``, comparisons, integer
-  conversions) then gives one result in every program.
+  conversions) then gives one result in every program, with one exception: XLA rewrites a
+  division by an operand a batch shares (a map's distances under a ``vmap`` over runs) as a
+  multiplication by its reciprocal, so a quotient differs by an ulp between a run alone and
+  the same run in a batch. Divide by a shared operand as ``x * (1 / y)``, what every program
+  computes.
 * **Transcendentals.** XLA's ``exp`` takes another code path on some widths (1 of 8 results
   differs in its last bit between a row of 3 and a row of 3,000); ``log``, ``pow``, ``tanh``,
   ``log1p`` and ``expm1`` were the same on every width tried. :func:`exp` is built from IEEE

@@ -116,7 +116,8 @@ def paper_altitude_rule(state: RFDState, before: Graph, after: Graph, old: Task,
     altitude = state.altitude
     valid = after.valid_edges()[old.goal]
     around = jnp.where(valid, altitude[jnp.maximum(after.nbr[old.goal], 0)], 0.0)
-    mean = ordered_sum(around) / jnp.maximum(jnp.sum(valid), 1)
+    # Times the reciprocal: the count comes from the map, which a batch of runs may share.
+    mean = ordered_sum(around) * (1.0 / jnp.maximum(jnp.sum(valid), 1))
     nodes = jnp.arange(altitude.shape[0])
     moved = (nodes == old.goal) & (new.goal != old.goal)
     opened = after.free & ~before.free
