@@ -167,6 +167,7 @@ class _Search:
         self.agents = np.arange(len(moves.goals))
         self.priorities: list[np.ndarray] = []  # f64[A] of each configuration, by id
         self.trees: list[_Tree | None] = []  # by id
+        self.options: dict[int, list[int]] = {}  # by node, see _options
         self.began = time.perf_counter()
         self.first_soc: int | None = None
         self.first_loss: int | None = None
@@ -286,12 +287,20 @@ class _Search:
     def _grow(self, node: int, tree: "_Tree", constraint: _Constraint) -> None:
         """Add the children of ``constraint``: the next agent's candidates, keyed order."""
         agent = int(tree.order[constraint.depth])
-        here = int(self.explored.nodes[node, agent])
-        moves = self.moves
-        options = np.append(moves.heads[moves.indptr[here]:moves.indptr[here + 1]], here)
-        for v in self.rng.permutation(options).tolist():
-            tree.constraints.append(_Constraint(constraint.who + (agent,),
-                                                constraint.where + (v,)))
+        options = list(self._options(int(self.explored.nodes[node, agent])))
+        self.rng.shuffle(options)
+        who = constraint.who + (agent,)
+        for v in options:
+            tree.constraints.append(_Constraint(who, constraint.where + (v,)))
+
+    def _options(self, here: int) -> list[int]:
+        """The nodes an agent on ``here`` may go to next: its neighbours, then ``here``."""
+        options = self.options.get(here)
+        if options is None:
+            moves = self.moves
+            options = self.options[here] = (
+                moves.heads[moves.indptr[here]:moves.indptr[here + 1]].tolist() + [here])
+        return options
 
     def _successor(self, node: int, tree: "_Tree",
                    constraint: _Constraint) -> np.ndarray | None:
