@@ -208,7 +208,7 @@ def test_two_agents_head_on_in_a_corridor_swap_where_it_widens():
 @pytest.mark.parametrize("option, value, error, message", [
     ("time_limit", -1, ValueError, "time_limit must be positive, got -1"),
     ("time_limit", float("nan"), ValueError, "time_limit must be positive, got nan"),
-    ("time_limit", "5", TypeError, "time_limit must be a number, got '5'"),
+    ("time_limit", "5", TypeError, "time_limit must be a number of seconds, got '5'"),
     ("refine", float("nan"), ValueError, "refine must be at least 0, got nan"),
     ("refine", None, TypeError, "refine must be a number, got None"),
     ("max_configurations", 2.5, TypeError, "max_configurations must be an integer, got 2.5"),

@@ -37,6 +37,7 @@ import numpy as np
 
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.explored import NONE, Explored
+from jaxswarm.multiagent.limits import check_count, check_seconds
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
@@ -133,23 +134,19 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
 
 def _check_options(*, time_limit, refine, swap, max_configurations, seed, restart_rate):
     """Refuse, naming it, an option of :func:`lacam` of the wrong type or out of its range."""
-    for name, value in (("time_limit", time_limit), ("refine", refine),
-                        ("restart_rate", restart_rate)):
+    check_seconds("time_limit", time_limit)
+    check_count("max_configurations", max_configurations)
+    for name, value in (("refine", refine), ("restart_rate", restart_rate)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real):
             raise TypeError(f"{name} must be a number, got {value!r}")
-    for name, value in (("max_configurations", max_configurations), ("seed", seed)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-            raise TypeError(f"{name} must be an integer, got {value!r}")
+    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
+        raise TypeError(f"seed must be an integer, got {seed!r}")
     if not isinstance(swap, (bool, np.bool_)):
         raise TypeError(f"swap must be True or False, got {swap!r}")
-    if not time_limit > 0:
-        raise ValueError(f"time_limit must be positive, got {time_limit}")
     if not refine >= 0:
         raise ValueError(f"refine must be at least 0, got {refine}")
     if not 0 <= restart_rate <= 1:
         raise ValueError(f"restart_rate must be between 0 and 1, got {restart_rate}")
-    if max_configurations < 1:
-        raise ValueError(f"max_configurations must be at least 1, got {max_configurations}")
     if seed < 0:
         raise ValueError(f"seed must be at least 0, got {seed}")
 
