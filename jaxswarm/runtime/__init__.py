@@ -3,5 +3,6 @@
 (:mod:`~jaxswarm.runtime.cpu`), compiled programs kept between processes
 (:mod:`~jaxswarm.runtime.cache`) and let go when a process holds too many
 (:mod:`~jaxswarm.runtime.programs`), files written whole or not at all
-(:mod:`~jaxswarm.runtime.atomic`) and a vmap rule for loops whose trip count differs between
+(:mod:`~jaxswarm.runtime.atomic`), one writing process per folder (:mod:`~jaxswarm.runtime.lock`)
+and a vmap rule for loops whose trip count differs between
 batch members (:mod:`~jaxswarm.runtime.batching`)."""
