@@ -4,6 +4,7 @@ any JAX program is compiled (this file has no budget in tests/compile_budgets.to
 with a ValueError naming the key or argument, from the CLI with exit status 2."""
 import json
 import math
+import re
 
 import jax
 import numpy as np
@@ -336,6 +337,16 @@ def test_replay_of_a_tune_s_store_says_so(tmp_path, capsys):
                                          "sweep's"):
         replay_row(out, 0)
     assert f"{out} is a tune's store" in exit_message(["replay", str(out), "0"], capsys)
+
+
+def test_replay_of_a_store_whose_metadata_is_not_json_names_the_file_and_line(tmp_path, capsys):
+    out = tmp_path / "store"
+    (out / "runs").mkdir(parents=True)
+    (out / "metadata.json").write_text('{"spec": [')
+    expected = f"{out / 'metadata.json'}: line 1 column 11: not valid JSON"
+    with pytest.raises(ValueError, match=re.escape(expected)):
+        replay_row(out, 0)
+    assert expected in exit_message(["replay", str(out), "0"], capsys)
 
 
 ROW = dict(map=["mosaic20"], map_index=[0], run=[0], algorithm=["rfd_star"], seed=[0],

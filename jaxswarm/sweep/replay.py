@@ -16,7 +16,6 @@ missing value), is refused with the store, the row and the column named.
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 import re
 from pathlib import Path
@@ -32,7 +31,7 @@ from jaxswarm.swarm.core import Swarm, Task, Trace
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep.maps import SweepMap, resolve_map
 from jaxswarm.sweep.spec import SEED_LIMIT, spec_from_record
-from jaxswarm.sweep.store import read_results
+from jaxswarm.sweep.store import ResultsStore, read_results
 
 CHECKED = ("cost", "iterations", "moves", "evaluations", "fingerprint")
 """The stored figures a replay of a store's row must reproduce bit for bit."""
@@ -136,13 +135,9 @@ def _replay_table_row(table: Path, row: int) -> Replayed:
 
 def _sweep_record(metadata_path: Path) -> dict:
     """The sweep spec a store's ``metadata.json`` records, or a ValueError naming the file:
-    unreadable JSON, a tune's store (its spec names a method and training instances), or no
-    spec."""
-    try:
-        metadata = json.loads(metadata_path.read_text())
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise ValueError(f"{metadata_path}: cannot be read as JSON ({error})") from None
-    record = metadata.get("spec") if isinstance(metadata, dict) else None
+    not a JSON object (:meth:`~jaxswarm.sweep.store.ResultsStore.read_metadata`), a tune's
+    store (its spec names a method and training instances), or no spec."""
+    record = ResultsStore.read_metadata(metadata_path.parent).get("spec")
     if isinstance(record, dict) and "training" in record and "method" in record:
         raise ValueError(f"{metadata_path.parent} is a tune's store (jaxswarm tune), not a "
                          "sweep's: replay takes a sweep's store or a results folder with a "
