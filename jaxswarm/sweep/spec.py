@@ -345,9 +345,9 @@ def _params(params: Any, swarm, algorithm: str, fail,
 def _check_grid(spec: SweepSpec, swarm, fail) -> None:
     """Every combination of the grid is a valid set of params for the swarm, so an
     out-of-range value fails here, before any compute; the error names the param the swarm's
-    check names (:class:`~jaxswarm.swarm.core.ParamError`). The swarms' checks take arrays, so the whole grid is
-    checked at once; only a grid that fails is gone through combination by combination, to
-    name the first that does."""
+    check names (:class:`~jaxswarm.swarm.core.ParamError`). The swarms' checks take arrays, so
+    the whole grid is checked at once; only a grid that fails is gone through combination by
+    combination, to name the first that does."""
     every = spec.combination_values(np.arange(spec.num_combinations))
     try:
         swarm.check_params(swarm.params_with(**every))
