@@ -72,8 +72,10 @@ MAPF_FULL := --maps all --scenarios random,even --agents 10,20,50,100,200,400,70
 	--time-limit 30
 CALIBRATION_FULL := --stores out/calibration/stores --compare-specs tunes/compare/aco_star.toml \
 	tunes/compare/iwd.toml tunes/compare/max_min_aco.toml tunes/compare/rfd_star.toml
-TABLE1_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
-RFD_QUICK := --maps alley20 --seeds 1 --iterations 2 --agents 8
+# The sizes of tests/test_rfd_paper_static.py's and tests/test_rfd_static.py's runs of the same
+# scripts: the slow tier compiles their programs once for both (JAX's persistent cache).
+TABLE1_QUICK := --maps mosaic20 --seeds 2 --iterations 3 --agents 16
+RFD_QUICK := --maps maze20 --seeds 2 --iterations 4 --agents 16
 PATHMAPS_QUICK := --sizes 10x10 --runs 2 --max-ants 200
 EXACT_QUICK := --sizes 10 --grids 2
 DYNAMIC_QUICK := --maps alley20 --tables 2 --seeds 1 --iterations 2 --patience 1 --agents 8

@@ -1,8 +1,10 @@
 """Every registered swarm's promises (:mod:`jaxswarm.swarm.testing`) on its conformance world
 (maze20 for the walkers, the 6 x 6 plane for the bees): one key, one result (alone equals the
 same key in a batch of 3 runs; in batches of 1 and 64, and of 1,000, in the slow tier),
-reproducible per key, valid results never below the optimum, a batch over params compiled once,
-and its golden records (``tests/golden/swarms.json``) replayed bit for bit. Sweep rows on other
+reproducible per key, valid results never below the optimum, a walker's clean "not found" on a
+goal behind a wall (the shared size's run on a map cut out of the maze's shape), a batch over
+params compiled once, and its golden records (``tests/golden/swarms.json``) replayed bit for
+bit. Sweep rows on other
 thread and device counts, in processes of their own, are checked in ``test_sweep.py``.
 
 One test class per swarm: under ``--dist loadscope`` (the Makefile's) a class runs on one
@@ -14,15 +16,18 @@ after agent, is checked in the default tier by ``test_walk.py`` (a batch of walk
 agents than lanes, each as alone) and here in the slow tier (batches of 64 runs)."""
 import json
 
+import numpy as np
 import pytest
 import sizes
 from conformance import field, maze, world_of  # noqa: F401 (fixtures)
 from golden.swarms import GOLDEN, cases, replay
 
 from jaxswarm import swarm as swarms
-from jaxswarm.swarm import make
+from jaxswarm.swarm import make, make_task
 from jaxswarm.swarm.testing import (check_batch_invariant, check_compiles_once,
-                                     check_reproducible, check_valid_results)
+                                     check_reproducible, check_unreachable_goal,
+                                     check_valid_results)
+from jaxswarm.world.graph import Graph
 
 SMALL = sizes.CONFIG
 ITERATIONS = sizes.ITERATIONS
@@ -90,8 +95,28 @@ class Conformance:
                               widths=(1000,))
 
 
+@pytest.fixture(scope="module")
+def walled():
+    """``(graph, task)``: a 6 x 6 room of the shared map's shape split by a wall, from the start
+    on one side to the goal on the other: the shared size's run program on a goal no walker
+    reaches."""
+    free = np.ones((6, 6), bool)
+    free[:, 3] = False
+    graph = sizes.cut_out(free)
+    return graph, make_task(graph, (0, 0), (5, 5))
+
+
+class WalkerConformance(Conformance):
+    """The checks of a swarm on a graph: those of every swarm, and a goal it cannot reach."""
+
+    def test_an_unreachable_goal_is_a_clean_not_found_result(self, walled):
+        graph, task = walled
+        check_unreachable_goal(make(self.name, **SMALL), graph, task, iterations=ITERATIONS)
+
+
 for _name in [*FIRST, *(n for n in swarms.registered() if n not in FIRST)]:
-    globals()[f"TestSwarm_{_name}"] = type(f"TestSwarm_{_name}", (Conformance,), {"name": _name})
+    _base = WalkerConformance if make(_name).world is Graph else Conformance
+    globals()[f"TestSwarm_{_name}"] = type(f"TestSwarm_{_name}", (_base,), {"name": _name})
 
 
 def test_every_registered_swarm_has_its_golden_records():

@@ -22,6 +22,7 @@ from jaxswarm.studies.success import SUCCESS_GAP
 from jaxswarm.world.paths import as_node, is_valid_path, path_length
 from repo_scripts import load_script
 
+# The Makefile's TABLE1_QUICK (make reproduce-quick): the slow tier compiles one set of programs.
 MAP, SEEDS, ITERATIONS, AGENTS = "mosaic20", 2, 3, 16
 EXACT = ("Dijkstra", "A*")
 # Row label -> what runs (runs.csv's planner column) and the paper's Table 1 row beside it.

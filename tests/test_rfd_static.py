@@ -18,6 +18,7 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.studies.success import SUCCESS_GAP
 from repo_scripts import load_script
 
+# The Makefile's RFD_QUICK (make reproduce-quick): the slow tier compiles one set of programs.
 MAP, SEEDS, ITERATIONS, AGENTS = "maze20", 2, 4, 16
 SOURCES = {"rfd": "RFD paper", "rfd_star": "RFD paper", "rfd_graded": "ours"}
 

@@ -609,12 +609,15 @@ ONE_KEY = textwrap.dedent("""
 
 
 def one_key_document(name: str) -> dict:
-    """A sweep of ``name`` over 4 seeds in chunks of 4 (2 runs a device on 2 devices)."""
+    """A sweep of ``name`` over 4 seeds in chunks of 4 (2 runs a device on 2 devices) at the
+    shared size on the shared maze (the bees on plane map1), whose runs alone are the slow
+    conformance checks' programs (iwd's, with drops that change the soil as they walk, the
+    hooked walk's)."""
     on_plane = make(name).world is not jaxswarm.Graph
-    config = {"num_agents": 8} | ({"local_updates": "while_walking"} if name == "iwd" else {})
+    config = sizes.CONFIG | ({"local_updates": "while_walking"} if name == "iwd" else {})
     return {"sweep": {"name": f"one_key_{name}", "algorithm": name, "seeds": 4,
-                      "maps": [{"plane": "map1"}] if on_plane else ["mosaic20"],
-                      "iterations": 4, "chunk_size": 4},
+                      "maps": [{"plane": "map1"}] if on_plane else [sizes.MAP],
+                      "iterations": sizes.ITERATIONS, "chunk_size": 4},
             "config": config}
 
 

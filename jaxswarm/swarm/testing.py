@@ -10,6 +10,9 @@ Each check raises ``AssertionError`` naming what failed:
   optimum; the trace's best cost never rises; the memory stays finite. On a plane the path is a
   trajectory of waypoints: it starts at the start, ends at the goal, no waypoint lies inside a
   rectangle, and its cost is :func:`jaxswarm.world.plane.trajectory_length`.
+* :func:`check_unreachable_goal`: on a graph whose goal cannot be reached, a run ends as a
+  clean "not found": no path, an infinite cost, no agent arrived, and it runs its whole budget
+  (the convergence stop needs arrivals).
 * :func:`check_compiles_once`: a ``vmap`` of runs over valid values of a param compiles once,
   and new values of the same shapes do not compile again.
 * :func:`check_batch_invariant`: one key, one result: a run alone equals the same key in
@@ -189,6 +192,24 @@ def check_valid_results(swarm: Swarm, graph: World, task: Task, optimum: float, 
             f"{swarm.name}: cost is not the path's length")
     assert float(solution.cost) >= optimum, f"{swarm.name}: beats the optimum {optimum}"
     assert float(solution.cost) == best[ran - 1], f"{swarm.name}: trace and state disagree"
+
+
+def check_unreachable_goal(swarm: Swarm, graph: World, task: Task, *,
+                           iterations: int = 8) -> None:
+    """A run on ``graph``, whose ``task.goal`` cannot be reached from ``task.start``, finds no
+    path: ``found`` is false, the cost infinite, the path all -1, no agent arrived in any
+    iteration, and the run used all ``iterations`` (no agent arrived, so no iteration
+    converged; patience counts only from the first path, which
+    :func:`~jaxswarm.swarm.core.run` applies alike to every swarm)."""
+    state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
+                       iterations=iterations)
+    solution = swarm.best(state)
+    assert not bool(solution.found), f"{swarm.name}: found a path to an unreachable goal"
+    assert np.isinf(float(solution.cost)), f"{swarm.name}: a finite cost without a path"
+    assert (np.asarray(solution.path) == -1).all(), f"{swarm.name}: a path without a way"
+    assert (np.asarray(trace.arrived) == 0).all(), f"{swarm.name}: agents arrived"
+    assert int(trace.iterations) == iterations, (
+        f"{swarm.name}: stopped after {int(trace.iterations)} of {iterations} iterations")
 
 
 def _check_trajectory(swarm: Swarm, plane: Plane, task: Task, solution) -> None:
