@@ -276,7 +276,8 @@ def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations:
 
 
 def check_swarm(swarm: Swarm, graph: World, task: Task, optimum: float) -> None:
-    """Every check of this module, with their defaults."""
+    """Every check of this module that runs on a reachable goal, with their defaults (for
+    :func:`check_unreachable_goal`, give it a graph whose goal cannot be reached)."""
     check_reproducible(swarm, graph, task)
     check_batch_invariant(swarm, graph, task)
     check_valid_results(swarm, graph, task, optimum)
