@@ -8,7 +8,8 @@ The notebooks also check their own results with ``assert``. After a run, the tes
 
 * quickstart: the JSON line printed by the cell tagged ``checks``. The three exact planners report
   one finite optimum, no swarm beats it, and a repeated key reproduces its run. Its figures were
-  shown inline.
+  shown inline. Its small sizes are the suite's shared size (``tests/sizes.py``), so its runs
+  alone are programs the default tier compiled (JAX's persistent cache, when it ran first).
 * dynamic: the JSON line of its ``checks`` cell (three swarms continued after the goal moved, none
   beating the new optimum) and the GIF it wrote under ``tmp_path``.
 * tuning: the JSON line of its ``checks`` cell (a race and a random search within their budget,
