@@ -66,7 +66,7 @@ class ConstraintTrees:
 @inline
 def _queue(trees, tree, parent, agent, node, depth):
     """Append a new constraint to ``tree``'s queue."""
-    order, head, tail, parent_of, agent_of, node_of, depth_of, queued, counts = trees
+    (_, head, tail, parent_of, agent_of, node_of, depth_of, queued, counts) = trees
     new = counts[1]
     counts[1] += 1
     parent_of[new], agent_of[new], node_of[new], depth_of[new] = parent, agent, node, depth
@@ -82,7 +82,7 @@ def _queue(trees, tree, parent, agent, node, depth):
 def plant(trees, priorities):
     """A new tree for agents of ``priorities`` (f64[A]): its order, highest priority first and
     ties by agent number, and its root queued. Returns its id."""
-    order, head, tail, parent, agent, node, depth, queued, counts = trees
+    (order, head, _, _, _, _, _, _, counts) = trees
     tree = counts[0]
     counts[0] += 1
     order[tree] = np.argsort(-priorities, kind="mergesort")
@@ -97,7 +97,7 @@ def take(trees, tree, indptr, heads, current, options, rng):
     (``heads[indptr[u]:indptr[u + 1]]`` and ``u``, its node in ``current``, i32[A]) shuffled
     by ``rng`` (a NumPy ``Generator``) in the scratch array ``options`` (i32[C]). Returns the
     constraint, or NONE when the tree has none left."""
-    order, head, tail, parent, agent, node, depth, queued, counts = trees
+    (order, head, _, _, _, _, depth, queued, _) = trees
     taken = head[tree]
     if taken == NONE:
         return NONE
@@ -119,7 +119,7 @@ def take(trees, tree, indptr, heads, current, options, rng):
 def gather(trees, constraint, who, where):
     """Write the agents ``constraint`` fixes to ``who`` and their next nodes to ``where`` (i32[A]
     each), the order's first agent first; returns how many."""
-    order, head, tail, parent, agent, node, depth, queued, counts = trees
+    (_, _, _, parent, agent, node, depth, _, _) = trees
     fixed = depth[constraint]
     k = fixed
     while k > 0:

@@ -175,8 +175,7 @@ def _rebuild(nodes, size, slots, old_links, links):
 def spare(explored):
     """i32[A] the row the next configuration is written to before :func:`find` (the arrays
     hold room for it between the loop's calls, :meth:`Explored.reserve`)."""
-    (goals, nodes, cost, bound, parent, first, settled, slots, edge_next, edge_head, edge_cost,
-     links, counts) = explored
+    (_, nodes, _, _, _, _, _, _, _, _, _, _, counts) = explored
     return nodes[counts[0]]
 
 
@@ -184,8 +183,7 @@ def spare(explored):
 def find(explored):
     """``(id, slot)``: the id of the configuration in :func:`spare` (NONE if it is new) and its
     slot in the hash table, for :func:`add`."""
-    (goals, nodes, cost, bound, parent, first, settled, slots, edge_next, edge_head, edge_cost,
-     links, counts) = explored
+    (_, nodes, _, _, _, _, _, slots, _, _, _, _, counts) = explored
     s = _slot(nodes, slots, nodes[counts[0]])
     return slots[s], s
 
@@ -195,8 +193,7 @@ def add(explored, slot, parent, bound):
     """Add the new configuration in :func:`spare` (``slot``: from :func:`find`), reached from
     ``parent`` (an id) with lower bound ``bound`` to the goals; the edge from the parent is
     added. Returns its id."""
-    (goals, nodes, cost, bound_of, parent_of, first, settled, slots, edge_next, edge_head,
-     edge_cost, links, counts) = explored
+    (_, _, cost, bound_of, parent_of, first, _, slots, _, _, _, _, counts) = explored
     new = counts[0]
     counts[0] += 1
     slots[slot] = new
@@ -211,8 +208,7 @@ def add(explored, slot, parent, bound):
 def _link(explored, source, target, key):
     """Add the edge ``source -> target`` (its ``key`` not in ``links`` yet); returns its step
     cost: the agents not resting at their goals through the step."""
-    (goals, nodes, cost, bound, parent, first, settled, slots, edge_next, edge_head, edge_cost,
-     links, counts) = explored
+    (goals, nodes, _, _, _, first, _, _, edge_next, edge_head, edge_cost, links, counts) = explored
     links[_link_slot(links, key)] = key
     step = 0
     for a in range(goals.shape[0]):
@@ -242,8 +238,8 @@ def connect(explored, source, target, limit):
       fell and whose cost plus bound is now below ``limit``, cheapest first, the ones to search
       again.
     """
-    (goals, nodes, cost, bound, parent, first, settled, slots, edge_next, edge_head, edge_cost,
-     links, counts) = explored
+    (_, _, cost, bound, parent, first, settled, _, edge_next, edge_head, edge_cost, links,
+     _) = explored
     key = (source << 32) | target
     if source == target or links[_link_slot(links, key)] == key:
         return 0
