@@ -4,7 +4,9 @@ when there is none), LaCAM* to the joint-state optimum, and both on benchmark in
 the validator."""
 from __future__ import annotations
 
+import collections
 import heapq
+import itertools
 import math
 
 import numpy as np
@@ -13,6 +15,7 @@ import pytest
 import oracle
 from jaxswarm.multiagent import (hop_fields, lacam, load_instance, lower_bound, pibt,
                                  prioritized, validate)
+from jaxswarm.multiagent.constraint_trees import NONE, ConstraintTrees, gather, plant, take
 from jaxswarm.multiagent.pibt import Moves, Workspace, by_priority, configuration
 from jaxswarm.world.graph import grid_graph
 
@@ -83,6 +86,39 @@ def test_fixed_moves_are_kept_and_colliding_ones_refused():
 
 def test_priorities_put_the_longest_waiting_first():
     assert by_priority(np.array([0.5, 2.25, 2.25, 1.0])).tolist() == [1, 2, 3, 0]
+
+
+def test_a_constraint_tree_enumerates_every_combination_of_moves_once_breadth_first():
+    # Nodes 0 1 2 / 3 # 5. The tree orders the agents by priority (agent 1, then 0 and 2, tied,
+    # by number); a constraint at depth d fixes the first d of them, each to its neighbours or
+    # its own node, and the root's children come in the order NumPy's Generator.shuffle gives
+    # the list of the first agent's candidates.
+    graph, adjacency = grid(["...", ".#."])
+    current = np.array([0, 2, 3], np.int32)
+    moves = Moves.build(graph, current, hop_fields(graph, current))
+    trees = ConstraintTrees(agents=3)
+    trees.reserve(1, 64)
+    tree = plant(trees.arrays, np.array([0.5, 2.0, 0.5]))
+    assert trees.order[tree].tolist() == [1, 0, 2]
+    rng = np.random.default_rng(3)
+    options, who, where = (np.empty(n, np.int32) for n in (moves.candidates, 3, 3))
+    taken = collections.defaultdict(list)  # depth: the nodes of each constraint taken
+    depths = []
+    while (constraint := take(trees.arrays, tree, moves.indptr, moves.heads, current, options,
+                              rng)) != NONE:
+        depth = gather(trees.arrays, constraint, who, where)
+        assert who[:depth].tolist() == [1, 0, 2][:depth]
+        taken[depth].append(tuple(where[:depth].tolist()))
+        depths.append(depth)
+    assert depths == sorted(depths)
+    candidates = [[y * 3 + x for (x, y), _ in adjacency[(u % 3, u // 3)]] + [u]
+                  for u in current[[1, 0, 2]].tolist()]
+    for depth in range(4):
+        combinations = list(itertools.product(*candidates[:depth]))
+        assert sorted(taken[depth]) == sorted(combinations)  # each once
+    first = moves.heads[moves.indptr[2]:moves.indptr[3]].tolist() + [2]
+    np.random.default_rng(3).shuffle(first)
+    assert [nodes[0] for nodes in taken[1]] == first
 
 
 TINY = [  # (obstacle rows, starts, goals): the joint-state search's instances of test_multiagent
@@ -358,6 +394,17 @@ def test_lacam_star_claims_an_optimum_only_when_the_joint_state_search_agrees():
              (np.array([[0, 0, 0], [0, 0, 1], [0, 0, 0]], bool), [6, 8, 7, 1], [7, 2, 1, 4])]
     assert assert_optimum_claims(found, seeds=range(4)) == 8
     assert assert_optimum_claims(tiny_instances(12, seed=7), seeds=range(2)) >= 12
+
+
+def test_lacam_star_reaches_the_optimum_past_its_stores_first_capacity():
+    """2,727 configurations (the stores grow from 1,024 rows, their hash tables rebuilt) and
+    still the joint-state optimum, sum of loss 20."""
+    found = [(np.array([[0, 1, 0, 0, 0], [0, 0, 0, 0, 0]], bool), [5, 8, 2, 9, 7],
+              [2, 5, 4, 7, 6])]
+    assert assert_optimum_claims(found, seeds=[0]) == 1
+    blocked, starts, goals = found[0]
+    plan = lacam(grid_graph(blocked, connectivity=4), starts, goals, refine=30.0)
+    assert plan.stats["configurations"] > 2048 and plan.stats["sum_of_loss"] == 20
 
 
 @pytest.mark.slow

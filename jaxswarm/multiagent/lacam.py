@@ -25,45 +25,28 @@ sum of loss exists (``stats["optimal"]``); the sum of costs, which also counts t
 rests at its goal before it leaves it again, may be above its least. LaCAM*'s other change,
 its successor generator (``swap``: PIBT with the swap operation, which lets two agents meeting
 head on in a corridor trade places where it widens), is a switch of its own.
+
+The search runs compiled (numba, as PIBT's step): one call of its loop takes a few hundred steps
+over the arrays of :mod:`~jaxswarm.multiagent.explored` (the configurations, found by a hash of
+their nodes) and :mod:`~jaxswarm.multiagent.constraint_trees` (the trees, a constraint a few
+numbers), drawing the trees' orders and the restarts from one NumPy ``Generator`` seeded with
+``seed``; between calls Python checks the time, grows the arrays and records the solutions.
 """
 from __future__ import annotations
 
-import collections
-import dataclasses
 import numbers
 import time
 
 import numpy as np
 
+from jaxswarm.exact.kernels import inline, jit
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
-from jaxswarm.multiagent.explored import NONE, Explored
+from jaxswarm.multiagent.constraint_trees import ConstraintTrees, gather, plant, take
+from jaxswarm.multiagent.explored import NONE, Explored, add, connect, find, grown, spare
 from jaxswarm.multiagent.limits import check_count, check_seconds
-from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
-                                      initial_priorities, next_priorities)
+from jaxswarm.multiagent.pibt import Moves, Workspace, compiled_configuration, initial_priorities
 from jaxswarm.multiagent.plan import Plan, arrival_steps
 from jaxswarm.world.graph import Graph
-
-
-@dataclasses.dataclass
-class _Constraint:
-    """A node of a configuration's constraint tree: the next nodes of the first ``depth``
-    agents of the configuration's order (``who[k]`` goes to ``where[k]``)."""
-
-    who: tuple
-    where: tuple
-
-    @property
-    def depth(self) -> int:
-        return len(self.who)
-
-
-@dataclasses.dataclass
-class _Tree:
-    """A configuration's agents by priority (i32[A]) and the constraints of its tree not taken
-    yet (breadth first); made when the configuration is first expanded."""
-
-    order: np.ndarray
-    constraints: collections.deque
 
 
 _UNBOUNDED = np.iinfo(np.int64).max
@@ -152,19 +135,26 @@ def _check_options(*, time_limit, refine, swap, max_configurations, seed, restar
 
 
 class _Search:
-    """One LaCAM (or LaCAM*) search over an instance's configurations."""
+    """One LaCAM (or LaCAM*) search over an instance's configurations: the stores of
+    :mod:`~jaxswarm.multiagent.explored` and :mod:`~jaxswarm.multiagent.constraint_trees`, each
+    configuration's priorities and tree, and the open stack, which :func:`_steps` works on."""
 
     def __init__(self, moves: Moves, seed: int, swap: bool, restart_rate: float):
+        agents = len(moves.goals)
         self.moves = moves
         self.swap = swap
         self.restart_rate = restart_rate
         self.work = Workspace(moves, seed)
         self.rng = np.random.default_rng(seed)
         self.explored = Explored(moves.goals)
-        self.agents = np.arange(len(moves.goals))
-        self.priorities: list[np.ndarray] = []  # f64[A] of each configuration, by id
-        self.trees: list[_Tree | None] = []  # by id
-        self.options: dict[int, list[int]] = {}  # by node, see _options
+        self.trees = ConstraintTrees(agents)
+        capacity = len(self.explored.cost)
+        self.priorities = np.empty((capacity, agents))  # f64[capacity, A] by configuration
+        self.tree_of = np.empty(capacity, np.int64)  # i64[capacity] its tree (NONE: not yet)
+        self.open = np.empty(capacity, np.int64)  # i64[capacity] the open stack's ids
+        self.state = np.array([0, NONE], np.int64)  # the open stack's height, the goal's id
+        self.scratch = (np.empty(agents, np.int32), np.empty(agents, np.int32),
+                        np.empty(moves.candidates, np.int32))  # see _steps
         self.began = time.perf_counter()
         self.first_soc: int | None = None
         self.first_loss: int | None = None
@@ -185,128 +175,224 @@ class _Search:
     def run(self, starts: np.ndarray, *, deadline: float, refine: float,
             max_configurations: int) -> tuple[list | None, str]:
         """``(configurations from the starts to the goals, "")``, or ``(None, why not)``."""
-        goals = self.moves.goals
-        explored = self.explored
-        root = self._add(starts, NONE, initial_priorities(self.moves, starts))
-        open_ = [root]
-        goal = NONE
+        moves, explored = self.moves, self.explored
+        root = explored.add_root(starts, int(moves.fields[np.arange(len(starts)), starts].sum()))
+        self.priorities[root] = initial_priorities(moves, starts)
+        self.tree_of[root] = NONE
+        self.open[0] = root
+        self.state[0] = 1
+        pibt = (moves.indptr, moves.heads, moves.fields, moves.goals, self.work.occupied_now,
+                self.work.occupied_next, self.work.stack, self.work.counts, self.work.keys,
+                self.work.random)
         found_at = 0.0
-        while open_:
-            if time.perf_counter() > deadline or explored.size >= max_configurations:
-                break
-            node = open_[-1]
-            if not self._promising(node, goal):
-                open_.pop()
-                continue
-            if goal == NONE and np.array_equal(explored.nodes[node], goals):
-                goal = node
-                self.first_soc = _soc(explored.way(goal), goals)
+        event = _RAN
+        while time.perf_counter() <= deadline:
+            self._reserve()
+            event = _steps(pibt, explored.arrays, self.trees.arrays, self.priorities,
+                           self.tree_of, self.open, self.state, self.scratch, self.rng,
+                           self.swap, refine > 0, self.restart_rate, max_configurations, _STEPS)
+            goal = int(self.state[1])
+            if event == _FOUND:
+                self.first_soc = _soc(explored.way(goal), moves.goals)
                 self.first_loss = int(explored.cost[goal])
                 if refine <= 0:
                     return explored.way(goal), ""
                 found_at = time.perf_counter()
                 deadline = found_at + refine
-                continue
-            exhausted, following = self._next_of(node)
-            if exhausted:
-                open_.pop()
-                continue
-            if following is None:
-                continue
-            known = explored.find(following)
-            if known == NONE:
-                child = self._add(following, node,
-                                  next_priorities(self.priorities[node], following == goals))
-                if self._promising(child, goal):
-                    open_.append(child)
-                continue
-            if refine > 0:
-                again, known = self._rewire(node, known, goal, found_at, root)
-                open_.extend(again)
-            if self._promising(known, goal):
-                open_.append(known)
+            elif event == _IMPROVED:
+                self.improvements.append((time.perf_counter() - found_at,
+                                          int(explored.cost[goal]),
+                                          _soc(explored.way(goal), moves.goals)))
+            elif event in (_EXHAUSTED, _LIMIT):
+                break
+        top, goal = (int(value) for value in self.state)
         if goal != NONE:
-            self.optimal = not open_
+            self.optimal = top == 0
             self.loss = int(explored.cost[goal])
             return explored.way(goal), ""
-        if not open_:
+        if top == 0:
             return None, ("no solution: every configuration reachable from the starts "
                           f"({explored.size}) was explored")
-        if time.perf_counter() > deadline:
-            return None, f"reached the time limit after {explored.size} configurations"
-        return None, f"reached the limit of {max_configurations} configurations"
+        if event == _LIMIT:
+            return None, f"reached the limit of {max_configurations} configurations"
+        return None, f"reached the time limit after {explored.size} configurations"
 
-    def _next_of(self, node: int) -> tuple[bool, np.ndarray | None]:
-        """``(exhausted, configuration)``: the configuration that ``node``'s next constraint
-        leads to (None where PIBT finds none under it), or ``exhausted`` when ``node`` has no
-        constraint left; its constraint tree is made on first use."""
-        tree = self.trees[node]
-        if tree is None:
-            tree = self.trees[node] = _Tree(by_priority(self.priorities[node]),
-                                            collections.deque([_Constraint((), ())]))
-        if not tree.constraints:
-            return True, None
-        constraint = tree.constraints.popleft()
-        if constraint.depth < len(self.moves.goals):
-            self._grow(node, tree, constraint)
-        return False, self._successor(node, tree, constraint)
-
-    def _rewire(self, node: int, known: int, goal: int, found_at: float,
-                root: int) -> tuple[list[int], int]:
-        """``(again, next)`` when the search meets ``known`` from ``node`` while refining: the
-        step joins the explored graph and the Dijkstra update lowers costs through it;
-        ``again`` the configurations whose cost fell below the best solution's (searched
-        again), ``next`` the configuration to search on (``known``, or the starts' after a
-        random restart). Records an improvement of the best solution."""
+    def _reserve(self) -> None:
+        """Grow the stores so that :func:`_steps` has room for ``_STEPS`` steps, and the open
+        stack room for the next step."""
         explored = self.explored
-        limit = explored.cost[goal] if goal != NONE else _UNBOUNDED
-        again = explored.connect(node, known, limit)
-        if goal == NONE:
-            return [], known
-        if explored.cost[goal] < limit:
-            self.improvements.append((time.perf_counter() - found_at, int(explored.cost[goal]),
-                                      _soc(explored.way(goal), self.moves.goals)))
-        if self.rng.random() < self.restart_rate:
-            known = root
-        return again.tolist(), known
+        explored.reserve(_STEPS + 1, _STEPS)  # + 1: the spare row
+        self.trees.reserve(_STEPS, _STEPS * (self.moves.candidates + 1))
+        self.priorities = grown(self.priorities, len(explored.cost))
+        self.tree_of = grown(self.tree_of, len(explored.cost))
+        self.open = grown(self.open, self.state[0] + explored.size + 2)
 
-    def _promising(self, node: int, goal: int) -> bool:
-        """Whether ``node`` may still lead to a solution cheaper than ``goal``'s (always, while
-        no solution is known)."""
-        explored = self.explored
-        return goal == NONE or explored.cost[node] + explored.bound[node] < explored.cost[goal]
 
-    def _add(self, nodes: np.ndarray, parent: int, priorities: np.ndarray) -> int:
-        self.priorities.append(priorities)
-        self.trees.append(None)
-        return self.explored.add(nodes, parent, int(self.moves.fields[self.agents, nodes].sum()))
+_STEPS = 256
+"""Steps of the search per call of :func:`_steps` (the time limit is checked between calls)."""
 
-    def _grow(self, node: int, tree: "_Tree", constraint: _Constraint) -> None:
-        """Add the children of ``constraint``: the next agent's candidates, keyed order."""
-        agent = int(tree.order[constraint.depth])
-        options = list(self._options(int(self.explored.nodes[node, agent])))
-        self.rng.shuffle(options)
-        who = constraint.who + (agent,)
-        for v in options:
-            tree.constraints.append(_Constraint(who, constraint.where + (v,)))
+_RAN, _FOUND, _IMPROVED, _EXHAUSTED, _LIMIT, _FULL = range(6)
+"""How a call of :func:`_steps` ended: it ran its steps; it found the first solution (the goal's
+id in ``state[1]``); it lowered the solution's cost; the open stack ran out; the configurations
+reached their limit; the open stack needs room."""
 
-    def _options(self, here: int) -> list[int]:
-        """The nodes an agent on ``here`` may go to next: its neighbours, then ``here``."""
-        options = self.options.get(here)
-        if options is None:
-            moves = self.moves
-            options = self.options[here] = (
-                moves.heads[moves.indptr[here]:moves.indptr[here + 1]].tolist() + [here])
-        return options
 
-    def _successor(self, node: int, tree: "_Tree",
-                   constraint: _Constraint) -> np.ndarray | None:
-        current = self.explored.nodes[node]
-        following = np.empty_like(current)
-        ok = configuration(self.moves, self.work, current, tree.order,
-                           np.array(constraint.who, np.int32),
-                           np.array(constraint.where, np.int32), following, swap=self.swap)
-        return following if ok else None
+@jit
+def _steps(pibt, explored, trees, priorities, tree_of, open_, state, scratch, rng, swap,
+           refine, restart_rate, max_configurations, steps):
+    """Up to ``steps`` steps of the search; returns how it ended (``_RAN`` ...).
+
+    A step takes the configuration on top of the open stack: drops it when it cannot beat the
+    solution known, or when its constraint tree has no constraint left; else it takes the next
+    constraint and pushes the configuration PIBT makes under it (:func:`_successor`), new or
+    known. While refining, a known one is connected (the Dijkstra update), those whose cost fell
+    below the solution's are pushed again, and with probability ``restart_rate`` the starts'
+    configuration is pushed in its place.
+
+    Args:
+      pibt: the arrays of :func:`~jaxswarm.multiagent.pibt.compiled_configuration`, its moves
+        and its workspace.
+      explored: :attr:`Explored.arrays`, with room for ``steps`` more configurations and edges.
+      trees: :attr:`ConstraintTrees.arrays`, with room for ``steps`` more trees and their
+        constraints.
+      priorities, tree_of: f64[capacity, A] each configuration's PIBT priorities, i64[capacity]
+        its tree (NONE: not made yet).
+      open_: i64[H] the open stack (ids, the top last).
+      state: i64[2] in and out: the open stack's height, the goal's id (NONE: none found).
+      scratch: i32[A], i32[A], i32[C]: a constraint's agents, their nodes, and a tree's
+        candidates.
+      rng: the NumPy ``Generator`` of the trees' orders and of the restarts.
+      swap, refine, restart_rate, max_configurations: :func:`lacam`'s (``refine``: a bool).
+    """
+    fields, goals = pibt[2], pibt[3]
+    (_, nodes, cost, bound, _, _, _, _, _, _, _, _, sizes) = explored
+    top, goal = state[0], state[1]
+    event = _RAN
+    for _ in range(steps):
+        event = _halt(top, sizes[0], open_.shape[0], max_configurations)
+        if event != _RAN:
+            break
+        node = open_[top - 1]
+        if not _promising(cost, bound, node, goal):
+            top -= 1
+            continue
+        if goal == NONE and _same(nodes[node], goals):
+            goal, event = node, _FOUND
+            break
+        made = _successor(pibt, explored, trees, priorities, tree_of, node, scratch, rng, swap)
+        if made == _NO_CONSTRAINT:
+            top -= 1
+            continue
+        if made == _NO_CONFIGURATION:
+            continue
+        known, slot = find(explored)
+        if known == NONE:
+            known = _add(explored, slot, node, fields, priorities, tree_of)
+        elif refine:
+            known, top, event = _met_again(explored, open_, top, node, known, goal, rng,
+                                           restart_rate)
+        if _promising(cost, bound, known, goal):
+            open_[top] = known
+            top += 1
+        if event == _IMPROVED:
+            break
+    state[0], state[1] = top, goal
+    return event
+
+
+_NO_CONSTRAINT, _NO_CONFIGURATION, _MADE = range(3)
+"""What :func:`_successor` did: the tree had no constraint left; PIBT found no configuration
+under the constraint taken; it wrote one to the spare row."""
+
+
+@inline
+def _successor(pibt, explored, trees, priorities, tree_of, node, scratch, rng, swap):
+    """Take the next constraint of ``node``'s tree (planted on first use; its children queued)
+    and write the configuration PIBT makes from ``node`` under it to the spare row of
+    ``explored``; returns ``_MADE``, or why not."""
+    (indptr, heads, fields, goals, occupied_now, occupied_next, stack, counts, keys,
+     random) = pibt
+    nodes = explored[1]
+    who, where, options = scratch
+    if tree_of[node] == NONE:
+        tree_of[node] = plant(trees, priorities[node])
+    tree = tree_of[node]
+    taken = take(trees, tree, indptr, heads, nodes[node], options, rng)
+    if taken == NONE:
+        return _NO_CONSTRAINT
+    fixed = gather(trees, taken, who, where)
+    if compiled_configuration(indptr, heads, fields, goals, nodes[node], trees[0][tree],
+                              who[:fixed], where[:fixed], spare(explored), occupied_now,
+                              occupied_next, stack, counts, keys, random, swap):
+        return _MADE
+    return _NO_CONFIGURATION
+
+
+@inline
+def _met_again(explored, open_, top, node, known, goal, rng, restart_rate):
+    """LaCAM*, refining: the search made ``known`` again, from ``node``. The step joins the
+    explored graph and the Dijkstra update lowers costs through it; once a solution is known
+    (``goal``), the configurations whose cost fell below its cost are pushed again on the open
+    stack (of height ``top``) and with probability ``restart_rate`` the root takes the place of
+    ``known``. Returns ``(the configuration to push, the new height, _IMPROVED or _RAN)``."""
+    cost, settled = explored[2], explored[6]
+    limit = cost[goal] if goal != NONE else _UNBOUNDED
+    again = connect(explored, node, known, limit)
+    if goal == NONE:
+        return known, top, _RAN
+    event = _IMPROVED if cost[goal] < limit else _RAN
+    if rng.random() < restart_rate:
+        known = 0  # the root
+    open_[top:top + again] = settled[:again]
+    return known, top + again, event
+
+
+@inline
+def _halt(top, size, height, max_configurations):
+    """Why the search cannot take another step: the open stack is empty (``top``), the
+    configurations (``size``) reached their limit, the open stack (``height`` long) may
+    overflow; ``_RAN`` when it can."""
+    if top == 0:
+        return _EXHAUSTED
+    if size >= max_configurations:
+        return _LIMIT
+    if top + size + 2 > height:  # a step pushes at most every configuration and one more
+        return _FULL
+    return _RAN
+
+
+@inline
+def _add(explored, slot, parent, fields, priorities, tree_of):
+    """Add the new configuration in the spare row of ``explored`` (``slot``: its hash slot),
+    found from ``parent``: its bound (the agents' distances to their goals, ``fields``
+    i32[A, N]) and its priorities (those of ``parent``, one more for every agent away from its
+    goal, the fractional part at it: ``pibt.next_priorities``). Returns its id."""
+    goals, nodes = explored[0], explored[1]
+    following = spare(explored)
+    to_goals = 0
+    for a in range(goals.shape[0]):
+        to_goals += fields[a, following[a]]
+    child = add(explored, slot, parent, to_goals)
+    tree_of[child] = NONE
+    for a in range(goals.shape[0]):
+        p = priorities[parent, a]
+        priorities[child, a] = p - np.floor(p) if nodes[child, a] == goals[a] else p + 1.0
+    return child
+
+
+@inline
+def _promising(cost, bound, node, goal):
+    """Whether ``node`` may still lead to a solution cheaper than ``goal``'s (always, while
+    no solution is known)."""
+    return goal == NONE or cost[node] + bound[node] < cost[goal]
+
+
+@inline
+def _same(nodes, goals):
+    for a in range(goals.shape[0]):
+        if nodes[a] != goals[a]:
+            return False
+    return True
 
 
 def _soc(configurations: list, goals: np.ndarray) -> int:

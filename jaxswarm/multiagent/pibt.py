@@ -113,10 +113,10 @@ def configuration(moves: Moves, work: Workspace, current: np.ndarray, order: np.
       would stay where a fixed agent moves in (``following`` is then not a configuration).
       Without fixed agents the step always succeeds: an agent with no free candidate stays.
     """
-    return bool(_configuration(moves.indptr, moves.heads, moves.fields, moves.goals, current,
-                               order, fixed, fixed_to, following, work.occupied_now,
-                               work.occupied_next, work.stack, work.counts, work.keys,
-                               work.random, swap))
+    return bool(compiled_configuration(moves.indptr, moves.heads, moves.fields, moves.goals,
+                                       current, order, fixed, fixed_to, following,
+                                       work.occupied_now, work.occupied_next, work.stack,
+                                       work.counts, work.keys, work.random, swap))
 
 
 @inline
@@ -153,8 +153,11 @@ def _candidates(indptr, heads, fields, agent, node, stack, frame, counts, keys, 
 
 
 @jit
-def _configuration(indptr, heads, fields, goals, current, order, fixed, fixed_to, following,
-                   occupied_now, occupied_next, stack, counts, keys, random, swap):
+def compiled_configuration(indptr, heads, fields, goals, current, order, fixed, fixed_to,
+                           following, occupied_now, occupied_next, stack, counts, keys, random,
+                           swap):
+    """:func:`configuration` for compiled callers (LaCAM's search loop): the arrays of
+    :class:`Moves` and :class:`Workspace` spelled out; returns the same bool."""
     for a in range(current.shape[0]):
         following[a] = NONE
         occupied_now[current[a]] = a
