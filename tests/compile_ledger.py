@@ -6,11 +6,10 @@ programs it builds (:mod:`program_hooks`: XLA programs by a fingerprint of their
 numba functions by dispatcher and signature), and so does every Python process a test starts.
 
 A file's programs are the programs its tests use, whatever ran before them: the process forgets
-which programs it built when the next test is of another file and around each session fixture's
-set-up (:func:`program_hooks.forget`: it keeps its traced and lowered programs, so the next use
-of each passes through JAX's Python dispatch, where it is recorded, without a trace or a
-compile). A session fixture's programs are counted for the file that defines it, whichever test
-first asks for it. So a file's count is the same on any number of workers and in
+its compiled programs when the next test is of another file and around each session fixture's
+set-up (:func:`program_hooks.forget`; the on-disk caches still hold them, so forgetting costs a
+re-trace, not a compile). A session fixture's programs are counted for the file that defines it,
+whichever test first asks for it. So a file's count is the same on any number of workers and in
 any order, and a test that adds a program to a file adds it to that file's count.
 
 The controller joins the workers' records (a program built in two workers is one program) and,

@@ -16,9 +16,9 @@ linux = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="Linux's
 @linux
 def test_a_compiled_program_holds_mappings_that_a_release_gives_back(maze):
     graph, task, _ = maze
-    jax.clear_caches()  # so that the run's program is new to this process
     before = programs.mapped_regions()
-    # A swarm's run at the shared size, compiled or loaded from the persistent cache.
+    # A swarm's run at the shared size: compiled, or loaded from the persistent cache, it is
+    # new to this process (the compile ledger forgets programs between test files).
     swarm = make("aco_star", **sizes.CONFIG)
     jax.block_until_ready(run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                               iterations=sizes.ITERATIONS))

@@ -13,11 +13,9 @@ A program is recorded once per process under a fingerprint that is the same in e
   numba for it (compiled, or loaded from numba's disk cache), not where numba compiles it
   inside another function's compile, so that a cold and a warm run record the same.
 
-:func:`forget` makes the next use of each program record it again. For XLA it clears only the
-caches that let a call of a jitted function skip Python (JAX's C++ dispatch caches): the traced
-and lowered programs stay, so the next call passes through JAX's Python dispatch, where the
-hook finds the program it lowered before and records it, without tracing, lowering or loading it
-again. numba's loaded overloads are dropped (numba's disk cache keeps them).
+:func:`forget` drops the process's compiled programs (JAX's in-memory caches, numba's loaded
+overloads) so that the next use of each program records it again; the on-disk caches keep them,
+so what is forgotten is found again cheaply.
 """
 from __future__ import annotations
 
@@ -63,15 +61,9 @@ def install(record: Record) -> None:
 
 
 def forget() -> None:
-    """Make the next use of every program this process built record it again (see the module
-    docstring): JAX's C++ dispatch caches cleared, numba's loaded overloads dropped."""
-    if "jax._src.pjit" in sys.modules:
-        from jax._src import pjit
-        from jax._src.lib import _jax
-
-        pjit._cpp_pjit_cache_fun_only.clear()
-        pjit._cpp_pjit_cache_explicit_attributes.clear()
-        _jax.PjitFunctionCache.clear_all()
+    """Drop the compiled programs this process holds in memory (not those on disk)."""
+    if "jax" in sys.modules:
+        sys.modules["jax"].clear_caches()
     for dispatcher in list(_dispatchers):
         dispatcher._reset_overloads()
 
@@ -82,19 +74,15 @@ def _record(fingerprint: str, name: str, seconds: float = 0.0) -> None:
 
 def _patch_jax() -> None:
     import jax
-    from jax._src import pjit
     from jax._src.core import jaxprs_in_params
     from jax._src.interpreters import pxla
 
     lower, compile_ = pxla.lower_sharding_computation, pxla._cached_compilation
-    resolve = pjit._resolve_and_lower
     # A program's function is named with its source ("name at file:line"): JAX's own functions
     # (and the primitives it applies one at a time) are the eager operations, but for a loop or
     # a branch applied outside jit, which is a whole program of its own.
     eager_source = f" at {os.path.dirname(jax.__file__)}{os.sep}"
     lowered: dict[int, tuple[str, str]] = {}  # id of a module -> its fingerprint and name
-    # Every program lowered (JAX keeps it while its jaxpr lives) -> its fingerprint and name.
-    known: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
     def loops(jaxpr) -> bool:
         return any(eqn.primitive.name in CONTROL_FLOW
@@ -110,15 +98,8 @@ def _patch_jax() -> None:
         if not eager(closed_jaxpr):
             text = computation._hlo.operation.get_asm(enable_debug_info=False)
             digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-            lowered[id(computation._hlo)] = known[computation] = (f"xla:{digest}", str(fun_name))
+            lowered[id(computation._hlo)] = (f"xla:{digest}", str(fun_name))
             _record(f"xla:{digest}", str(fun_name))
-        return computation
-
-    def resolve_and_record(*args, **kwargs):
-        # A call that missed the C++ dispatch caches: a program lowered before is used again.
-        computation = resolve(*args, **kwargs)
-        if computation in known:
-            _record(*known[computation])
         return computation
 
     def compile_and_time(computation, *args, **kwargs):
@@ -130,7 +111,6 @@ def _patch_jax() -> None:
 
     pxla.lower_sharding_computation = lower_and_record
     pxla._cached_compilation = compile_and_time
-    pjit._resolve_and_lower = resolve_and_record
 
 
 def _patch_numba() -> None:
