@@ -44,6 +44,7 @@ def swarm_run(request) -> sizes.SharedRun:
     parametrization: ``@pytest.mark.parametrize("swarm_run", ["rfd"], indirect=True)``) at the
     shared size (:func:`sizes.shared_run`), made once per worker for every test outside its
     conformance checks that needs a run of that swarm (the figures drawn of it, its memory's
-    shape). Its conformance checks run the same program themselves (the library's checks call
-    ``run``) and replay its golden record."""
+    shape). Its conformance checks compile the same program and replay its golden record
+    themselves: the compile ledger forgets a process's programs around a session fixture, so
+    reading the fixture there would trace the program twice more."""
     return sizes.shared_run(request.param)
