@@ -4,8 +4,8 @@ same key in a batch of 3 runs; in batches of 1 and 64, and of 1,000, in the slow
 reproducible per key, valid results never below the optimum, a walker's clean "not found" on a
 goal behind a wall (the shared size's run on a map cut out of the maze's shape), a batch over
 params compiled once, and its golden records (``tests/golden/swarms.json``) replayed bit for
-bit. Sweep rows on other
-thread and device counts, in processes of their own, are checked in ``test_sweep.py``.
+bit. Sweep rows on other thread and device counts, in processes of their own, are checked in
+``test_sweep.py``.
 
 One test class per swarm: under ``--dist loadscope`` (the Makefile's) a class runs on one
 worker, which builds the swarm's two programs of the default tier (a run alone and a batch of 3

@@ -206,7 +206,7 @@ def check_unreachable_goal(swarm: Swarm, graph: World, task: Task, *,
     solution = swarm.best(state)
     assert not bool(solution.found), f"{swarm.name}: found a path to an unreachable goal"
     assert np.isinf(float(solution.cost)), f"{swarm.name}: a finite cost without a path"
-    assert (np.asarray(solution.path) == -1).all(), f"{swarm.name}: a path without a way"
+    assert (np.asarray(solution.path) == -1).all(), f"{swarm.name}: a path of nodes without a path found"
     assert (np.asarray(trace.arrived) == 0).all(), f"{swarm.name}: agents arrived"
     assert int(trace.iterations) == iterations, (
         f"{swarm.name}: stopped after {int(trace.iterations)} of {iterations} iterations")
