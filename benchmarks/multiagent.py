@@ -347,7 +347,7 @@ def bench_pibt(mapf: Path, agents: int, steps: int) -> tuple[str, float, int]:
         began = time.perf_counter()
         configuration(moves, work, current, order, nothing, nothing, following)
         times.append(time.perf_counter() - began)
-        priorities = next_priorities(priorities, following == goals)
+        next_priorities(priorities, following, goals, priorities)
         current = following
     return instance.name, statistics.median(times[1:]), int((current == goals).sum())
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from jaxswarm.exact.kernels import inline
 from jaxswarm.multiagent.explored import grown
+from jaxswarm.multiagent.pibt import by_priority
 
 NONE = -1
 """No constraint (a root's parent, a queue's end, an empty queue)."""
@@ -85,7 +86,7 @@ def plant(trees, priorities):
     (order, head, _, _, _, _, _, _, counts) = trees
     tree = counts[0]
     counts[0] += 1
-    order[tree] = np.argsort(-priorities, kind="mergesort")
+    order[tree] = by_priority(priorities)
     head[tree] = NONE
     _queue(trees, tree, NONE, NONE, NONE, 0)
     return tree

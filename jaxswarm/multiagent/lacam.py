@@ -44,7 +44,8 @@ from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.constraint_trees import ConstraintTrees, gather, plant, take
 from jaxswarm.multiagent.explored import NONE, Explored, add, connect, find, grown, spare
 from jaxswarm.multiagent.limits import check_count, check_seconds
-from jaxswarm.multiagent.pibt import Moves, Workspace, compiled_configuration, initial_priorities
+from jaxswarm.multiagent.pibt import (Moves, Workspace, compiled_configuration, initial_priorities,
+                                      next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
 from jaxswarm.world.graph import Graph
 
@@ -365,8 +366,7 @@ def _halt(top, size, height, max_configurations):
 def _add(explored, slot, parent, fields, priorities, tree_of):
     """Add the new configuration in the spare row of ``explored`` (``slot``: its hash slot),
     found from ``parent``: its bound (the agents' distances to their goals, ``fields``
-    i32[A, N]) and its priorities (those of ``parent``, one more for every agent away from its
-    goal, the fractional part at it: ``pibt.next_priorities``). Returns its id."""
+    i32[A, N]) and its priorities (``pibt.next_priorities`` of ``parent``'s). Returns its id."""
     goals, nodes = explored[0], explored[1]
     following = spare(explored)
     to_goals = 0
@@ -374,9 +374,7 @@ def _add(explored, slot, parent, fields, priorities, tree_of):
         to_goals += fields[a, following[a]]
     child = add(explored, slot, parent, to_goals)
     tree_of[child] = NONE
-    for a in range(goals.shape[0]):
-        p = priorities[parent, a]
-        priorities[child, a] = p - np.floor(p) if nodes[child, a] == goals[a] else p + 1.0
+    next_priorities(priorities[parent], nodes[child], goals, priorities[child])
     return child
 
 
