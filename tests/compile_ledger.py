@@ -7,8 +7,8 @@ numba functions by dispatcher and signature), and so does every Python process a
 
 A file's programs are the programs its tests use, whatever ran before them: the process forgets
 its compiled programs when the next test is of another file and around each session fixture's
-set-up (:func:`program_hooks.forget`; the on-disk caches still hold them, so forgetting costs a
-re-trace, not a compile). A session fixture's programs are counted for the file that defines it,
+set-up (:func:`program_hooks.forget`: JAX keeps their traces and lowered modules and the on-disk
+caches the programs, so forgetting costs a load, not a trace or a compile). A session fixture's programs are counted for the file that defines it,
 whichever test first asks for it. So a file's count is the same on any number of workers and in
 any order, and a test that adds a program to a file adds it to that file's count.
 

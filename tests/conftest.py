@@ -46,5 +46,5 @@ def swarm_run(request) -> sizes.SharedRun:
     conformance checks that needs a run of that swarm (the figures drawn of it, its memory's
     shape). Its conformance checks compile the same program and replay its golden record
     themselves: the compile ledger forgets a process's programs around a session fixture, so
-    reading the fixture there would trace the program twice more."""
+    reading the fixture there would load the program twice more."""
     return sizes.shared_run(request.param)

@@ -13,9 +13,10 @@ A program is recorded once per process under a fingerprint that is the same in e
   numba for it (compiled, or loaded from numba's disk cache), not where numba compiles it
   inside another function's compile, so that a cold and a warm run record the same.
 
-:func:`forget` drops the process's compiled programs (JAX's in-memory caches, numba's loaded
-overloads) so that the next use of each program records it again; the on-disk caches keep them,
-so what is forgotten is found again cheaply.
+:func:`forget` drops the process's compiled programs (JAX's executables, numba's loaded
+overloads) so that the next use of each program records it again. JAX keeps each program's trace
+and lowered module, so a program is traced, lowered and fingerprinted once a process, and the
+on-disk caches keep the programs, so what is forgotten is loaded again cheaply.
 """
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ CONTROL_FLOW = frozenset({"while", "scan", "cond"})
 
 _installed: list[Record] = []
 _dispatchers: weakref.WeakSet = weakref.WeakSet()
+_computations: weakref.WeakSet = weakref.WeakSet()
 _depth = threading.local()
 
 
@@ -61,9 +63,22 @@ def install(record: Record) -> None:
 
 
 def forget() -> None:
-    """Drop the compiled programs this process holds in memory (not those on disk)."""
-    if "jax" in sys.modules:
-        sys.modules["jax"].clear_caches()
+    """Drop the compiled programs this process holds in memory (not those on disk), so that the
+    next use of each compiles it again, or loads it from the persistent cache, and records it.
+    JAX keeps its traces and lowered modules: a program is traced and lowered once a process."""
+    if "jax._src.interpreters.pxla" in sys.modules:
+        from jax._src import pjit
+        from jax._src.interpreters import pxla
+        from jax._src.lib import _jax
+
+        # JAX's executables live in its C++ dispatch caches, its compile cache and on each
+        # lowering (which compiles once); its traces and lowerings live in other caches.
+        pjit._cpp_pjit_cache_fun_only.clear()
+        pjit._cpp_pjit_cache_explicit_attributes.clear()
+        _jax.PjitFunctionCache.clear_all()
+        pxla._cached_compilation.cache_clear()
+        for computation in list(_computations):
+            computation._executable = None
     for dispatcher in list(_dispatchers):
         dispatcher._reset_overloads()
 
@@ -82,7 +97,8 @@ def _patch_jax() -> None:
     # (and the primitives it applies one at a time) are the eager operations, but for a loop or
     # a branch applied outside jit, which is a whole program of its own.
     eager_source = f" at {os.path.dirname(jax.__file__)}{os.sep}"
-    lowered: dict[int, tuple[str, str]] = {}  # id of a module -> its fingerprint and name
+    # id of a module -> its fingerprint and name (the module is kept, so that its id is its own)
+    lowered: dict[int, tuple[str, str, object]] = {}
 
     def loops(jaxpr) -> bool:
         return any(eqn.primitive.name in CONTROL_FLOW
@@ -95,10 +111,11 @@ def _patch_jax() -> None:
 
     def lower_and_record(closed_jaxpr, api_name, fun_name, *args, **kwargs):
         computation = lower(closed_jaxpr, api_name, fun_name, *args, **kwargs)
+        _computations.add(computation)
         if not eager(closed_jaxpr):
             text = computation._hlo.operation.get_asm(enable_debug_info=False)
             digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-            lowered[id(computation._hlo)] = (f"xla:{digest}", str(fun_name))
+            lowered[id(computation._hlo)] = (f"xla:{digest}", str(fun_name), computation._hlo)
             _record(f"xla:{digest}", str(fun_name))
         return computation
 
@@ -106,9 +123,11 @@ def _patch_jax() -> None:
         began = time.perf_counter()
         executable = compile_(computation, *args, **kwargs)
         if id(computation) in lowered:
-            _record(*lowered.pop(id(computation)), time.perf_counter() - began)
+            fingerprint, name, _ = lowered[id(computation)]
+            _record(fingerprint, name, time.perf_counter() - began)
         return executable
 
+    compile_and_time.cache_clear = compile_.cache_clear
     pxla.lower_sharding_computation = lower_and_record
     pxla._cached_compilation = compile_and_time
 
