@@ -38,10 +38,15 @@ OUT_VARIABLE = "JAXSWARM_LEDGER_OUT"
 (``sitecustomize.py``)."""
 CONTROL_FLOW = frozenset({"while", "scan", "cond"})
 """Primitives that make an eager operation a program worth counting (a loop's or a branch's)."""
+KEEP_TRACES_BELOW = 4 << 30
+"""Resident bytes of the process above which :func:`forget` drops JAX's traces and lowered
+modules too (all its caches), so that what a long run keeps cannot exhaust the machine."""
 
 _installed: list[Record] = []
 _dispatchers: weakref.WeakSet = weakref.WeakSet()
 _computations: weakref.WeakSet = weakref.WeakSet()
+# id of a lowered module -> its fingerprint and name; every lowering sets or drops its id's entry
+_lowered: dict[int, tuple[str, str]] = {}
 _depth = threading.local()
 
 
@@ -66,7 +71,9 @@ def forget() -> None:
     """Drop the compiled programs this process holds in memory (not those on disk), so that the
     next use of each compiles it again, or loads it from the persistent cache, and records it.
     JAX keeps its traces and lowered modules: a program is traced and lowered once a process."""
-    if "jax._src.interpreters.pxla" in sys.modules:
+    if "jax._src.interpreters.pxla" in sys.modules and _resident_bytes() > KEEP_TRACES_BELOW:
+        sys.modules["jax"].clear_caches()
+    elif "jax._src.interpreters.pxla" in sys.modules:
         from jax._src import pjit
         from jax._src.interpreters import pxla
         from jax._src.lib import _jax
@@ -83,6 +90,15 @@ def forget() -> None:
         dispatcher._reset_overloads()
 
 
+def _resident_bytes() -> int:
+    """The process's resident memory in bytes (Linux; 0 where the system does not say)."""
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 def _record(fingerprint: str, name: str, seconds: float = 0.0) -> None:
     _installed[0](fingerprint, name, seconds)
 
@@ -97,8 +113,6 @@ def _patch_jax() -> None:
     # (and the primitives it applies one at a time) are the eager operations, but for a loop or
     # a branch applied outside jit, which is a whole program of its own.
     eager_source = f" at {os.path.dirname(jax.__file__)}{os.sep}"
-    # id of a module -> its fingerprint and name (the module is kept, so that its id is its own)
-    lowered: dict[int, tuple[str, str, object]] = {}
 
     def loops(jaxpr) -> bool:
         return any(eqn.primitive.name in CONTROL_FLOW
@@ -112,19 +126,20 @@ def _patch_jax() -> None:
     def lower_and_record(closed_jaxpr, api_name, fun_name, *args, **kwargs):
         computation = lower(closed_jaxpr, api_name, fun_name, *args, **kwargs)
         _computations.add(computation)
-        if not eager(closed_jaxpr):
+        if eager(closed_jaxpr):
+            _lowered.pop(id(computation._hlo), None)
+        else:
             text = computation._hlo.operation.get_asm(enable_debug_info=False)
             digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-            lowered[id(computation._hlo)] = (f"xla:{digest}", str(fun_name), computation._hlo)
+            _lowered[id(computation._hlo)] = (f"xla:{digest}", str(fun_name))
             _record(f"xla:{digest}", str(fun_name))
         return computation
 
     def compile_and_time(computation, *args, **kwargs):
         began = time.perf_counter()
         executable = compile_(computation, *args, **kwargs)
-        if id(computation) in lowered:
-            fingerprint, name, _ = lowered[id(computation)]
-            _record(fingerprint, name, time.perf_counter() - began)
+        if id(computation) in _lowered:
+            _record(*_lowered[id(computation)], time.perf_counter() - began)
         return executable
 
     compile_and_time.cache_clear = compile_.cache_clear
