@@ -3,7 +3,7 @@
 numba because a priority-queue search is a scalar loop with data-dependent branches: XLA has no
 fast form of it, and a pure-Python heap spends most of its time in the interpreter (7-9 ms per A*
 query on a 128 x 128 maze where a C++ A* takes 0.3 ms). The loops are written over plain arrays
-(``jaxswarm.exact._host.EdgeArrays``, a :class:`~jaxswarm.exact.search.Workspace`), so a
+(:class:`~jaxswarm.world.edges.EdgeArrays`, a :class:`~jaxswarm.exact.search.Workspace`), so a
 batch of queries reuses its buffers and pays no Python per node.
 
 The indexed binary heap orders entries by ``(f, -g, node)`` exactly as the readable heapq planners
@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 ZERO, EUCLIDEAN, OCTILE = 0, 1, 2
-"""Heuristic codes of the kernels (by name: :func:`jaxswarm.exact._host.heuristic_code`)."""
+"""Heuristic codes of the kernels (by name: :func:`jaxswarm.exact.host.heuristic_code`)."""
 
 DIAGONAL_EXTRA = math.sqrt(2.0) - 1.0
 
