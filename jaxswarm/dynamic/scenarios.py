@@ -1,6 +1,6 @@
 """Deprecated: the RFD paper's dynamic scenarios are :mod:`jaxswarm.studies.rfd_dynamic`.
 
-This old path gives their names with a :class:`DeprecationWarning` until jaxswarm 0.11 and is
+This old path gives their names with a ``DeprecationWarning`` until jaxswarm 0.11 and is
 removed then: import them from :mod:`jaxswarm.studies.rfd_dynamic`.
 """
 from __future__ import annotations

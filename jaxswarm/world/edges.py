@@ -55,9 +55,9 @@ _ARRAYS: "weakref.WeakKeyDictionary[Graph, EdgeArrays]" = weakref.WeakKeyDiction
 def edge_arrays(graph: Graph) -> EdgeArrays:
     """The cached EdgeArrays of the valid edges of ``graph`` (built on first use, O(N K)).
 
-    An edge is valid as :meth:`Graph.valid_edges` says; the edges out of a node are in slot
-    order. Grid edge lengths are the distance between cell centres in float64 (1 or sqrt 2
-    exactly as float64 gives them); other graphs' are ``graph.cost`` in float64.
+    An edge is valid as :meth:`~jaxswarm.world.graph.Graph.valid_edges` says; the edges out of
+    a node are in slot order. Grid edge lengths are the distance between cell centres in float64
+    (1 or sqrt 2 as float64 gives them); other graphs' are ``graph.cost`` in float64.
     """
     cached = _ARRAYS.get(graph)
     if cached is None:
