@@ -2,7 +2,7 @@
 beside A* from scratch and D* Lite's repair.
 
 For each map of ``--maps`` (default: the three 100 x 100 paper maps) and each of the paper's
-dynamic tables 2-5 (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: the goal moves, obstacles
+dynamic tables 2-5 (:func:`jaxswarm.studies.rfd_dynamic.paper_scenario`: the goal moves, obstacles
 are added, removed, or a major change), and for each swarm of ``--swarms`` (default ``rfd_star``,
 ``rfd_graded``, ``aco_star``; ``--agents`` agents, default params) and each of ``--seeds`` seeds:
 
@@ -42,10 +42,10 @@ import time
 import jax
 
 from jaxswarm.dynamic.events import apply_event, check_events, first_iteration_at, replan
-from jaxswarm.dynamic.scenarios import TABLES, paper_scenario
 from jaxswarm.exact import astar, dijkstra, replanner
 from jaxswarm.maps.paper import paper_map, paper_map_names
 from jaxswarm.runtime.cpu import configure
+from jaxswarm.studies.rfd_dynamic import TABLES, paper_scenario
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.world.graph import grid_graph

@@ -88,6 +88,16 @@ BENCHMARKS = [
 ]
 """(title, script, arguments, quick arguments, what it measures) of each section."""
 
+BY_HAND = "## Constants measured by hand"
+"""The heading of ``docs/performance.md``'s last section, written by hand: a new report keeps it."""
+
+
+def by_hand() -> str:
+    """The hand-written last section of ``docs/performance.md`` (from ``BY_HAND`` on), or ""."""
+    path = ROOT / "docs" / "performance.md"
+    text = path.read_text() if path.is_file() else ""
+    return text[text.index(BY_HAND):] if BY_HAND in text else ""
+
 
 def run_benchmark(script: str, arguments: list[str]) -> tuple[str, float]:
     """The benchmark's printed output and its wall time; exits naming the script if it fails."""
@@ -123,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
                   "medians after a warm-up). Shared machines are noisy: compare figures of one "
                   "run, and rerun a script rather than trusting a number here. Each script's "
                   "docstring says exactly what it measures.")
-    write_atomically(Path(args.out), record.document("\n".join(sections)))
+    write_atomically(Path(args.out), record.document("\n".join([*sections, by_hand()])))
     print(f"wrote {args.out}")
     return 0
 

@@ -18,12 +18,15 @@ The names a first plan needs are here::
 Everything else lives in one room per concern; imports only go down this list (the import
 contract in ``pyproject.toml``, checked by the tests):
 
-* :mod:`jaxswarm.runtime`: how jaxswarm runs: XLA:CPU devices and threads
-  (:func:`jaxswarm.runtime.cpu.configure`, called before JAX starts), files written whole or not
-  at all, a vmap rule for loops of differing trip counts, the old import paths of moved names.
+* :mod:`jaxswarm.runtime`: how jaxswarm runs: arithmetic that does not depend on the batch,
+  XLA:CPU devices and threads (:func:`jaxswarm.runtime.cpu.configure`, called before JAX
+  starts), compiled programs kept on disk and let go, files written whole or not at all, one
+  writer per folder, a vmap rule for loops of differing trip counts, the evolution strategies'
+  gradient estimate.
 * :mod:`jaxswarm.world`: what a swarm plans in: the :class:`Graph` (dense padded adjacency
-  tensors) with its lattice, shape-preserving edits, padded paths and the min-plus relaxation;
-  the :class:`Plane` of rectangles and its geometry.
+  tensors) with its lattice, shape-preserving edits, padded paths, the min-plus relaxation and
+  its edges as CSR arrays for the host's planners; the :class:`Plane` of rectangles and its
+  geometry.
 * :mod:`jaxswarm.maps`: where worlds come from: the RFD paper's maps (:func:`paper_map`), seeded
   random grids and path maps (:func:`random_grid`), Moving AI ``.map``/``.scen`` files
   (:func:`load_map`), the IWD_PG experiments' maps and the bees' planes (:func:`paper_plane`).
@@ -34,13 +37,18 @@ contract in ``pyproject.toml``, checked by the tests):
   shared walker, the algorithms (RFD, ACO, IWD on graphs; the bees on planes), the registry of
   names (:func:`make`, :func:`registered`) and the conformance suite every swarm passes.
 * :mod:`jaxswarm.dynamic`: worlds that change during a run: events and what each swarm's memory
-  does on them, the RFD paper's dynamic scenarios (Tables 2-5), a robot that re-plans.
+  does on them, a robot that re-plans.
 * :mod:`jaxswarm.multiagent`: many agents on one map: the A* report's two-robot scheme,
-  prioritised space-time A*, Conflict-Based Search, one plan format and one validator.
-* :mod:`jaxswarm.sweep`: parameter sweeps: specs as TOML data, the batched, sharded, resumable
-  runner and the Parquet results store.
+  prioritised space-time A*, Conflict-Based Search and its improvements, ECBS and EECBS, PIBT and
+  LaCAM, one plan format and one validator.
+* :mod:`jaxswarm.sweep`: parameter sweeps: specs as TOML data, a swarm's runs as compiled
+  batches over the devices, the resumable runner, the Parquet results store, replaying a row.
 * :mod:`jaxswarm.plot`: figures and animations, one module per world or subject.
-* :mod:`jaxswarm.studies`: what the table scripts of ``sweeps/`` share (provenance records).
+* :mod:`jaxswarm.tune`: tuning a swarm's open constants: search spaces, iterated racing, random
+  search, the grid and evolution strategies, rescoring on held-out instances.
+* :mod:`jaxswarm.studies`: what the table scripts of ``sweeps/`` share (provenance, timed runs,
+  success, arguments, figures) and the RFD paper's tables they reproduce (Table 1's rows, the
+  dynamic scenarios of Tables 2-5).
 * :mod:`jaxswarm.cli`: the ``jaxswarm`` command.
 
 Importing the package does not start JAX's backend, so :func:`jaxswarm.runtime.cpu.configure` can

@@ -3,7 +3,7 @@
 The rows of Table 1 (:mod:`jaxswarm.studies.rfd_table1`, the same labels, swarms and params) plus
 "D* Lite (repair)", a row the paper lacks. Per map, each swarm first solves the static map once per
 seed (keys split from key 0, ``--iterations`` iterations, like Table 1): its Table 1 state. Then
-for each of the paper's changes (:func:`jaxswarm.dynamic.scenarios.paper_scenario`: Table 2 the
+for each of the paper's changes (:func:`jaxswarm.studies.rfd_dynamic.paper_scenario`: Table 2 the
 goal moves, 3 obstacles added, 4 removed, 5 a major change) the swarm continues from that state:
 :func:`jaxswarm.dynamic.events.change` applies the change and the swarm's memory rule, then ``run``
 continues (``--iterations`` at most, patience ``--patience``; key ``fold_in(seed key, table)``).
@@ -42,8 +42,6 @@ import matplotlib
 matplotlib.use("Agg")
 
 from jaxswarm.dynamic.events import apply_event, check_events, first_iteration_at, replan
-from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
-                                         paper_scenario)
 from jaxswarm.exact import astar, replanner
 from jaxswarm.maps.named import named_map
 from jaxswarm.maps.paper import paper_maps_argument
@@ -53,6 +51,8 @@ from jaxswarm.runtime.programs import release_if_crowded
 from jaxswarm.studies import provenance
 from jaxswarm.studies.arguments import add_out_argument, check_counts, numbers_argument
 from jaxswarm.studies.figures import panel_grid, write_png
+from jaxswarm.studies.rfd_dynamic import (PAPER_DYNAMIC_LENGTH, PAPER_DYNAMIC_MS, TABLES,
+                                          paper_scenario)
 from jaxswarm.studies.rfd_table1 import (ABOUT as TABLE1_ABOUT, ALGORITHMS as TABLE1_LABELS,
                                          PLANNERS, ROWS, draw_best_paths, length_cell,
                                          optimal_cell, row_definitions, row_swarm, time_cell)

@@ -6,9 +6,9 @@ import pytest
 from graphs import geometric_graph
 from jaxswarm.exact import (astar, balanced_bidirectional_astar, bidirectional_astar, dijkstra,
                             dstar_lite, kernels, reference, shortest_lengths, warm_up)
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.search import workspace
 from jaxswarm.maps.random import random_path_map
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import grid_graph, path_map_graph
 
 PAIRS = [(dijkstra, reference.dijkstra), (astar, reference.astar),

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 import oracle
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import (PLANNERS, cbs, ecbs, eecbs, hop_fields, load_instance,
                                  lower_bound, validate)
 from jaxswarm.multiagent import mdd
 from jaxswarm.multiagent.constraints import Constraints, split_collision
 from jaxswarm.multiagent.spacetime import EXHAUSTED, Reservations, occupancy, search
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import grid_graph
 
 

@@ -7,10 +7,11 @@ import sizes
 from graphs import solved_paper_map
 from jitted import apply_event, change
 from jaxswarm.dynamic.events import check_events
-from jaxswarm.dynamic.scenarios import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
-                                         paper_scenario)
 from jaxswarm.exact import dijkstra
 from jaxswarm.maps.paper import PAPER_OPTIMA, paper_map
+from jaxswarm.studies import rfd_dynamic
+from jaxswarm.studies.rfd_dynamic import (PAPER_DYNAMIC_LENGTH, TABLE2_GOALS, nearest_free,
+                                          paper_scenario)
 from jaxswarm.swarm import make_task, run
 from jaxswarm.world.graph import grid_graph
 
@@ -72,6 +73,17 @@ def test_unknown_map_or_table():
         paper_scenario("maze30", 2)
     with pytest.raises(ValueError, match="tables are 2-5"):
         paper_scenario("maze20", 6)
+
+
+def test_the_old_path_gives_the_moved_names_with_a_deprecation_warning():
+    from jaxswarm.dynamic import scenarios  # importing the old path alone does not warn
+
+    for name in scenarios.MOVED:
+        with pytest.warns(DeprecationWarning, match=rf"scenarios\.{name} moved to "
+                                                     rf"jaxswarm\.studies\.rfd_dynamic\.{name}"):
+            assert getattr(scenarios, name) is getattr(rfd_dynamic, name)
+    with pytest.raises(AttributeError, match="has no attribute 'paper_scenarios'"):
+        scenarios.paper_scenarios  # noqa: B018 - a name that never lived there
 
 
 def test_budget_replays_a_run_up_to_an_iteration():

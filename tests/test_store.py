@@ -20,7 +20,8 @@ from jaxswarm import cli
 from jaxswarm.sweep import StoreMismatchError, read_results, run_sweep, runner
 from jaxswarm.sweep.maps import SweepMap
 from jaxswarm.sweep.spec import spec_from_dict
-from jaxswarm.sweep.store import ResultsStore
+from jaxswarm.sweep.store import SAME_RESULTS_SINCE, ResultsStore
+from jaxswarm.swarm import registered
 from jaxswarm.tune import tune_spec_from_dict
 from jaxswarm.tune.evaluate import Evaluator, Setting, StoreConflictError
 
@@ -151,6 +152,36 @@ def test_chunks_without_metadata_are_refused(tmp_path):
     with pytest.raises(StoreMismatchError, match="holds chunks but .*metadata.json is missing"):
         ResultsStore(tmp_path, {"sweep": 1}, {"swarm": SWARM})
     assert not (tmp_path / "metadata.json").exists()
+
+
+def test_every_registered_swarm_has_the_release_since_which_its_results_are_the_same():
+    assert set(SAME_RESULTS_SINCE) == set(registered())
+
+
+@pytest.mark.parametrize("written_by, swarm, message", [
+    ("0.6.0", SWARM, r"written by jaxswarm 0\.6\.0; 'rfd_star' gives the same results since "
+                     r"jaxswarm 0\.7\.0 \(CHANGELOG\.md says what changed\)"),
+    ("0.7.1", dict(SWARM, name="rfd"), r"written by jaxswarm 0\.7\.1; 'rfd' gives the same "
+                                       r"results since jaxswarm 0\.8\.0 \(CHANGELOG\.md"),
+    ("0.1.0", None, r"written by jaxswarm 0\.1\.0, which did not record the definition of "
+                    r"'rfd_star'; 'rfd_star' gives the same results since jaxswarm 0\.7\.0 "
+                    r"\(CHANGELOG\.md"),
+    (None, dict(SWARM, name="rfd_flat"), r"no release is known since which 'rfd_flat' gives the "
+                                         r"same results"),
+], ids=["older release", "older than its swarm's", "no definition", "unlisted swarm"])
+def test_a_store_of_a_release_before_its_swarms_results_is_refused(tmp_path, written_by, swarm,
+                                                                     message):
+    """The release that wrote the store and the one since which the swarm gives the same results
+    (the same definition as recorded: the release alone refuses it); nothing is written."""
+    today = swarm or SWARM
+    ResultsStore(tmp_path, {"sweep": 1}, {"swarm": today}).write_chunk(0, 0, {"run": [0]})
+    metadata = json.loads((tmp_path / "metadata.json").read_text())
+    metadata.update(jaxswarm=written_by, swarm=swarm)
+    (tmp_path / "metadata.json").write_text(json.dumps(metadata))
+    before = sorted(tmp_path.rglob("*"))
+    with pytest.raises(StoreMismatchError, match=message):
+        ResultsStore(tmp_path, {"sweep": 1}, {"swarm": today})
+    assert sorted(tmp_path.rglob("*")) == before
 
 
 HOLDER = textwrap.dedent("""

@@ -362,8 +362,8 @@ def test_a_store_of_0_6_0_is_not_resumed(finished, tmp_path):
     old = tmp_path / "old"
     shutil.copytree(out, old)
     _rewrite_metadata(old, lambda m: m.update(jaxswarm="0.6.0"))  # same definition, older results
-    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.6\.0, whose 'rfd_star' "
-                       r"computed otherwise \(its results changed in 0\.7\.0"):
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.6\.0; 'rfd_star' gives "
+                                                 r"the same results since jaxswarm 0\.7\.0"):
         run_sweep(spec, old, progress=False)
 
 
@@ -381,8 +381,8 @@ def test_a_store_of_0_7_is_refused_for_a_swarm_calibrated_in_0_8(tmp_path, name)
     # exist, but the version alone refuses it): its results changed with 0.8.0's defaults.
     metadata = dict(jaxswarm="0.7.1", swarm=definition(make(name)))
     ResultsStore(tmp_path, {"sweep": 1}, metadata)
-    with pytest.raises(StoreMismatchError, match=rf"whose '{name}' computed otherwise \(its "
-                                                 r"results changed in 0\.8\.0"):
+    with pytest.raises(StoreMismatchError, match=rf"0\.7\.1; '{name}' gives the same results "
+                                                 r"since jaxswarm 0\.8\.0"):
         ResultsStore(tmp_path, {"sweep": 1}, dict(metadata, jaxswarm="0.8.0"))
 
 
@@ -397,9 +397,10 @@ def test_a_store_of_0_1_0s_rfd_star_is_not_resumed(finished, tmp_path):
 
     _rewrite_metadata(old, as_written_by_0_1_0)
     stamps = sorted(p.name for p in (old / "runs").iterdir())
-    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.1\.0.*'rfd_star' was "
-                                                 r"the graded law, now registered as "
-                                                 r"'rfd_graded'"):
+    with pytest.raises(StoreMismatchError, match=r"written by jaxswarm 0\.1\.0, which did not "
+                                                 r"record the definition of 'rfd_star'; "
+                                                 r"'rfd_star' gives the same results since "
+                                                 r"jaxswarm 0\.7\.0"):
         run_sweep(spec, old, progress=False)
     assert sorted(p.name for p in (old / "runs").iterdir()) == stamps  # nothing written
 

@@ -1,5 +1,6 @@
 """Worlds that change during a run: events and what a swarm's memory does about them
-(:mod:`~jaxswarm.dynamic.events`), the RFD paper's dynamic scenarios, Tables 2-5
-(:mod:`~jaxswarm.dynamic.scenarios`), and a robot that re-plans where it finds a blocked path
-(:mod:`~jaxswarm.dynamic.robot`).
+(:mod:`~jaxswarm.dynamic.events`) and a robot that re-plans where it finds a blocked path
+(:mod:`~jaxswarm.dynamic.robot`). The RFD paper's dynamic scenarios are
+:mod:`jaxswarm.studies.rfd_dynamic` (:mod:`~jaxswarm.dynamic.scenarios`, their old path, is
+deprecated).
 """

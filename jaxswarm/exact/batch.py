@@ -17,9 +17,10 @@ from typing import NamedTuple
 import numpy as np
 
 from jaxswarm.exact import kernels
-from jaxswarm.exact._host import EdgeArrays, default_heuristic, edge_arrays, heuristic_code
+from jaxswarm.exact.host import default_heuristic, heuristic_code
 from jaxswarm.exact.search import workspace
 from jaxswarm.exact.stats import SearchStats
+from jaxswarm.world.edges import EdgeArrays, edge_arrays
 from jaxswarm.world.graph import Graph
 
 

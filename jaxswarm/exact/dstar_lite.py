@@ -27,8 +27,9 @@ import weakref
 import numpy as np
 
 from jaxswarm.exact import kernels
-from jaxswarm.exact._host import EdgeArrays, default_heuristic, heuristic_code, lattice_arrays
+from jaxswarm.exact.host import default_heuristic, heuristic_code
 from jaxswarm.exact.stats import SearchStats, make_solution
+from jaxswarm.world.edges import EdgeArrays, lattice_arrays
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 
@@ -182,7 +183,7 @@ class DStarLite:
 @dataclasses.dataclass(frozen=True, eq=False)
 class _Structure:
     """A map's lattice, cached per Graph: ``arrays`` every lattice edge (valid or not,
-    :func:`~jaxswarm.exact._host.lattice_arrays`), ``edge[i, k]`` slot k's edge index (-1
+    :func:`~jaxswarm.world.edges.lattice_arrays`), ``edge[i, k]`` slot k's edge index (-1
     without neighbour), ``nbr`` the lattice it was built from, ``valid`` bool[N, K] the graph's
     valid edges and ``cost`` f64[E] the lengths of the valid ones, ``inf`` elsewhere (a planner's
     starting costs)."""

@@ -1,9 +1,9 @@
 """The compiled search loops of the exact planners (numba, nopython, cached on disk).
 
 numba because a priority-queue search is a scalar loop with data-dependent branches: XLA has no
-fast form of it, and a pure-Python heap spends most of its time in the interpreter (7-9 ms per A*
-query on a 128 x 128 maze where a C++ A* takes 0.3 ms). The loops are written over plain arrays
-(``jaxswarm.exact._host.EdgeArrays``, a :class:`~jaxswarm.exact.search.Workspace`), so a
+fast form of it, and a pure-Python heap spends most of its time in the interpreter (measured:
+``docs/performance.md``). The loops are written over plain arrays
+(:class:`~jaxswarm.world.edges.EdgeArrays`, a :class:`~jaxswarm.exact.search.Workspace`), so a
 batch of queries reuses its buffers and pays no Python per node.
 
 The indexed binary heap orders entries by ``(f, -g, node)`` exactly as the readable heapq planners
@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 ZERO, EUCLIDEAN, OCTILE = 0, 1, 2
-"""Heuristic codes of the kernels (by name: :func:`jaxswarm.exact._host.heuristic_code`)."""
+"""Heuristic codes of the kernels (by name: :func:`jaxswarm.exact.host.heuristic_code`)."""
 
 DIAGONAL_EXTRA = math.sqrt(2.0) - 1.0
 
@@ -43,7 +43,7 @@ def heuristic(kind, x, y, v, tx, ty):
 @inline
 def _before(f1, h1, n1, f2, h2, n2):
     """Whether entry ``(f1, h1, n1)`` orders before ``(f2, h2, n2)`` (lexicographically).
-    Bitwise, not short-circuit: no branches to mispredict (measured 10-20% faster searches)."""
+    Bitwise, not short-circuit: no branches to mispredict."""
     return (f1 < f2) | ((f1 == f2) & ((h1 < h2) | ((h1 == h2) & (n1 < n2))))
 
 

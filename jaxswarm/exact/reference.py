@@ -18,8 +18,8 @@ import math
 import time
 from typing import Callable
 
-from jaxswarm.exact._host import HostGraph, default_heuristic, host_graph
-from jaxswarm.exact._host import heuristic as make_heuristic
+from jaxswarm.exact.host import HostGraph, default_heuristic, host_graph
+from jaxswarm.exact.host import heuristic as make_heuristic
 from jaxswarm.exact.stats import SearchStats, make_solution
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node

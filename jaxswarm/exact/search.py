@@ -2,7 +2,7 @@
 
 A :class:`Workspace` holds the per-node labels and heaps of one map's searches. Its labels are
 valid where ``seen`` equals the current stamp, so a new query starts by taking a new stamp instead
-of clearing N entries. Workspaces are cached per ``jaxswarm.exact._host.EdgeArrays`` (per
+of clearing N entries. Workspaces are cached per :class:`~jaxswarm.world.edges.EdgeArrays` (per
 map), and are not shared between threads: a search from another thread gets its own.
 """
 from __future__ import annotations
@@ -15,8 +15,9 @@ import weakref
 import numpy as np
 
 from jaxswarm.exact import kernels
-from jaxswarm.exact._host import EdgeArrays, default_heuristic, edge_arrays, heuristic_code
+from jaxswarm.exact.host import default_heuristic, heuristic_code
 from jaxswarm.exact.stats import SearchStats, make_solution
+from jaxswarm.world.edges import EdgeArrays, edge_arrays
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 

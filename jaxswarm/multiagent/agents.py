@@ -17,9 +17,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.exact import distance_field
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import jit
 from jaxswarm.maps.movingai import MovingAIFormatError, load_scenarios, read_map
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph, grid_graph
 from jaxswarm.world.paths import as_node
 

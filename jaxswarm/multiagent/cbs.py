@@ -40,7 +40,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent import dependency, mdd
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
@@ -51,6 +50,7 @@ from jaxswarm.multiagent.limits import check_count, check_seconds
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.rectangle import Rectangles
 from jaxswarm.multiagent.spacetime import occupancy, search
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 

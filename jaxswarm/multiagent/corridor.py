@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import UNREACHABLE, breadth_first
 from jaxswarm.multiagent.constraints import Constraints, reservations
 from jaxswarm.multiagent.spacetime import LIMIT, search
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 ARRIVAL_EXPANSIONS = 100_000

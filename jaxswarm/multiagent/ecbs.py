@@ -34,13 +34,13 @@ import time
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.constraints import Constraints, earliest_collision, forbid
 from jaxswarm.multiagent.limits import check_count, check_seconds
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import occupancy
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 

@@ -27,7 +27,7 @@ def mdd(indptr: np.ndarray, heads: np.ndarray, start: int, goal: int, cost: int,
     the constraints).
 
     Args:
-      indptr, heads: the map's moves as CSR arrays (``jaxswarm.exact._host.edge_arrays``).
+      indptr, heads: the map's moves as CSR arrays (:func:`jaxswarm.world.edges.edge_arrays`).
       start, goal: node indices.
       cost: the steps of the paths.
       field: i32[N] steps from every node to ``goal`` (the pruning: a node with more steps to go

@@ -25,10 +25,10 @@ import time
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import inline, jit
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.plan import Plan, arrival_steps
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 NONE = -1

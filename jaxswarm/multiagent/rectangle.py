@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import breadth_first
 from jaxswarm.multiagent.constraints import Constraints
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 

@@ -31,10 +31,10 @@ import time
 import numpy as np
 
 from jaxswarm.exact import astar
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.multiagent.agents import agent_nodes, distance_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.plan import Plan, pack
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.edits import block_cells
 from jaxswarm.world.graph import Graph, grid_graph
 

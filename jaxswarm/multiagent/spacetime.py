@@ -31,9 +31,9 @@ import dataclasses
 
 import numpy as np
 
-from jaxswarm.exact._host import edge_arrays
 from jaxswarm.exact.kernels import inline, jit
 from jaxswarm.multiagent.agents import UNREACHABLE, breadth_first
+from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 FREE, FORBIDDEN = -1, -2

@@ -1,4 +1,5 @@
-"""What the table scripts of ``sweeps/`` share, one idea a module:
+"""What the table scripts of ``sweeps/`` share, and the papers' tables they reproduce, one idea a
+module:
 
 * :mod:`~jaxswarm.studies.provenance`: the provenance record of every table, and the index of a
   results folder;
@@ -8,5 +9,7 @@
 * :mod:`~jaxswarm.studies.success`: when a run reaches the optimum;
 * :mod:`~jaxswarm.studies.figures`: grids of map panels, written as PNG files;
 * :mod:`~jaxswarm.studies.rfd_table1`: the rows of the RFD paper's Table 1, which three scripts
-  run.
+  run;
+* :mod:`~jaxswarm.studies.rfd_dynamic`: the RFD paper's dynamic scenarios (its Tables 2-5) on our
+  rebuilds of its maps.
 """

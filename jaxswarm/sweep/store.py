@@ -16,10 +16,11 @@ store at a time: the writer holds the store's lock from opening it (where it che
 metadata) until it lets go of the store, and removes only the temporary files of writers that are
 no longer running. Reopening a store for the same spec, the same swarm definition and the same
 ``depends_on`` finds the finished chunks (resume). Anything else is refused, naming what differs:
-a different spec, a swarm that has changed under its name (a store of jaxswarm 0.1.0, whose
-``rfd_star`` was the law now called ``rfd_graded``), a map file edited since the store was
-written, a file in ``runs/`` that is not one of its chunks, a ``metadata.json`` that cannot be read,
-chunks without a ``metadata.json``.
+a different spec, a swarm that has changed under its name (another recorded definition, or a
+store of a release older than the one since which the swarm gives the same results:
+:data:`SAME_RESULTS_SINCE`), a map file edited since the store was written, a file in
+``runs/`` that is not one of its chunks, a ``metadata.json`` that cannot be read, chunks without
+a ``metadata.json``.
 """
 from __future__ import annotations
 
@@ -207,21 +208,11 @@ def _differences(before: dict, after: dict) -> list[str]:
     return sorted(k for k in set(before) | set(after) if before.get(k) != after.get(k))
 
 
-SAME_RESULTS_SINCE = (0, 7)
-"""The jaxswarm release since which a run's results are the same: 0.7.0 computes with arithmetic
-that does not depend on the batch (:mod:`jaxswarm.runtime.arithmetic`; see CHANGELOG.md), so a
-store of an older release is not resumed."""
-
-SAME_RESULTS_SINCE_BY_SWARM = {"ant_system": (0, 8), "iwd": (0, 8), "max_min_aco": (0, 8),
-                               "rfd": (0, 8)}
-"""Swarms whose results changed in a later release than ``SAME_RESULTS_SINCE``: 0.8.0 made the
-calibrated constants of these four their defaults (``results/calibration``)."""
-
-
-def same_results_since(name: str) -> tuple[int, int]:
-    """``(major, minor)``: the release since which the registered swarm ``name`` gives the same
-    results (``SAME_RESULTS_SINCE_BY_SWARM``, else ``SAME_RESULTS_SINCE``)."""
-    return SAME_RESULTS_SINCE_BY_SWARM.get(name, SAME_RESULTS_SINCE)
+SAME_RESULTS_SINCE = {
+    "aco_star": (0, 7), "ant_system": (0, 8), "cabc": (0, 7), "improved_max_min_aco": (0, 7),
+    "iwd": (0, 8), "iwd_pg": (0, 7), "max_min_aco": (0, 8), "rfd": (0, 8), "rfd_graded": (0, 7),
+    "rfd_star": (0, 7)}
+"""Per registered swarm, ``(major, minor)``: a store written by an older release is refused."""
 
 
 def _older_release(version: str | None, since: tuple[int, int]) -> bool:
@@ -238,35 +229,31 @@ def _check_definition(root: Path, existing: dict, swarm: dict) -> None:
 
     Raises:
       StoreMismatchError: naming the difference (the config fields and default params that
-        changed, or the jaxswarm version that wrote a store without a recorded definition or
-        before the release since which the swarm gives the same results,
-        :func:`same_results_since`).
+        changed), or the jaxswarm release that wrote the store where it is older than the one
+        since which the swarm gives the same results (:data:`SAME_RESULTS_SINCE`) or where the
+        store did not record the swarm's definition.
     """
-    stored = existing.get("swarm")
-    since = same_results_since(swarm["name"])
-    if stored is not None and _older_release(existing.get("jaxswarm"), since):
+    stored, release, name = existing.get("swarm"), existing.get("jaxswarm"), swarm["name"]
+    since = SAME_RESULTS_SINCE.get(name)
+    if since is None:
         raise StoreMismatchError(
-            f"{root} was written by jaxswarm {existing.get('jaxswarm')}, whose {swarm['name']!r} "
-            f"computed otherwise (its results changed in {since[0]}.{since[1]}.0, see "
-            "CHANGELOG.md); choose another --out or delete it")
+            f"{root}: no release is known since which {name!r} gives the same results (it is "
+            "not in jaxswarm.sweep.store.SAME_RESULTS_SINCE); choose another --out or delete it")
+    if stored is None or _older_release(release, since):
+        unrecorded = f", which did not record the definition of {name!r}" if stored is None else ""
+        raise StoreMismatchError(
+            f"{root} was written by jaxswarm {release or '(release not recorded)'}{unrecorded}; "
+            f"{name!r} gives the same results since jaxswarm {since[0]}.{since[1]}.0 "
+            "(CHANGELOG.md says what changed); choose another --out or delete it")
     if stored == swarm:
         return
-    if stored is None:
-        renamed = (" (its 'rfd_star' was the graded law, now registered as 'rfd_graded'; "
-                   "'rfd_star' is now the RFD paper's RFD*)" if swarm["name"] == "rfd_star"
-                   else "")
-        raise StoreMismatchError(
-            f"{root} was written by jaxswarm {existing.get('jaxswarm') or 'before 0.2.0'}, "
-            f"which did not record the definition of {swarm['name']!r}; since 0.2.0 a "
-            f"registered name is the paper's algorithm{renamed}, see CHANGELOG.md; choose "
-            "another --out or delete it")
     changed = [f"config.{k}" for k in _differences(stored.get("config", {}), swarm["config"])]
     changed += [f"default_params.{k}" for k in _differences(stored.get("default_params", {}),
                                                             swarm["default_params"])]
     raise StoreMismatchError(
-        f"{root} holds results of another definition of {swarm['name']!r} (written by jaxswarm "
-        f"{existing.get('jaxswarm')}; differs in: {', '.join(changed) or 'name'}); choose "
-        "another --out or delete it")
+        f"{root} holds results of another definition of {name!r} (written by jaxswarm "
+        f"{release}; differs in: {', '.join(changed) or 'name'}); choose another --out or "
+        "delete it")
 
 
 def read_results(root) -> pd.DataFrame:

@@ -57,15 +57,13 @@ from jaxswarm.world.relax import lowest_neighbour, relax
 
 SETTLE_SWEEPS = 1024
 """Most relaxation sweeps of :func:`settle` per iteration (a bound for ground that has no way
-down; it stops as soon as nothing moves). Sediment may have to slide far: at one maze100
-iteration we measured, settling took 188 sweeps (5.5-7 ms). Settling at most 64 sweeps per
-iteration, and the rest in later ones, made the optimum come later: in two sets of 20 maze100
-seeds at median iterations 67 and 26.5, against 22.5 and 19 when settled fully."""
+down; it stops as soon as nothing moves). Sediment may have to slide far, and settling part of
+it in later iterations makes the optimum come later (measured: ``docs/performance.md``)."""
 
 CARVE_COLUMNS = 8
 """Path columns per block of the carving (:func:`carve`). Its reverse running sum and minimum
-lower to reduce-windows whose cost grows with the square of the block width on CPU: 8 columns
-carve maze100 in about 3 ms per iteration, 64 (the walk's block) in about 5."""
+lower to reduce-windows whose cost grows with the square of the block width on CPU
+(measured: ``docs/performance.md``)."""
 
 
 @dataclasses.dataclass(frozen=True)

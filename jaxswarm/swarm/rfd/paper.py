@@ -17,57 +17,21 @@ gradient(i, j)`` (eq. 4; negative gradients erode nothing), and every node then 
 node where it stands (the paper's "a fraction of carried sediment", without an amount: the
 parameter is that amount). Altitudes are kept non-negative and the goal stays at 0.
 
-Readings of the paper's text, as config of ``rfd_star`` (the default is the reading we can
-justify; ``rfd`` erodes as the defaults do):
+Every change of the altitudes (sediment, erosion) is added by compensated summation
+(:func:`~jaxswarm.swarm.rfd.river.add_compensated`, the state's ``residual``).
 
-* ``erode``: whose paths erode. The text: "After all drops move, an erosion process is executed
-  on all travelled paths by reducing altitudes of nodes in proportion to their gradient with a
-  successive node (line 7)"; Algorithm 1: "6: Analyse complete paths / 7: Height of nodes on
-  paths -= erosion based on path costs". ``"arrived"`` (the default) erodes the paths of the
-  drops that reached the goal: the sentence defers to line 7, which erodes the paths line 6
-  analyses, "complete paths", "based on path costs", a cost only a path to the goal has; and a
-  drop that cannot move "deposits a fraction of carried sediment and evaporates", which the text
-  says is "weakening bad paths": eroding its trail would deepen the path its sediment weakens.
-  ``"travelled"`` erodes every drop's path, arrived, stuck or out of steps: the text's "all
-  travelled paths" (and its "a group of drops sequentially traverses the space, and then
-  performs erosion on visited nodes").
-* ``erosion_law``: ``"linear"`` is eq. 4; ``"exponential"`` erodes by ``p_base ** gradient``
-  instead of ``gradient`` (the paper, of eq. 6: "the same formula can be applied to the erosion
-  values"), and then gives at most the node's altitude minus the lowest altitude among the
-  nodes its eroding moves go to. Without that bound the exponential asks for amounts that grow
-  without limit with the gradient (even capped at ``exp(MAX_LOG_EROSION)`` against float32
-  overflow): on alley50 with ``E = 1000`` one iteration cut nodes far below the nodes they drain
-  to, and eq. 5 handed the surplus to every node, a median altitude of 3.95e9 (1.01 with the
-  bound). The bound is ours, from the text's erosion "in proportion to their gradient with a
-  successive node": it ends where the gradient does, as a river does not cut below its outlet.
-  So a node whose eroding moves are all flat or uphill erodes nothing, as under eq. 4, where the
-  unbounded form would erode flat ground by ``p_base ** 0 = 1``. The linear law is eq. 4 as
-  written: a drop leaves a node at most once per iteration, so it does not cut a node below the
-  node it drains to while ``E`` is at most ``N - 1`` times the shortest edge; above that it can,
-  and the clamp at 0 applies.
+Options of ``rfd_star`` (``rfd`` erodes as their defaults do; how we read the paper's text for
+each, and where the defaults come from: ``docs/papers.md``):
 
-Arithmetic, not algorithm: an erosion step is ``E / ((N - 1) D)`` times a gradient, and in
-float32 a step below about 3e-8 taken from an altitude of 1 is lost whole (on mosaic50, after 20
-iterations of the default ``rfd_star``, 17 % of the eroding moves of an iteration asked for less
-than 3e-8 times their node's altitude). Every change of the altitudes (sediment, erosion) is
-added by compensated summation (:func:`~jaxswarm.swarm.rfd.river.add_compensated`, the state's
-``residual``), so small steps add up as their sum does.
-
-Additions of this project, each off in the paper's variant:
-
-* ``greedy_drops``: the first drops take their most likely move instead of drawing one, so that
-  formed altitudes are walked exactly (one unlikely draw in 150 moves misses a long optimum).
-* ``fill_blind_alleys``: a stuck drop fills the whole blind alley it ran into
-  (:func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`), not only the node where it stands, so a dead
-  end is closed in one iteration instead of one node per iteration.
-* ``max_climb``: drops do not take moves steeper uphill than this gradient, so a filled alley is
-  not re-entered.
-
-The paper gives no parameter values. RFD's defaults (``DEFAULT_RFD``) are the setting its
-calibration found (``tunes/rfd.toml``); RFD*'s (``DEFAULT_RFD_STAR``) are this project's, as its
-calibration (``tunes/rfd_star.toml``) found no setting at least as good on every held-out map.
-The quality they reach is reported by ``sweeps/rfd_static.py`` and ``sweeps/rfd_paper_static.py``,
-not tuned into them.
+* ``erode``: whose paths erode: ``"arrived"`` (default), the drops that reached the goal, or
+  ``"travelled"``, every drop's.
+* ``erosion_law``: ``"linear"`` (eq. 4) or ``"exponential"``: ``p_base ** gradient`` in place of
+  the gradient (capped at ``exp(MAX_LOG_EROSION)``), and at most the node's altitude minus the
+  lowest altitude among the nodes its eroding moves go to.
+* additions of this project, each off in the paper's variant: ``greedy_drops`` (the first drops
+  take their most likely move), ``fill_blind_alleys`` (a stuck drop fills the whole blind alley
+  it ran into, :func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`) and ``max_climb`` (no move
+  steeper uphill than this gradient).
 """
 from __future__ import annotations
 

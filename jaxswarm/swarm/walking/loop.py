@@ -68,49 +68,32 @@ from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
 
 LANES = 1024
-"""The most lanes one walk loop steps. Measured on maze100 on a 2-core machine
-(``benchmarks/walk.py``): more lanes than this no longer speed a step up (their visited sets
-leave the caches)."""
+"""The most lanes one walk loop steps: more no longer speed a step up (their visited sets leave the
+caches; measured: ``docs/performance.md``)."""
 
 AGENTS_PER_LANE = 8
 """A loop of ``count`` agents steps about ``count // AGENTS_PER_LANE`` lanes (at least
 ``FEWEST_LANES``, at most ``LANES``): each lane walks several agents one after another, so the
 lanes stay busy while the queue lasts and only the last agents' lanes wait for the slowest. A
-lane-step costs about the same at 128 lanes as at 1,024 (its kernels' fixed cost is a few
-microseconds a step, against about 0.1 microsecond a lane), so fewer, busier lanes make more
-moves a second. Measured on maze100 and Berlin_1_256 (2 cores, one JAX device per core, walks
-of 1,024 agents): from the first memory, 128 lanes against one lane per agent moved agents on
-0.72-0.86 of the lane-steps instead of 0.58-0.65; over eight walks (two maps, two swarms, first
-and converged memory) they made up to 30 % more moves a second (one 3 % fewer, in the noise); at
-16,384 agents the queue keeps 1,024 lanes busy (0.86-0.95): 128 or 256 lanes were no faster on
-maze100, and up to 19 % faster on Berlin_1_256 (a rule by map size is not measured yet)."""
+lane-step's fixed cost is shared by its lanes, so fewer, busier lanes make more moves a second
+(measured: ``docs/performance.md``)."""
 
 FEWEST_LANES = 128
 """The fewest lanes a loop of more agents steps (see ``AGENTS_PER_LANE``): below it a step's
-fixed cost is no longer shared out (on maze100, 64 lanes made no more moves a second than 128)."""
+fixed cost is no longer shared out."""
 
 STEPS_PER_REFILL = BLOCK
-"""Moves a lane makes between two refills (an agent that stops within them idles until then).
-Measured on maze100 (2 cores): 16 against 8 made rfd_graded's runs about 7 % faster (fewer
-loop iterations) and left the walk of 16,384 agents as fast."""
+"""Moves a lane makes between two refills (an agent that stops within them idles until then)."""
 
 REFILL_SHARE = 2
 """At most ``lanes // REFILL_SHARE`` lanes take a new agent per refill: copying a stopped agent's
 visited set out costs a row of words, so the copy is sized for the usual number of stops, and
-any more stopped lanes wait for the next refill. Measured on maze100 (2 cores): a share of 2,
-4 or 1 made as many moves a second; on a small grid where agents stop after 14-30 moves on
-average (1,024 agents on 128 lanes), a share of 4 left 0.22-0.51 of the lane-steps moving, 2
-0.41-0.72, 1 0.54-0.72."""
+any more stopped lanes wait for the next refill."""
 
 COMPACT_SHARE = 4
 """When the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, the walk
 goes on with only them, in a batch of that many lanes; again and again as agents stop (see
-``SMALLEST_COMPACTION``). Measured on maze100 (2 cores, ``benchmarks/walk.py``'s walks of 1,024
-agents from the first memory, where a few agents walk on long after the others stopped):
-with a share of 8 and one narrowing, 0.36-0.40 of the lane-steps moved an agent and a walk took
-15.0 ms (ACO*) and 22.3 ms (rfd_graded); with 4 and narrowing down to 16 lanes, 0.61-0.67 and
-10.6 / 15.4 ms (a share of 2: 0.68-0.77, 9.8 / 15.1 ms, for twice the narrowed loops to compile).
-Walks of 16,384 agents spend their time while the queue is full, and were as fast."""
+``SMALLEST_COMPACTION``), so a walk's last agents do not keep every lane stepping."""
 
 SMALLEST_COMPACTION = 16
 """The lanes a walk narrows to, after its first narrowing, are at least this many: every

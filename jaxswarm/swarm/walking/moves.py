@@ -38,10 +38,8 @@ NARROWEST = 128
 
 GROWTH = 4
 """Each width of :func:`~jaxswarm.swarm.walking.moves.move_widths` is this times the one
-before. Every width is a branch to compile: on mosaic50 IWD_PG (smoothing, closest pairs and
-the drops' soil on these widths) compiles in about 20 s with widths 128, 512 and 800, and in
-about 25 s with 64, 128, 256, 512 and 800, which save it a few milliseconds an iteration
-(``benchmarks/iwd_pg.py``)."""
+before. Every width is a branch to compile, and a narrower one saves the moves' work of an
+iteration that needs no more (the trade measured: ``docs/performance.md``)."""
 
 
 def move_widths(columns: int) -> tuple[int, ...]:
