@@ -5,7 +5,6 @@ removed then: import them from :mod:`jaxswarm.studies.rfd_dynamic`.
 """
 from __future__ import annotations
 
-import importlib
 import warnings
 
 MOVED = ("MAX_BLOCK", "PAPER_DYNAMIC_LENGTH", "PAPER_DYNAMIC_MS", "Scenario", "TABLE2_GOALS",
@@ -20,5 +19,6 @@ def __getattr__(name: str):
     warnings.warn(f"jaxswarm.dynamic.scenarios.{name} moved to jaxswarm.studies.rfd_dynamic."
                   f"{name}; this path is removed in jaxswarm 0.11", DeprecationWarning,
                   stacklevel=2)
-    # Looked up when used, not imported: the paper's study sits above dynamic/ in the layers.
-    return getattr(importlib.import_module("jaxswarm.studies.rfd_dynamic"), name)
+    from jaxswarm.studies import rfd_dynamic  # above dynamic/: the layers contract names it
+
+    return getattr(rfd_dynamic, name)
