@@ -10,9 +10,10 @@ walk.
 
 ``jaxswarm mapf MAP SCEN`` plans for the first ``--agents`` agents of a Moving AI MAPF scenario
 (:mod:`jaxswarm.multiagent`) with one registered planner (:mod:`jaxswarm.multiagent.registry`:
-the A* report's scheme, prioritised planning, the CBS family, PIBT, LaCAM), validates the solution, prints its sum of costs against the lower bound and writes a GIF of
-the agents moving; it exits with status 1 when the planner finds no solution (naming the agent)
-or its solution breaks a rule.
+the A* report's scheme, prioritised planning, the CBS family, PIBT, LaCAM), validates the
+solution, prints its sum of costs against the lower bound and writes a GIF of the agents moving;
+it exits with status 1 when the planner finds no solution (naming the agent) or its solution
+breaks a rule.
 
 ``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per

@@ -16,7 +16,7 @@ from jaxswarm.multiagent.limits import OptionError
 from jaxswarm.world.graph import grid_graph
 from repo_scripts import ROOT, load_script
 
-BAD = {"time_limit": [(0, ValueError, "must be positive"), ("5", TypeError, "must be a number")],
+BAD = {"time_limit": [(-1, ValueError, "must be"), ("5", TypeError, "must be a number")],
        "max_nodes": [(0, ValueError, "at least 1"), (2.5, TypeError, "an integer")],
        "max_expansions": [(-3, ValueError, "at least 1"), (True, TypeError, "an integer")],
        "w": [(0.5, ValueError, "at least 1"), ("1.2", TypeError, "a number")],

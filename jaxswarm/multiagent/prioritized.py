@@ -16,7 +16,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
-from jaxswarm.multiagent.limits import OptionError, check_count, check_seconds
+from jaxswarm.multiagent.limits import OptionError, check_count, check_number
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import LIMIT, Reservations, search
 from jaxswarm.world.graph import Graph
@@ -59,7 +59,7 @@ class PrioritizedConfig:
         checked with the instance).
       seed: the seed of the random order (at least 0).
       max_expansions: the per-agent limit on expanded space-time states (at least 1).
-      time_limit: give up after this many seconds (checked between agents; positive,
+      time_limit: give up after this many seconds (checked between agents; at least 0,
         ``math.inf``: none).
 
     Raises:
@@ -79,13 +79,13 @@ class PrioritizedConfig:
         elif (not isinstance(self.order, Iterable)
               or not all(isinstance(a, numbers.Integral) and not isinstance(a, bool)
                          for a in self.order)):
-            raise TypeError(f"order must be a name of ORDERS or a sequence of agents, got "
-                            f"{self.order!r}")
+            raise TypeError(f"order must be one of {', '.join(ORDERS)} or a sequence of agents, "
+                            f"got {self.order!r}")
         else:
             object.__setattr__(self, "order", tuple(int(a) for a in self.order))
         check_count("seed", self.seed, least=0)
         check_count("max_expansions", self.max_expansions)
-        check_seconds("time_limit", self.time_limit)
+        check_number("time_limit", self.time_limit, least=0)
 
 
 def prioritized(graph: Graph, starts, goals, **options) -> Plan:
