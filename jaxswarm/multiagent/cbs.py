@@ -55,7 +55,8 @@ from jaxswarm.world.graph import Graph
 
 
 SWITCHES = ("prioritize", "bypass", "avoid", "wdg", "target", "corridor", "rectangle")
-"""The improvements of :class:`CBSConfig`, each a switch (see the module docstring)."""
+"""The improvements of :class:`~jaxswarm.multiagent.cbs.CBSConfig`, each a switch (see the module
+docstring)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,7 +107,7 @@ def cbs(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      **options: those of :class:`CBSConfig` (limits and improvements).
+      **options: those of :class:`~jaxswarm.multiagent.cbs.CBSConfig` (limits and improvements).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with
@@ -121,7 +122,8 @@ def cbs(graph: Graph, starts, goals, **options) -> Plan:
       least sum of costs plus heuristic left (the optimum when solved), ``seconds``.
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`CBSConfig`), naming it, before any search.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.cbs.CBSConfig`), naming
+        it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     config = CBSConfig(**options)

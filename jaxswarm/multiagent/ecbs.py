@@ -80,7 +80,8 @@ def eecbs(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      **options: those of :class:`ECBSConfig` (``w``, ``max_nodes``, ``time_limit``).
+      **options: those of :class:`~jaxswarm.multiagent.ecbs.ECBSConfig` (``w``, ``max_nodes``,
+        ``time_limit``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="eecbs"``); not solved when an
@@ -89,7 +90,8 @@ def eecbs(graph: Graph, starts, goals, **options) -> Plan:
       ``cost_error`` and ``collision_error`` (e_h and e_d as learnt), ``seconds``.
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`ECBSConfig`), naming it, before any search.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.ecbs.ECBSConfig`),
+        naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     return _bounded(graph, starts, goals, ECBSConfig(**options), explicit=True)

@@ -100,8 +100,8 @@ def lacam(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      **options: those of :class:`LaCAMConfig` (limits, ``refine``, ``swap``, ``seed``,
-        ``restart_rate``).
+      **options: those of :class:`~jaxswarm.multiagent.lacam.LaCAMConfig` (limits, ``refine``,
+        ``swap``, ``seed``, ``restart_rate``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``lacam``, or ``lacam_star``
@@ -116,8 +116,8 @@ def lacam(graph: Graph, starts, goals, **options) -> Plan:
       true only when the search ran out, so that no solution of a smaller sum of loss exists.
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`LaCAMConfig`), naming it, before any
-        search.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.lacam.LaCAMConfig`),
+        naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     config = LaCAMConfig(**options)

@@ -394,7 +394,7 @@ def pibt(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      **options: those of :class:`PIBTConfig` (``max_steps``, ``seed``).
+      **options: those of :class:`~jaxswarm.multiagent.pibt.PIBTConfig` (``max_steps``, ``seed``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="pibt"``); not solved when an
@@ -403,7 +403,8 @@ def pibt(graph: Graph, starts, goals, **options) -> Plan:
       steps).
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`PIBTConfig`), naming it, before any search.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.pibt.PIBTConfig`),
+        naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     config = PIBTConfig(**options)

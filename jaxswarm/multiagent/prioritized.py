@@ -94,8 +94,8 @@ def prioritized(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      **options: those of :class:`PrioritizedConfig` (``order``, ``seed``,
-        ``max_expansions``, ``time_limit``).
+      **options: those of :class:`~jaxswarm.multiagent.prioritized.PrioritizedConfig` (``order``,
+        ``seed``, ``max_expansions``, ``time_limit``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="prioritized"``); not solved, naming
@@ -103,8 +103,8 @@ def prioritized(graph: Graph, starts, goals, **options) -> Plan:
       agents planned before it, or when the time limit is reached before its turn.
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`PrioritizedConfig`), naming it, before
-        any search.
+      TypeError, ValueError: a bad option (see
+        :class:`~jaxswarm.multiagent.prioritized.PrioritizedConfig`), naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or an
         order that is not a permutation of its agents.
     """

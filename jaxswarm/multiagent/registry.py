@@ -191,7 +191,8 @@ def config(name: str, **given):
 def make_planner(name: str, **given) -> Callable[[Graph, object, object], Plan]:
     """The planner ``name`` with the options ``given``: ``(graph, starts, goals) -> Plan``.
 
-    The options are checked now, before any instance (see :func:`config`, which raises).
+    The options are checked now, before any instance (see
+    :func:`~jaxswarm.multiagent.registry.config`, which raises).
     """
     checked = config(name, **given)
     return functools.partial(entry(name).plan, **{field.name: getattr(checked, field.name)

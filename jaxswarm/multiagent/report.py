@@ -88,7 +88,7 @@ def report_scheme(graph: Graph, starts, goals, **options) -> Plan:
     Args:
       graph: the map; A* plans with its edge lengths, every move takes one step.
       starts, goals: (x, y) cells (or node indices), one per robot, all distinct.
-      **options: those of :class:`ReportConfig` (``max_repairs``).
+      **options: those of :class:`~jaxswarm.multiagent.report.ReportConfig` (``max_repairs``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="report"``) whose ``log`` has the
@@ -96,7 +96,8 @@ def report_scheme(graph: Graph, starts, goals, **options) -> Plan:
       re-plans fail, or the repairs run out.
 
     Raises:
-      TypeError, ValueError: a bad option (see :class:`ReportConfig`), naming it.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.report.ReportConfig`),
+        naming it.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
     config = ReportConfig(**options)
