@@ -9,10 +9,11 @@ a swarm and D* Lite re-plan whenever it finds one; it prints what each did and w
 walk.
 
 ``jaxswarm mapf MAP SCEN`` plans for the first ``--agents`` agents of a Moving AI MAPF scenario
-(:mod:`jaxswarm.multiagent`) with one planner (the A* report's scheme, prioritised planning or
-CBS), validates the solution, prints its sum of costs against the lower bound and writes a GIF of
-the agents moving; it exits with status 1 when the planner finds no solution (naming the agent)
-or its solution breaks a rule.
+(:mod:`jaxswarm.multiagent`) with one registered planner (:mod:`jaxswarm.multiagent.registry`:
+the A* report's scheme, prioritised planning, the CBS family, PIBT, LaCAM), validates the
+solution, prints its sum of costs against the lower bound and writes a GIF of the agents moving;
+it exits with status 1 when the planner finds no solution (naming the agent) or its solution
+breaks a rule.
 
 ``jaxswarm sweep FILE`` runs (or resumes) the parameter sweep a TOML file describes (see
 :mod:`jaxswarm.sweep.spec`), writes its results store and figures and prints the best params per
@@ -41,8 +42,9 @@ from jaxswarm.dynamic.robot import MEMORY, check_world, dstar_robot, hidden_bloc
 from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
 from jaxswarm.maps.named import NamedMap, named_map
 from jaxswarm.maps.paper import PAPER_MAPS
-from jaxswarm.multiagent import (ORDERS, PLANNERS, UNREACHABLE, load_instance, lower_bound,
-                                 validate)
+from jaxswarm.multiagent import ORDERS, UNREACHABLE, load_instance, lower_bound, validate
+from jaxswarm.multiagent import registry as planners
+from jaxswarm.multiagent.limits import OptionError
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, registry, run
 from jaxswarm.sweep.spec import DEFAULT_MAX_RUNS
@@ -155,31 +157,14 @@ def _add_mapf_parser(subparsers) -> None:
     mapf.add_argument("scen", type=Path, help="a .scen file of the map: its first rows are the "
                                               "agents")
     mapf.add_argument("--agents", type=int, default=10, help="how many agents (default 10)")
-    mapf.add_argument("--planner", choices=PLANNERS, default="prioritized",
-                      help="report: the A* report's two-robot scheme, pairwise; prioritized "
-                           "(default): space-time A* in priority order; cbs: Conflict-Based "
-                           "Search (optimal, few agents); icbs: CBS with prioritised "
-                           "collisions and bypassing (optimal); cbsh: ICBS with the weighted "
-                           "dependency graph heuristic (optimal); cbsh_tc: CBSH with target "
-                           "and corridor reasoning (optimal); cbsh_rtc: with rectangle "
-                           "reasoning too (optimal); ecbs, eecbs: Enhanced and Explicit "
-                           "Estimation CBS (within --w of the optimum); pibt: PIBT steps "
-                           "(fast, incomplete); lacam: "
-                           "LaCAM (complete, hundreds of agents); lacam_star: with LaCAM*'s "
-                           "swap generator (--refine: its anytime refinement)")
-    mapf.add_argument("--order", choices=ORDERS,
-                      help="prioritized only: the priority order (default given)")
-    mapf.add_argument("--seed", type=int,
-                      help="prioritized: seed of --order random; pibt, lacam, lacam_star: "
-                           "of the tie-breaks (default 0)")
-    mapf.add_argument("--time-limit", type=float,
-                      help="the CBS family, lacam, lacam_star: give up after this many "
-                           "seconds (default 60)")
-    mapf.add_argument("--w", type=float,
-                      help="ecbs, eecbs: the suboptimality bound (default 1.2)")
-    mapf.add_argument("--refine", type=float,
-                      help="lacam, lacam_star: lower the sum of costs for this many more "
-                           "seconds after the first solution (LaCAM*'s refinement)")
+    mapf.add_argument("--planner", choices=planners.registered(), default="prioritized",
+                      help="; ".join(f"{name}: {planners.entry(name).label}"
+                                     for name in planners.registered())
+                           + " (default prioritized; see jaxswarm.multiagent.registry)")
+    for option, (kind, about) in MAPF_OPTIONS.items():
+        owners = _owners(option)
+        mapf.add_argument(_flag(option), type=kind, choices=ORDERS if option == "order" else None,
+                          help=f"{about} ({', '.join(owners)}; default: the planner's)")
     gif = mapf.add_mutually_exclusive_group()
     gif.add_argument("--gif", type=Path,
                      help="GIF of the agents moving (default out/mapf_MAP_PLANNER.gif)")
@@ -419,7 +404,7 @@ def run_mapf(args: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     from jaxswarm.plot.agents import animate_plan, drawn_agents
 
-    options = _planner_options(args)
+    planner = _planner(args)
     if args.agents < 1:
         raise ValueError(f"--agents must be at least 1, got {args.agents}")
     for kind, path in (("MAP", args.map), ("SCEN", args.scen)):
@@ -431,11 +416,10 @@ def run_mapf(args: argparse.Namespace) -> int:
     height, width = graph.shape
     print(f"map {args.map.stem}: {width}x{height}, {int(graph.free.sum())} free cells, "
           f"{args.agents} agents from {args.scen.name}, planner {args.planner}")
-    planner = PLANNERS[args.planner]
     bound = lower_bound(graph, instance.starts, instance.goals)  # also compiles the hop fields
-    planner(graph, instance.starts[:1], instance.goals[:1], **options)  # load the kernels
+    planner(graph, instance.starts[:1], instance.goals[:1])  # load the kernels
     began = time.perf_counter()
-    plan = planner(graph, instance.starts, instance.goals, **options)
+    plan = planner(graph, instance.starts, instance.goals)
     seconds = time.perf_counter() - began
     violations = (validate(graph, plan.paths, instance.starts, instance.goals, plan.lengths)
                   if plan.solved else [])
@@ -463,25 +447,42 @@ def run_mapf(args: argparse.Namespace) -> int:
     return 0 if solved else 1
 
 
-def _planner_options(args: argparse.Namespace) -> dict:
-    """The keyword arguments of the chosen planner; ValueError for an option of another."""
-    given = {"order": args.order, "seed": args.seed, "time_limit": args.time_limit,
-             "refine": args.refine, "w": args.w}
-    owners = {"order": ("prioritized",), "seed": ("prioritized", "pibt", "lacam", "lacam_star"),
-              "time_limit": ("cbs", "icbs", "cbsh", "cbsh_tc", "cbsh_rtc", "ecbs", "eecbs",
-                             "lacam", "lacam_star"),
-              "refine": ("lacam", "lacam_star"), "w": ("ecbs", "eecbs")}
-    for option, value in given.items():
-        if value is not None and args.planner not in owners[option]:
-            raise ValueError(f"--{option.replace('_', '-')} applies to --planner "
-                             f"{' or '.join(owners[option])}, not {args.planner}")
-    if args.time_limit is not None and not args.time_limit > 0:
-        raise ValueError(f"--time-limit must be positive, got {args.time_limit}")
-    if args.refine is not None and args.refine < 0:
-        raise ValueError(f"--refine must be at least 0, got {args.refine}")
-    if args.w is not None and not args.w >= 1:
-        raise ValueError(f"--w must be at least 1, got {args.w}")
-    return {option: value for option, value in given.items() if value is not None}
+MAPF_OPTIONS = {"order": (str, "the priority order"),
+                "seed": (int, "the seed of the random order or of the tie-breaks"),
+                "time_limit": (float, "give up after this many seconds"),
+                "w": (float, "the suboptimality bound"),
+                "refine": (float, "lower the sum of costs for this many more seconds after the "
+                                  "first solution (LaCAM*'s refinement)")}
+"""The planners' options the ``mapf`` command offers: option -> (its type, what it is); each
+applies to the registered planners that have it."""
+
+
+def _owners(option: str) -> list[str]:
+    """The registered planners that take ``option``."""
+    return [name for name in planners.registered() if option in planners.options(name)]
+
+
+def _flag(option: str) -> str:
+    """The command's argument of a planner's ``option`` (``time_limit``: ``--time-limit``)."""
+    return "--" + option.replace("_", "-")
+
+
+def _planner(args: argparse.Namespace):
+    """The chosen planner with its options checked: ``(graph, starts, goals) -> Plan``.
+
+    Raises:
+      ValueError: an option of another planner or out of its range, naming the argument.
+    """
+    given = {option: getattr(args, option) for option in MAPF_OPTIONS
+             if getattr(args, option) is not None}
+    for option in given:
+        if args.planner not in _owners(option):
+            raise ValueError(f"{_flag(option)} applies to --planner "
+                             f"{' or '.join(_owners(option))}, not {args.planner}")
+    try:
+        return planners.make_planner(args.planner, **given)
+    except OptionError as error:
+        raise ValueError(f"{_flag(error.option)} {error.problem}") from None
 
 
 def _run_swarm(swarm, graph, start, goal, args):

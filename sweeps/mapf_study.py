@@ -6,7 +6,9 @@ On each map of ``--maps`` (default: every ``*.map`` of ``--data`` with both scen
 scenario file of ``--scenarios`` (default ``random`` and ``even``: ``<map>-random-1.scen``,
 ``<map>-even-1.scen``) and each count k of ``--agents`` (default 10, 20, 50, 100, 200, 400, 700,
 1,000) that the file has rows for, the instance is the file's first k rows
-(:func:`jaxswarm.multiagent.load_instance`). Rows, the planners of :mod:`jaxswarm.multiagent`:
+(:func:`jaxswarm.multiagent.load_instance`). Rows, the planners of
+:mod:`jaxswarm.multiagent.registry` (their labels and figure styles too), each planner with an
+``order`` option once per order, every other but CBSH (:data:`LEFT_OUT`) once:
 
 * ``report``: :func:`~jaxswarm.multiagent.report_scheme`, the A* report's scheme (A* per robot,
   then side-steps, waits and "one robot moves first" at collisions; the report has two robots,
@@ -86,21 +88,21 @@ from __future__ import annotations
 
 import argparse
 import csv
-import functools
 import importlib.util
 import math
 import statistics
 import sys
 import time
 from pathlib import Path
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from jaxswarm.multiagent import PLANNERS as NAMED
-from jaxswarm.multiagent import (Instance, Plan, cbs, lacam, load_instance, lower_bound, pack,
-                                 pibt, prioritized, report_scheme, validate)
+from jaxswarm.multiagent import (ORDERS, Instance, Plan, cbs, lacam, load_instance, lower_bound,
+                                 pack, pibt, prioritized, report_scheme, validate)
+from jaxswarm.multiagent import registry
+from jaxswarm.multiagent.registry import Style
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.runtime.atomic import atomic_path, write_csv
 from jaxswarm.studies import provenance
@@ -112,22 +114,65 @@ SCENARIOS = ("random", "even")
 """The scenario files of a map: ``<map>-<name>-1.scen``."""
 AGENTS = (10, 20, 50, 100, 200, 400, 700, 1000)
 """The default agent counts (each map runs those its scenario files have rows for)."""
-PLANNERS = ("report", "prioritized (given)", "prioritized (distance)", "prioritized (random)",
-            "cbs", "icbs", "cbsh_tc", "cbsh_rtc", "ecbs", "eecbs", "pibt", "lacam", "lacam_star",
-            "pymapf lacam", "pymapf cbs")
-"""The rows, in the order they run on every instance."""
-PYMAPF = ("pymapf lacam", "pymapf cbs")
-"""The rows of pymapf's solvers (left out when pymapf is not installed)."""
+LEFT_OUT = ("cbsh",)
+"""Registered planners the study does not run: CBSH, whose heuristic CBSH-TC runs with more
+reasoning."""
+ORDER_STYLES = {"given": Style("s", "-"), "distance": Style("D", "--"), "random": Style("^", ":")}
+"""The figure's style of a planner's row per priority order."""
+PYMAPF = {"pymapf lacam": ("pymapf LaCAM", Style("H", "-")),
+          "pymapf cbs": ("pymapf CBS", Style("8", "--"))}
+"""The rows of pymapf's solvers (left out when pymapf is not installed): their labels and
+styles."""
+
+
+class Row(NamedTuple):
+    """One row of the study: a registered ``planner`` (None: pymapf's) with ``options`` (its
+    priority order), its ``label`` in the tables and its ``style`` in the figure."""
+
+    planner: str | None
+    options: dict
+    label: str
+    style: Style
+
+
+def study_rows() -> dict[str, Row]:
+    """Row name -> :class:`Row`, in the order they run on every instance: the registered
+    planners but :data:`LEFT_OUT` in the registry's order (one with an ``order`` option once per
+    order of ``ORDERS``, as ``"NAME (ORDER)"``), then pymapf's solvers."""
+    rows = {}
+    for name in registry.registered():
+        entry = registry.entry(name)
+        if name in LEFT_OUT:
+            continue
+        if "order" not in registry.options(name):
+            rows[name] = Row(name, {}, entry.label, entry.style)
+            continue
+        for order in ORDERS:
+            rows[f"{name} ({order})"] = Row(name, {"order": order}, f"{entry.label} ({order})",
+                                            ORDER_STYLES[order])
+    rows.update((name, Row(None, {}, label, style)) for name, (label, style) in PYMAPF.items())
+    return rows
+
+
+ROWS = study_rows()
+"""The rows (see :func:`study_rows`), as the registry holds them when the script is loaded."""
+PLANNERS = tuple(ROWS)
+"""The rows' names, in the order they run on every instance."""
+LABELS = {name: row.label for name, row in ROWS.items()}
+"""Each row's name in tables and figures."""
+MARKERS, STYLES = ("".join(row.style.marker for row in ROWS.values()),
+                   tuple(row.style.linestyle for row in ROWS.values()))
+"""The figure's marker and line style of each row of :data:`PLANNERS`, in order."""
 MAX_AGENTS = {"report": 100, "cbs": 100, "icbs": 100, "cbsh_tc": 100, "cbsh_rtc": 100,
               "ecbs": 400, "eecbs": 400, "pymapf lacam": 200, "pymapf cbs": 50}
-"""The most agents a planner is run with (the others: every count)."""
-OPTIMAL = ("cbs", "icbs", "cbsh_tc", "cbsh_rtc")
+"""The most agents a row is run with (the others: every count)."""
+OPTIMAL = tuple(name for name, row in ROWS.items()
+                if row.planner and registry.entry(row.planner).guarantee == "optimal")
 """The rows whose solved plans have the least sum of costs."""
-BOUNDED = ("ecbs", "eecbs")
+BOUNDED = tuple(name for name, row in ROWS.items()
+                if row.planner and registry.entry(row.planner).guarantee == "bounded")
 """The rows whose solved plans are within w of the bound they prove."""
-MARKERS, STYLES = "osD^vP*Xhd<>pH8", ("-", "-", "--", ":") * 4
-"""The figure's marker and line style of each row of :data:`PLANNERS`, in order."""
-RANDOM = "prioritized (random)"
+RANDOM = next(name for name, row in ROWS.items() if row.options.get("order") == "random")
 """The row run once per seed."""
 RUN_COLUMNS = ("map", "scenario", "agents", "planner", "seed", "solved", "sum_of_costs",
                "lower_bound", "ratio", "makespan", "seconds", "field_seconds", "reason", "error",
@@ -166,13 +211,6 @@ ABOUT = (
     "distances; it and the makespan are means over the solved runs only. Every solved plan "
     "passed `validate`.")
 """What the rows are (the paragraph under the provenance)."""
-LABELS = {"report": "report's scheme", "prioritized (given)": "prioritized (given)",
-          "prioritized (distance)": "prioritized (distance)",
-          "prioritized (random)": "prioritized (random)", "cbs": "CBS", "icbs": "ICBS",
-          "cbsh_tc": "CBSH-TC", "cbsh_rtc": "CBSH-RTC", "eecbs": "EECBS",
-          "ecbs": "ECBS", "pibt": "PIBT", "lacam": "LaCAM", "lacam_star": "LaCAM* (swap)",
-          "pymapf lacam": "pymapf LaCAM",
-          "pymapf cbs": "pymapf CBS"}
 PUBLISHED = (
     ("LaCAM* (Okumura, IJCAI 2023): its code's README, Kei18/lacam2, first solution on random "
      "starts and goals", "random-32-32-20", 400, "about 0.031 s"),
@@ -295,23 +333,22 @@ def pymapf_planner(solver: str, time_limit: float) -> Callable:
 def planner_calls(seeds: int, time_limit: float, w: float, with_pymapf: bool,
                   planners=PLANNERS) -> list[tuple[str, int | None, Callable]]:
     """``(planner, seed or None, call(graph, starts, goals) -> Plan)`` in the order they run,
-    for the rows of ``planners`` (pymapf's only ``with_pymapf``)."""
-    ranked = functools.partial(prioritized, time_limit=time_limit)
-    calls = [("report", None, report_scheme),
-             ("prioritized (given)", None, functools.partial(ranked, order="given")),
-             ("prioritized (distance)", None, functools.partial(ranked, order="distance"))]
-    calls += [(RANDOM, seed, functools.partial(ranked, order="random", seed=seed))
-              for seed in range(seeds)]
-    calls += [(name, None, functools.partial(NAMED[name], time_limit=time_limit))
-              for name in OPTIMAL]
-    calls += [(name, None, functools.partial(NAMED[name], w=w, time_limit=time_limit))
-              for name in BOUNDED]
-    calls += [("pibt", None, pibt)]
-    calls += [(name, None, functools.partial(NAMED[name], time_limit=time_limit))
-              for name in ("lacam", "lacam_star")]
-    if with_pymapf:
-        calls += [(f"pymapf {solver}", None, pymapf_planner(solver, time_limit))
-                  for solver in ("lacam", "cbs")]
+    for the rows of ``planners`` (pymapf's only ``with_pymapf``): each registered planner with
+    its row's options and, where it takes them, ``time_limit`` and ``w``; the random order
+    once per seed 0 .. ``seeds`` - 1."""
+    calls = []
+    for name, row in ROWS.items():
+        if row.planner is None:
+            if with_pymapf:
+                calls.append((name, None, pymapf_planner(name.split()[1], time_limit)))
+            continue
+        taken = registry.options(row.planner)
+        options = dict(row.options, **{option: value for option, value in
+                                       (("time_limit", time_limit), ("w", w))
+                                       if option in taken})
+        for seed in (range(seeds) if row.options.get("order") == "random" else [None]):
+            seeded = {} if seed is None else {"seed": seed}
+            calls.append((name, seed, registry.make_planner(row.planner, **options, **seeded)))
     return [call for call in calls if call[0] in planners]
 
 

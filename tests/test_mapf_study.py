@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from jaxswarm.maps.movingai import read_map
-from jaxswarm.multiagent import Plan, load_instance, pack, pibt, prioritized
+from jaxswarm.multiagent import Plan, load_instance, pack, pibt, prioritized, registry
 from jaxswarm.world.paths import as_node
 from repo_scripts import load_script
 
@@ -249,7 +249,8 @@ def test_a_planner_that_raises_is_recorded_and_the_study_goes_on(instance, monke
     def broken(graph, starts, goals, **options):
         raise IndexError("list index out of range")
 
-    monkeypatch.setattr(study, "report_scheme", broken)
+    monkeypatch.setitem(registry.REGISTRY, "report",
+                        registry.entry("report")._replace(plan=broken))
     monkeypatch.setattr(study, "warm_up", lambda instance: None)
     rows = study.run_instance(instance, WHERE, study.planner_calls(1, 5, 1.2, False), 5)
     report = rows[0]
@@ -269,7 +270,8 @@ def test_an_invalid_solved_plan_raises(instance, monkeypatch):
         nodes = [[as_node(graph, s), as_node(graph, g)] for s, g in zip(starts, goals)]
         return Plan(*pack(nodes), solved=True, planner="prioritized")
 
-    monkeypatch.setattr(study, "prioritized", teleport)
+    monkeypatch.setitem(registry.REGISTRY, "prioritized",
+                        registry.entry("prioritized")._replace(plan=teleport))
     monkeypatch.setattr(study, "warm_up", lambda instance: None)
     with pytest.raises(study.InvalidPlan, match="prioritized \\(given\\) on empty-32-32 .*"
                                                 "violations: agent 0 jumps"):

@@ -11,8 +11,8 @@ import pytest
 
 import oracle
 from jaxswarm.maps.movingai import MovingAIFormatError
-from jaxswarm.multiagent import (PLANNERS, UNREACHABLE, cbs, find_conflicts, hop_fields,
-                                 load_instance, lower_bound, pack, prioritized, report_scheme,
+from jaxswarm.multiagent import (UNREACHABLE, cbs, find_conflicts, hop_fields, load_instance,
+                                 lower_bound, pack, prioritized, registry, report_scheme,
                                  validate)
 from jaxswarm.multiagent import conflicts as conflicts_module
 from jaxswarm.multiagent.agents import distance_fields
@@ -20,6 +20,9 @@ from jaxswarm.multiagent.plan import arrival_steps
 from jaxswarm.multiagent.prioritized import priority_order
 from jaxswarm.multiagent.report import report_example
 from jaxswarm.world.graph import grid_graph
+
+PLANNERS = {name: registry.make_planner(name) for name in registry.registered()}
+"""Every registered planner with its default options."""
 
 
 def cells(graph, path):

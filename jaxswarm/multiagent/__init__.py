@@ -7,19 +7,22 @@ Conflict-Based Search, PIBT and LaCAM, with one solution format and one validato
   reservation table, in a given, distance or seeded random order.
 * :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs;
   ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements, ``avoid`` the
-  conflict avoidance table's tie-break (``"icbs"`` in ``PLANNERS``: all three), with MDDs from
-  :mod:`~jaxswarm.multiagent.mdd`; ``wdg`` the weighted dependency graph heuristic
-  (:mod:`~jaxswarm.multiagent.dependency`; ``"cbsh"``: all four), ``target``, ``corridor`` and
-  ``rectangle`` the symmetry reasoning of :mod:`~jaxswarm.multiagent.constraints`,
-  :mod:`~jaxswarm.multiagent.corridor` and :mod:`~jaxswarm.multiagent.rectangle`
-  (``"cbsh_tc"``: the first six, ``"cbsh_rtc"``: all seven).
+  conflict avoidance table's tie-break, with MDDs from :mod:`~jaxswarm.multiagent.mdd`; ``wdg``
+  the weighted dependency graph heuristic (:mod:`~jaxswarm.multiagent.dependency`), ``target``,
+  ``corridor`` and ``rectangle`` the symmetry reasoning of
+  :mod:`~jaxswarm.multiagent.constraints`, :mod:`~jaxswarm.multiagent.corridor` and
+  :mod:`~jaxswarm.multiagent.rectangle`.
 * :func:`ecbs` and :func:`eecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS and Explicit
   Estimation CBS, within a factor ``w`` of the optimum.
 * :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
   step for all agents at a time; fast, incomplete.
 * :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
-  configurations with PIBT as its generator, and LaCAM*'s generator (``swap``; ``"lacam_star"``
-  in ``PLANNERS``) and anytime refinement (``refine``).
+  configurations with PIBT as its generator, and LaCAM*'s generator (``swap``) and anytime
+  refinement (``refine``).
+* :mod:`~jaxswarm.multiagent.registry`: the planners by name (``icbs``, ``cbsh``, ``cbsh_tc``,
+  ``cbsh_rtc``, ``lacam_star``: the switches of their papers fixed), each with its Config,
+  label, paper and figure style; :func:`make_planner` checks a planner's options before any
+  search. The ``jaxswarm mapf`` command and the MAPF study read it.
 * :func:`validate` (:mod:`~jaxswarm.multiagent.validate`) checks any solution;
   :func:`find_conflicts` (:mod:`~jaxswarm.multiagent.conflicts`) is its batched JAX conflict
   check; :class:`Plan` (:mod:`~jaxswarm.multiagent.plan`) is the one result format.
@@ -28,7 +31,7 @@ Time is in steps: every agent moves along one edge or waits per step, and an age
 step from which it stays at its goal. On the MAPF benchmark maps (:func:`load_instance`, loaded
 4-connected) that is the benchmark's sum of costs.
 """
-import functools
+import warnings
 
 from jaxswarm.multiagent.agents import (UNREACHABLE, Instance, agent_nodes, hop_fields,
                                         load_instance, lower_bound)
@@ -39,21 +42,25 @@ from jaxswarm.multiagent.lacam import lacam
 from jaxswarm.multiagent.pibt import pibt
 from jaxswarm.multiagent.plan import Plan, arrival_steps, pack
 from jaxswarm.multiagent.prioritized import ORDERS, prioritized
+from jaxswarm.multiagent.registry import make_planner
 from jaxswarm.multiagent.report import report_scheme
 from jaxswarm.multiagent.validate import Violation, validate
 
-PLANNERS = {"report": report_scheme, "prioritized": prioritized, "cbs": cbs,
-            "icbs": functools.partial(cbs, prioritize=True, bypass=True, avoid=True),
-            "cbsh": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True),
-            "cbsh_tc": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True,
-                                         target=True, corridor=True),
-            "cbsh_rtc": functools.partial(cbs, prioritize=True, bypass=True, avoid=True, wdg=True,
-                                          target=True, corridor=True, rectangle=True),
-            "ecbs": ecbs, "eecbs": eecbs, "pibt": pibt, "lacam": lacam,
-            "lacam_star": functools.partial(lacam, swap=True)}
-"""The planners by name (as the ``jaxswarm mapf`` command and the study call them)."""
 
-__all__ = ["Conflicts", "Instance", "ORDERS", "PLANNERS", "Plan", "UNREACHABLE", "Violation",
+def __getattr__(name: str):
+    """``PLANNERS``, deprecated: name -> planner function with its variant's switches set, as
+    :func:`jaxswarm.multiagent.registry.planner_functions` gives it."""
+    if name == "PLANNERS":
+        warnings.warn("jaxswarm.multiagent.PLANNERS is deprecated and goes in the next minor "
+                      "release; use jaxswarm.multiagent.registry (make_planner, registered, "
+                      "entry)", DeprecationWarning, stacklevel=2)
+        from jaxswarm.multiagent.registry import planner_functions
+
+        return planner_functions()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["Conflicts", "Instance", "ORDERS", "Plan", "UNREACHABLE", "Violation",
            "agent_nodes", "arrival_steps", "cbs", "ecbs", "eecbs", "find_conflicts", "hop_fields",
-           "lacam", "load_instance", "lower_bound", "pack", "pibt", "prioritized",
-           "report_scheme", "validate"]
+           "lacam", "load_instance", "lower_bound", "make_planner", "pack", "pibt",
+           "prioritized", "report_scheme", "validate"]

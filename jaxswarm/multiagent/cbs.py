@@ -46,7 +46,7 @@ from jaxswarm.multiagent.conflicts import pair_collision_steps, pair_collisions
 from jaxswarm.multiagent.constraints import (Constraints, earliest_collision, reservations,
                                              resting_on, split_collision)
 from jaxswarm.multiagent.corridor import Corridors
-from jaxswarm.multiagent.limits import check_count, check_seconds
+from jaxswarm.multiagent.limits import check_count, check_seconds, check_switch
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.rectangle import Rectangles
 from jaxswarm.multiagent.spacetime import occupancy, search
@@ -54,18 +54,19 @@ from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 
-def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: float = 60.0,
-        max_expansions: int = 10_000_000, prioritize: bool = False, bypass: bool = False,
-        avoid: bool = False, wdg: bool = False, target: bool = False,
-        corridor: bool = False, rectangle: bool = False) -> Plan:
-    """Conflict-Based Search.
+SWITCHES = ("prioritize", "bypass", "avoid", "wdg", "target", "corridor", "rectangle")
+"""The improvements of :class:`~jaxswarm.multiagent.cbs.CBSConfig`, each a switch (see the module
+docstring)."""
 
-    Args:
-      graph: the map; its valid edges are the moves, one step each.
-      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      max_nodes: give up after expanding this many constraint-tree nodes.
-      time_limit: give up after this many seconds.
-      max_expansions: the limit on expanded space-time states per low-level search.
+
+@dataclasses.dataclass(frozen=True)
+class CBSConfig:
+    """The options of :func:`cbs`, checked when made.
+
+    Attributes:
+      max_nodes: give up after expanding this many constraint-tree nodes (at least 1).
+      time_limit: give up after this many seconds (positive).
+      max_expansions: the limit on expanded space-time states per low-level search (at least 1).
       prioritize: split on cardinal collisions first, then semi-cardinal (from MDDs).
       bypass: take a child's path instead of splitting where it costs no more, collides less.
       avoid: of an agent's shortest paths, take the one meeting the fewest other agents.
@@ -74,6 +75,39 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       target: split a collision on a resting agent's goal by when that agent finishes.
       corridor: split a head-on collision in a corridor by which agent crosses first.
       rectangle: split a collision of two agents crossing a rectangle by barriers.
+
+    Raises:
+      TypeError, ValueError: a limit that is not a positive number (``time_limit``) or a whole
+        number of at least 1 (``max_nodes``, ``max_expansions``), or a switch that is not True
+        or False, naming it.
+    """
+
+    max_nodes: int = 100_000
+    time_limit: float = 60.0
+    max_expansions: int = 10_000_000
+    prioritize: bool = False
+    bypass: bool = False
+    avoid: bool = False
+    wdg: bool = False
+    target: bool = False
+    corridor: bool = False
+    rectangle: bool = False
+
+    def __post_init__(self):
+        check_seconds("time_limit", self.time_limit)
+        check_count("max_nodes", self.max_nodes)
+        check_count("max_expansions", self.max_expansions)
+        for switch in SWITCHES:
+            check_switch(switch, getattr(self, switch))
+
+
+def cbs(graph: Graph, starts, goals, **options) -> Plan:
+    """Conflict-Based Search.
+
+    Args:
+      graph: the map; its valid edges are the moves, one step each.
+      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
+      **options: those of :class:`~jaxswarm.multiagent.cbs.CBSConfig` (limits and improvements).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``cbs``, ``icbs`` with
@@ -88,28 +122,26 @@ def cbs(graph: Graph, starts, goals, *, max_nodes: int = 100_000, time_limit: fl
       least sum of costs plus heuristic left (the optimum when solved), ``seconds``.
 
     Raises:
-      TypeError, ValueError: a limit that is not a positive number (``time_limit``) or a whole
-        number of at least 1 (``max_nodes``, ``max_expansions``), naming it.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.cbs.CBSConfig`), naming
+        it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
-    check_seconds("time_limit", time_limit)
-    check_count("max_nodes", max_nodes)
-    check_count("max_expansions", max_expansions)
+    config = CBSConfig(**options)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     agents = len(start_nodes)
     instance = _Instance(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes),
-                         max_expansions=max_expansions, began=began,
-                         name=_name(prioritize, bypass, avoid, wdg, target, corridor,
-                                    rectangle),
-                         avoid=avoid, wdg=wdg, target=target,
-                         corridors=Corridors(graph) if corridor else None,
-                         rectangles=Rectangles(graph) if rectangle else None)
+                         max_expansions=config.max_expansions, began=began,
+                         name=_name(*(getattr(config, switch) for switch in SWITCHES)),
+                         avoid=config.avoid, wdg=config.wdg, target=config.target,
+                         corridors=Corridors(graph) if config.corridor else None,
+                         rectangles=Rectangles(graph) if config.rectangle else None)
     blocked = cut_off(graph, instance.fields, start_nodes, goal_nodes)
     if blocked is not None:
         return instance.stop([np.array([s], np.int32) for s in start_nodes], False, blocked[1],
                              blocked[0])
-    return _search(instance, agents, max_nodes, time_limit, prioritize, bypass)
+    return _search(instance, agents, config.max_nodes, config.time_limit, config.prioritize,
+                   config.bypass)
 
 
 def _search(instance: "_Instance", agents: int, max_nodes: int, time_limit: float,

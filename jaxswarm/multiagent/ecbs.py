@@ -29,7 +29,6 @@ from __future__ import annotations
 import dataclasses
 import heapq
 import itertools
-import numbers
 import time
 
 import numpy as np
@@ -37,30 +36,52 @@ import numpy as np
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
 from jaxswarm.multiagent.constraints import Constraints, earliest_collision, forbid
-from jaxswarm.multiagent.limits import check_count, check_seconds
+from jaxswarm.multiagent.limits import check_count, check_number, check_seconds
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import occupancy
 from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
 
 
-def ecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_000,
-         time_limit: float = 60.0) -> Plan:
+@dataclasses.dataclass(frozen=True)
+class ECBSConfig:
+    """The options of :func:`ecbs` and :func:`eecbs`, checked when made.
+
+    Attributes:
+      w: the bound: the sum of costs is at most w times the optimum (at least 1).
+      max_nodes: give up after splitting this many constraint-tree nodes (at least 1).
+      time_limit: give up after this many seconds (positive).
+
+    Raises:
+      TypeError, ValueError: a ``w`` that is not a number of at least 1, a ``time_limit`` that
+        is not a positive number or a ``max_nodes`` that is not a whole number of at least 1,
+        naming it.
+    """
+
+    w: float = 1.2
+    max_nodes: int = 100_000
+    time_limit: float = 60.0
+
+    def __post_init__(self):
+        check_number("w", self.w, least=1)
+        check_seconds("time_limit", self.time_limit)
+        check_count("max_nodes", self.max_nodes)
+
+
+def ecbs(graph: Graph, starts, goals, **options) -> Plan:
     """Enhanced CBS with suboptimality bound ``w`` (the arguments and result of
     :func:`eecbs`, ``planner="ecbs"``)."""
-    return _bounded(graph, starts, goals, w, max_nodes, time_limit, explicit=False)
+    return _bounded(graph, starts, goals, ECBSConfig(**options), explicit=False)
 
 
-def eecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_000,
-          time_limit: float = 60.0) -> Plan:
+def eecbs(graph: Graph, starts, goals, **options) -> Plan:
     """Explicit Estimation CBS with suboptimality bound ``w``.
 
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      w: the bound: the sum of costs is at most w times the optimum (at least 1).
-      max_nodes: give up after splitting this many constraint-tree nodes.
-      time_limit: give up after this many seconds.
+      **options: those of :class:`~jaxswarm.multiagent.ecbs.ECBSConfig` (``w``, ``max_nodes``,
+        ``time_limit``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="eecbs"``); not solved when an
@@ -69,31 +90,23 @@ def eecbs(graph: Graph, starts, goals, *, w: float = 1.2, max_nodes: int = 100_0
       ``cost_error`` and ``collision_error`` (e_h and e_d as learnt), ``seconds``.
 
     Raises:
-      TypeError, ValueError: a ``w`` that is not a number of at least 1, a ``time_limit`` that
-        is not a positive number or a ``max_nodes`` that is not a whole number of at least 1,
-        naming it.
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.ecbs.ECBSConfig`),
+        naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
-    return _bounded(graph, starts, goals, w, max_nodes, time_limit, explicit=True)
+    return _bounded(graph, starts, goals, ECBSConfig(**options), explicit=True)
 
 
-def _bounded(graph: Graph, starts, goals, w: float, max_nodes: int, time_limit: float, *,
-             explicit: bool) -> Plan:
+def _bounded(graph: Graph, starts, goals, config: ECBSConfig, *, explicit: bool) -> Plan:
     """ECBS, or with ``explicit`` EECBS (see :func:`eecbs`)."""
-    if not isinstance(w, numbers.Real) or isinstance(w, bool):
-        raise TypeError(f"w must be a number, got {w!r}")
-    if not w >= 1.0:
-        raise ValueError(f"w must be at least 1, got {w}")
-    check_seconds("time_limit", time_limit)
-    check_count("max_nodes", max_nodes)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
-    search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), w, began,
-                     explicit)
+    search = _Search(graph, start_nodes, goal_nodes, hop_fields(graph, goal_nodes), config.w,
+                     began, explicit)
     blocked = cut_off(graph, search.fields, start_nodes, goal_nodes)
     if blocked is not None:
         return search.stop([np.array([s]) for s in start_nodes], False, blocked[1], blocked[0])
-    return search.run(max_nodes, time_limit)
+    return search.run(config.max_nodes, config.time_limit)
 
 
 @dataclasses.dataclass(eq=False)

@@ -34,7 +34,7 @@ numbers), drawing the trees' orders and the restarts from one NumPy ``Generator`
 """
 from __future__ import annotations
 
-import numbers
+import dataclasses
 import time
 
 import numpy as np
@@ -43,7 +43,7 @@ from jaxswarm.exact.kernels import inline, jit
 from jaxswarm.multiagent.agents import agent_nodes, cut_off, hop_fields
 from jaxswarm.multiagent.constraint_trees import ConstraintTrees, gather, plant, take
 from jaxswarm.multiagent.explored import NONE, Explored, add, connect, find, grown, spare
-from jaxswarm.multiagent.limits import check_count, check_seconds
+from jaxswarm.multiagent.limits import check_count, check_number, check_seconds, check_switch
 from jaxswarm.multiagent.pibt import (Moves, Workspace, compiled_configuration, initial_priorities,
                                       next_priorities)
 from jaxswarm.multiagent.plan import Plan, arrival_steps
@@ -54,27 +54,54 @@ _UNBOUNDED = np.iinfo(np.int64).max
 """The limit of the Dijkstra update before any solution is known."""
 
 
-def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: float = 0.0,
-          swap: bool = False, max_configurations: int = 10_000_000, seed: int = 0,
-          restart_rate: float = 0.001) -> Plan:
-    """LaCAM, and with ``refine`` and ``swap`` LaCAM*.
+@dataclasses.dataclass(frozen=True)
+class LaCAMConfig:
+    """The options of :func:`lacam`, checked when made.
 
-    Args:
-      graph: the map; its valid edges are the moves, one step each.
-      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
+    Attributes:
       time_limit: give up after this many seconds without a solution (distance fields
         included).
       refine: LaCAM*: after the first solution, keep lowering its sum of loss for this many
         more seconds (0: return the first solution).
       swap: LaCAM*'s successor generator: PIBT with the swap operation
         (:func:`~jaxswarm.multiagent.pibt.configuration`), for corridors.
-      max_configurations: give up after this many configurations.
+      max_configurations: give up after this many configurations (at least 1).
       seed: the key of PIBT's tie-breaks and of the constraint trees' order (at least 0).
       restart_rate: LaCAM*'s random restarts while refining: when a known configuration is
         generated again, the starts' configuration is pushed in its place with this
         probability (the reference implementation's ``--restart_rate``, Kei18/lacam2, and its
         default), so that the search does not stay deep in one branch. The first solution is
         found without restarts, as LaCAM's.
+
+    Raises:
+      TypeError: a limit, ``seed`` or ``swap`` of the wrong type (naming it).
+      ValueError: a limit out of its range (naming it).
+    """
+
+    time_limit: float = 60.0
+    refine: float = 0.0
+    swap: bool = False
+    max_configurations: int = 10_000_000
+    seed: int = 0
+    restart_rate: float = 0.001
+
+    def __post_init__(self):
+        check_seconds("time_limit", self.time_limit)
+        check_count("max_configurations", self.max_configurations)
+        check_number("refine", self.refine, least=0)
+        check_number("restart_rate", self.restart_rate, least=0, most=1)
+        check_count("seed", self.seed, least=0)
+        check_switch("swap", self.swap)
+
+
+def lacam(graph: Graph, starts, goals, **options) -> Plan:
+    """LaCAM, and with ``refine`` and ``swap`` LaCAM*.
+
+    Args:
+      graph: the map; its valid edges are the moves, one step each.
+      starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
+      **options: those of :class:`~jaxswarm.multiagent.lacam.LaCAMConfig` (limits, ``refine``,
+        ``swap``, ``seed``, ``restart_rate``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner``: ``lacam``, or ``lacam_star``
@@ -89,13 +116,12 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
       true only when the search ran out, so that no solution of a smaller sum of loss exists.
 
     Raises:
-      TypeError: a limit, ``seed`` or ``swap`` of the wrong type (naming it).
-      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or a
-        limit out of its range (naming it).
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.lacam.LaCAMConfig`),
+        naming it, before any search.
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
-    _check_options(time_limit=time_limit, refine=refine, swap=swap,
-                   max_configurations=max_configurations, seed=seed, restart_rate=restart_rate)
-    name = "lacam_star" if swap else "lacam"
+    config = LaCAMConfig(**options)
+    name = "lacam_star" if config.swap else "lacam"
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     fields = hop_fields(graph, goal_nodes)
@@ -105,34 +131,17 @@ def lacam(graph: Graph, starts, goals, *, time_limit: float = 60.0, refine: floa
     if blocked is not None:
         return Plan(*waiting, solved=False, planner=name, reason=blocked[1], agent=blocked[0],
                     stats=dict(stats, configurations=0, seconds=0.0))
-    search = _Search(Moves.build(graph, goal_nodes, fields), seed, swap, restart_rate)
-    found, why = search.run(start_nodes, deadline=began + time_limit, refine=refine,
-                            max_configurations=max_configurations)
-    stats |= search.stats(refine > 0)
+    search = _Search(Moves.build(graph, goal_nodes, fields), config.seed, config.swap,
+                     config.restart_rate)
+    found, why = search.run(start_nodes, deadline=began + config.time_limit,
+                            refine=config.refine,
+                            max_configurations=config.max_configurations)
+    stats |= search.stats(config.refine > 0)
     if found is None:
         return Plan(*waiting, solved=False, planner=name, reason=why, stats=stats)
     paths = np.stack(found, axis=1)
     return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner=name,
                 stats=stats)
-
-
-def _check_options(*, time_limit, refine, swap, max_configurations, seed, restart_rate):
-    """Refuse, naming it, an option of :func:`lacam` of the wrong type or out of its range."""
-    check_seconds("time_limit", time_limit)
-    check_count("max_configurations", max_configurations)
-    for name, value in (("refine", refine), ("restart_rate", restart_rate)):
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            raise TypeError(f"{name} must be a number, got {value!r}")
-    if isinstance(seed, bool) or not isinstance(seed, numbers.Integral):
-        raise TypeError(f"seed must be an integer, got {seed!r}")
-    if not isinstance(swap, (bool, np.bool_)):
-        raise TypeError(f"swap must be True or False, got {swap!r}")
-    if not refine >= 0:
-        raise ValueError(f"refine must be at least 0, got {refine}")
-    if not 0 <= restart_rate <= 1:
-        raise ValueError(f"restart_rate must be between 0 and 1, got {restart_rate}")
-    if seed < 0:
-        raise ValueError(f"seed must be at least 0, got {seed}")
 
 
 class _Search:

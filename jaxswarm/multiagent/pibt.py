@@ -27,6 +27,7 @@ import numpy as np
 
 from jaxswarm.exact.kernels import inline, jit
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, cut_off, hop_fields
+from jaxswarm.multiagent.limits import check_count
 from jaxswarm.multiagent.plan import Plan, arrival_steps
 from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.graph import Graph
@@ -367,14 +368,33 @@ def by_priority(priorities):
     return np.argsort(-priorities, kind="mergesort").astype(np.int32)
 
 
-def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -> Plan:
+@dataclasses.dataclass(frozen=True)
+class PIBTConfig:
+    """The options of :func:`pibt`, checked when made.
+
+    Attributes:
+      max_steps: give up after this many steps (at least 1).
+      seed: the key of the tie-breaks (at least 0).
+
+    Raises:
+      TypeError, ValueError: an option that is not a whole number in its range, naming it.
+    """
+
+    max_steps: int = 1000
+    seed: int = 0
+
+    def __post_init__(self):
+        check_count("max_steps", self.max_steps)
+        check_count("seed", self.seed, least=0)
+
+
+def pibt(graph: Graph, starts, goals, **options) -> Plan:
     """PIBT steps from the starts until every agent is at its goal at once.
 
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      max_steps: give up after this many steps.
-      seed: the key of the tie-breaks.
+      **options: those of :class:`~jaxswarm.multiagent.pibt.PIBTConfig` (``max_steps``, ``seed``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="pibt"``); not solved when an
@@ -383,10 +403,11 @@ def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -
       steps).
 
     Raises:
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.pibt.PIBTConfig`),
+        naming it, before any search.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
-    if max_steps < 1:
-        raise ValueError(f"max_steps must be at least 1, got {max_steps}")
+    config = PIBTConfig(**options)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     fields = hop_fields(graph, goal_nodes)
@@ -398,13 +419,13 @@ def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -
                     planner="pibt", reason=blocked[1], agent=blocked[0],
                     stats=dict(stats, steps=0, seconds=0.0))
     moves = Moves.build(graph, goal_nodes, fields)
-    work = Workspace(moves, seed)
+    work = Workspace(moves, config.seed)
     searching = time.perf_counter()
     configurations = [start_nodes]
     priorities = initial_priorities(moves, start_nodes)
     empty = np.zeros(0, np.int32)
     current = start_nodes
-    while not np.array_equal(current, goal_nodes) and len(configurations) <= max_steps:
+    while not np.array_equal(current, goal_nodes) and len(configurations) <= config.max_steps:
         following = np.empty_like(current)
         configuration(moves, work, current, by_priority(priorities), empty, empty, following)
         next_priorities(priorities, following, goal_nodes, priorities)
@@ -416,6 +437,7 @@ def pibt(graph: Graph, starts, goals, *, max_steps: int = 1000, seed: int = 0) -
         away = int(np.nonzero(current != goal_nodes)[0][0])
         return Plan(paths, arrival_steps(paths, goal_nodes), solved=False, planner="pibt",
                     reason=f"agent {away} (and {int((current != goal_nodes).sum()) - 1} more) "
-                           f"not at its goal after {max_steps} steps", agent=away, stats=stats)
+                           f"not at its goal after {config.max_steps} steps", agent=away,
+                    stats=stats)
     return Plan(paths, arrival_steps(paths, goal_nodes), solved=True, planner="pibt",
                 stats=stats)

@@ -7,13 +7,16 @@ an agent can find its way walled in by those before it, and the result depends o
 """
 from __future__ import annotations
 
+import dataclasses
 import math
+import numbers
 import time
-from collections.abc import Sequence
+from collections.abc import Iterable
 
 import numpy as np
 
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields, place
+from jaxswarm.multiagent.limits import OptionError, check_count, check_number
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.multiagent.spacetime import LIMIT, Reservations, search
 from jaxswarm.world.graph import Graph
@@ -46,18 +49,53 @@ def priority_order(order, distances: np.ndarray, seed: int = 0) -> np.ndarray:
     return permutation.astype(np.int32)
 
 
-def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "given",
-                seed: int = 0, max_expansions: int = 10_000_000,
-                time_limit: float = math.inf) -> Plan:
+@dataclasses.dataclass(frozen=True)
+class PrioritizedConfig:
+    """The options of :func:`prioritized`, checked when made.
+
+    Attributes:
+      order: "given", "distance", "random" (see ``ORDERS``) or a permutation of the agents (a
+        sequence of integers, held as a tuple; that it is one of the instance's agents is
+        checked with the instance).
+      seed: the seed of the random order (at least 0).
+      max_expansions: the per-agent limit on expanded space-time states (at least 1).
+      time_limit: give up after this many seconds (checked between agents; at least 0,
+        ``math.inf``: none).
+
+    Raises:
+      TypeError, ValueError: an option of the wrong type or out of its range, naming it.
+    """
+
+    order: str | tuple[int, ...] = "given"
+    seed: int = 0
+    max_expansions: int = 10_000_000
+    time_limit: float = math.inf
+
+    def __post_init__(self):
+        if isinstance(self.order, str):
+            if self.order not in ORDERS:
+                raise OptionError("order", f"must be one of {', '.join(ORDERS)} or a "
+                                           f"permutation of the agents, got {self.order!r}")
+        elif (not isinstance(self.order, Iterable)
+              or not all(isinstance(a, numbers.Integral) and not isinstance(a, bool)
+                         for a in self.order)):
+            raise TypeError(f"order must be one of {', '.join(ORDERS)} or a sequence of agents, "
+                            f"got {self.order!r}")
+        else:
+            object.__setattr__(self, "order", tuple(int(a) for a in self.order))
+        check_count("seed", self.seed, least=0)
+        check_count("max_expansions", self.max_expansions)
+        check_number("time_limit", self.time_limit, least=0)
+
+
+def prioritized(graph: Graph, starts, goals, **options) -> Plan:
     """Prioritised planning with space-time A* and a reservation table.
 
     Args:
       graph: the map; its valid edges are the moves, one step each.
       starts, goals: (x, y) cells (or node indices), one per agent, all distinct.
-      order: "given", "distance", "random" (see ``ORDERS``) or a permutation of the agents.
-      seed: the seed of the random order.
-      max_expansions: the per-agent limit on expanded space-time states.
-      time_limit: give up after this many seconds (checked between agents).
+      **options: those of :class:`~jaxswarm.multiagent.prioritized.PrioritizedConfig` (``order``,
+        ``seed``, ``max_expansions``, ``time_limit``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="prioritized"``); not solved, naming
@@ -65,14 +103,18 @@ def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "gi
       agents planned before it, or when the time limit is reached before its turn.
 
     Raises:
-      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or order.
+      TypeError, ValueError: a bad option (see
+        :class:`~jaxswarm.multiagent.prioritized.PrioritizedConfig`), naming it, before any search.
+      ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`) or an
+        order that is not a permutation of its agents.
     """
+    config = PrioritizedConfig(**options)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     fields = hop_fields(graph, goal_nodes)
     agents = np.arange(len(start_nodes))
     distances = fields[agents, start_nodes]
-    ranking = priority_order(order, distances, seed)
+    ranking = priority_order(config.order, distances, config.seed)
     table = Reservations.empty(graph.num_nodes)
     paths = [np.array([s], np.int32) for s in start_nodes]
     expanded = 0
@@ -87,11 +129,11 @@ def prioritized(graph: Graph, starts, goals, *, order: str | Sequence[int] = "gi
         return stop(a, f"cannot reach its goal {place(graph, goal_nodes[a])} from "
                        f"{place(graph, start_nodes[a])}")
     for rank, a in enumerate(ranking.tolist()):
-        if time.perf_counter() - began > time_limit:
+        if time.perf_counter() - began > config.time_limit:
             return stop(a, f"not planned (priority {rank}): reached the time limit "
-                           f"({time_limit:g} s)")
+                           f"({config.time_limit:g} s)")
         path, count, outcome = search(graph, int(start_nodes[a]), int(goal_nodes[a]), fields[a],
-                                      table, max_expansions=max_expansions)
+                                      table, max_expansions=config.max_expansions)
         expanded += count
         if path is None:
             why = ("reached the expansion limit" if outcome == LIMIT else "found no way")

@@ -33,6 +33,7 @@ import numpy as np
 from jaxswarm.exact import astar
 from jaxswarm.multiagent.agents import agent_nodes, distance_fields
 from jaxswarm.multiagent.conflicts import pair_collisions
+from jaxswarm.multiagent.limits import check_count
 from jaxswarm.multiagent.plan import Plan, pack
 from jaxswarm.world.edges import edge_arrays
 from jaxswarm.world.edits import block_cells
@@ -62,14 +63,32 @@ def report_example(name: str) -> tuple[Graph, tuple, tuple]:
     return graph, example["starts"], example["goals"]
 
 
-def report_scheme(graph: Graph, starts, goals, *, max_repairs: int | None = None) -> Plan:
+@dataclasses.dataclass(frozen=True)
+class ReportConfig:
+    """The options of :func:`report_scheme`, checked when made.
+
+    Attributes:
+      max_repairs: give up after this many repairs (at least 0; None: 20 per robot).
+
+    Raises:
+      TypeError, ValueError: a ``max_repairs`` that is not None or a whole number of at least 0.
+    """
+
+    max_repairs: int | None = None
+
+    def __post_init__(self):
+        if self.max_repairs is not None:
+            check_count("max_repairs", self.max_repairs, least=0)
+
+
+def report_scheme(graph: Graph, starts, goals, **options) -> Plan:
     """The A* report's scheme: A* per robot, then side-steps, waits and "one robot moves first"
     at collisions (see the module docstring).
 
     Args:
       graph: the map; A* plans with its edge lengths, every move takes one step.
       starts, goals: (x, y) cells (or node indices), one per robot, all distinct.
-      max_repairs: give up after this many repairs (default 20 per robot).
+      **options: those of :class:`~jaxswarm.multiagent.report.ReportConfig` (``max_repairs``).
 
     Returns:
       A :class:`~jaxswarm.multiagent.plan.Plan` (``planner="report"``) whose ``log`` has the
@@ -77,12 +96,15 @@ def report_scheme(graph: Graph, starts, goals, *, max_repairs: int | None = None
       re-plans fail, or the repairs run out.
 
     Raises:
+      TypeError, ValueError: a bad option (see :class:`~jaxswarm.multiagent.report.ReportConfig`),
+        naming it.
       ValueError: a bad instance (see :func:`jaxswarm.multiagent.agents.agent_nodes`).
     """
+    config = ReportConfig(**options)
     began = time.perf_counter()
     start_nodes, goal_nodes = agent_nodes(graph, starts, goals)
     robots = len(start_nodes)
-    limit = 20 * robots if max_repairs is None else max_repairs
+    limit = 20 * robots if config.max_repairs is None else config.max_repairs
     scheme = _Scheme(goal_nodes, np.asarray(graph.xy).astype(int), began)
     paths = []
     for r in range(robots):
