@@ -82,13 +82,13 @@ What is measured
    sum of loss below the first solution's on at least 4 of the 5. The search stops at a time,
    not at a count of configurations, so these figures depend on the machine and its load.
 
-5. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in ``PLANNERS``) on the first 20 rows of
-   ``--cbs`` (default ``room-32-32-4-even-1``, ``maze-32-32-2-even-1`` and
-   ``maze-32-32-4-random-1``, the 32 x 32 files hardest for CBS), stopped after ``--cbs-nodes`` constraint-tree nodes (default
-   2,000): one warm-up call on 3 agents, then ``--cbs-repeats`` calls (default 3). The search
-   is deterministic, so every call must split as many nodes and expand as many space-time
-   states (the useful work), and a plan it solves must pass ``validate`` (the script exits 1
-   otherwise); ``median s`` is the median call,
+5. CBSH-RTC. ``cbs`` with every switch (``"cbsh_rtc"`` in :mod:`jaxswarm.multiagent.registry`)
+   on the first 20 rows of ``--cbs`` (default ``room-32-32-4-even-1``, ``maze-32-32-2-even-1``
+   and ``maze-32-32-4-random-1``, the 32 x 32 files hardest for CBS), stopped after
+   ``--cbs-nodes`` constraint-tree nodes (default 2,000): one warm-up call on 3 agents, then
+   ``--cbs-repeats`` calls (default 3). The search is deterministic, so every call must split
+   as many nodes and expand as many space-time states (the useful work), and a plan it solves
+   must pass ``validate`` (the script exits 1 otherwise); ``median s`` is the median call,
    ``nodes/s`` the nodes over it, ``k states/s`` the low-level states over it, ``pairs`` the
    two-agent problems its heuristic solved.
 
@@ -122,8 +122,8 @@ import numba
 import numpy as np
 
 from jaxswarm.maps.movingai import read_map
-from jaxswarm.multiagent import (ORDERS, PLANNERS, find_conflicts, hop_fields, lacam,
-                                 load_instance, lower_bound, prioritized, validate)
+from jaxswarm.multiagent import (ORDERS, find_conflicts, hop_fields, lacam, load_instance,
+                                 lower_bound, prioritized, registry, validate)
 from jaxswarm.multiagent.agents import agent_nodes
 from jaxswarm.multiagent.pibt import (Moves, Workspace, by_priority, configuration,
                                       initial_priorities, next_priorities)
@@ -445,11 +445,11 @@ def bench_cbs(mapf: Path, files: list[str], nodes: int, repeats: int) -> tuple[l
         name = scenario.rsplit("-", 2)[0]  # the map's name: without "-even-1" or "-random-1"
         instance = load_instance(mapf / f"{name}.map", mapf / f"{scenario}.scen", CBS_AGENTS)
         graph, starts, goals = instance.graph, instance.starts, instance.goals
-        PLANNERS["cbsh_rtc"](graph, starts[:3], goals[:3])  # load the kernels
+        registry.plan("cbsh_rtc", graph, starts[:3], goals[:3])  # load the kernels
         times, work = [], set()
         for _ in range(repeats):
             began = time.perf_counter()
-            plan = PLANNERS["cbsh_rtc"](graph, starts, goals, max_nodes=nodes, time_limit=600)
+            plan = registry.plan("cbsh_rtc", graph, starts, goals, max_nodes=nodes, time_limit=600)
             times.append(time.perf_counter() - began)
             work.add((plan.stats["nodes"], plan.stats["expanded"], plan.stats["pairs"]))
         same &= len(work) == 1 and (not plan.solved or not validate(graph, plan.paths, starts,

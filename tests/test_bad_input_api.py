@@ -12,7 +12,7 @@ import pytest
 
 from jaxswarm.cli import main
 from jaxswarm.maps.movingai import MovingAIFormatError, load_scenarios, read_map
-from jaxswarm.multiagent import PLANNERS
+from jaxswarm.multiagent import registry
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.registry import REGISTRY
 from jaxswarm.tune import load_tune_spec
@@ -198,5 +198,5 @@ def test_cbs_and_ecbs_check_their_limits_as_the_command_does(corridor, planner, 
                                                              error, message):
     graph = corridor[0]
     with pytest.raises(error) as raised:
-        PLANNERS[planner](graph, [(0, 0)], [(2, 0)], **{limit: value})
+        registry.plan(planner, graph, [(0, 0)], [(2, 0)], **{limit: value})
     assert str(raised.value) == message

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import oracle
-from jaxswarm.multiagent import PLANNERS, cbs, load_instance, validate
+from jaxswarm.multiagent import cbs, load_instance, registry, validate
 from jaxswarm.multiagent.agents import UNREACHABLE, agent_nodes, hop_fields
 from jaxswarm.multiagent.plan import pack
 from jaxswarm.multiagent.constraints import Constraints, reservations, split_collision
@@ -99,11 +99,11 @@ def _maze(movingai_dir, agents: int):
 
 def _the_heuristic_saves_nodes(instance, time_limit: float) -> None:
     graph, starts, goals = instance.graph, instance.starts, instance.goals
-    cbsh = PLANNERS["cbsh"](graph, starts, goals, time_limit=time_limit)
+    cbsh = registry.plan("cbsh", graph, starts, goals, time_limit=time_limit)
     assert cbsh.solved and cbsh.stats["pairs"] > 0
     assert cbsh.sum_of_costs == cbsh.stats["lower_bound"]
     assert validate(graph, cbsh.paths, starts, goals, cbsh.lengths) == []
-    icbs = PLANNERS["icbs"](graph, starts, goals, max_nodes=cbsh.stats["nodes"])
+    icbs = registry.plan("icbs", graph, starts, goals, max_nodes=cbsh.stats["nodes"])
     assert not icbs.solved  # as many nodes do not suffice without the heuristic
 
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import oracle
-from jaxswarm.multiagent import (PLANNERS, cbs, ecbs, eecbs, hop_fields, load_instance,
-                                 lower_bound, validate)
+from jaxswarm.multiagent import (cbs, ecbs, eecbs, hop_fields, load_instance, lower_bound,
+                                 registry, validate)
 from jaxswarm.multiagent import mdd
 from jaxswarm.multiagent.constraints import Constraints, split_collision
 from jaxswarm.multiagent.spacetime import EXHAUSTED, Reservations, occupancy, search
@@ -112,9 +112,9 @@ def test_planner_names_and_bad_bounds():
     starts, goals = [(0, 0), (2, 0)], [(2, 0), (0, 0)]
     assert cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True).planner == "icbs"
     assert cbs(graph, starts, goals, bypass=True, avoid=True).planner == "cbs+bypass+avoid"
-    assert PLANNERS["cbsh"](graph, starts, goals).planner == "cbsh"
-    assert PLANNERS["cbsh_tc"](graph, starts, goals).planner == "cbsh_tc"
-    assert PLANNERS["cbsh_rtc"](graph, starts, goals).planner == "cbsh_rtc"
+    assert registry.plan("cbsh", graph, starts, goals).planner == "cbsh"
+    assert registry.plan("cbsh_tc", graph, starts, goals).planner == "cbsh_tc"
+    assert registry.plan("cbsh_rtc", graph, starts, goals).planner == "cbsh_rtc"
     assert cbs(graph, starts, goals, prioritize=True, bypass=True, avoid=True, wdg=True,
                rectangle=True).planner == "cbsh_r"
     assert cbs(graph, starts, goals, wdg=True, corridor=True).planner == "cbs+wdg+corridor"
@@ -157,7 +157,7 @@ def test_cbsh_rtc_solves_twenty_agents_on_the_mazes_at_the_reference_optimum(mov
     mapf = movingai_dir / "mapf"
     instance = load_instance(mapf / f"{name.rsplit('-', 2)[0]}.map", mapf / f"{name}.scen", 20)
     graph, starts, goals = instance.graph, instance.starts, instance.goals
-    plan = PLANNERS["cbsh_rtc"](graph, starts, goals, max_nodes=nodes, time_limit=300)
+    plan = registry.plan("cbsh_rtc", graph, starts, goals, max_nodes=nodes, time_limit=300)
     assert plan.solved and plan.sum_of_costs == plan.stats["lower_bound"] == optimum
     assert validate(graph, plan.paths, starts, goals, plan.lengths) == []
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import oracle
-from jaxswarm.multiagent import PLANNERS, cbs, load_instance, validate
+from jaxswarm.multiagent import cbs, load_instance, registry, validate
 from jaxswarm.multiagent.constraints import Constraints
 from jaxswarm.multiagent.plan import pack
 from jaxswarm.multiagent.rectangle import Rectangles
@@ -161,9 +161,9 @@ def test_rectangles_solve_fifty_agents_on_an_empty_map_in_few_nodes(movingai_dir
     mapf = movingai_dir / "mapf"
     instance = load_instance(mapf / "empty-32-32.map", mapf / "empty-32-32-random-1.scen", 50)
     graph, starts, goals = instance.graph, instance.starts, instance.goals
-    reasoned = PLANNERS["cbsh_rtc"](graph, starts, goals, time_limit=60)
+    reasoned = registry.plan("cbsh_rtc", graph, starts, goals, time_limit=60)
     assert reasoned.solved and reasoned.stats["rectangles"] > 0
     assert reasoned.sum_of_costs == reasoned.stats["lower_bound"]
     assert validate(graph, reasoned.paths, starts, goals, reasoned.lengths) == []
-    without = PLANNERS["cbsh_tc"](graph, starts, goals, max_nodes=5 * reasoned.stats["nodes"])
+    without = registry.plan("cbsh_tc", graph, starts, goals, max_nodes=5 * reasoned.stats["nodes"])
     assert not without.solved
