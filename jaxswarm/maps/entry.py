@@ -38,10 +38,11 @@ from jaxswarm.swarm import Task, make_task
 from jaxswarm.world.graph import Graph, grid_graph, path_map_graph
 from jaxswarm.world.plane import Plane
 
-KEYS = {"random": {"random", "seed", "density"}, "pathmap": {"pathmap", "seed"},
-        "plane": {"plane", "seed", "rectangles"},
-        "movingai": {"movingai", "scenario", "scenario_file", "start", "goal"}}
-"""The keys of each kind of map table, by the key that names the kind."""
+KEYS = {"plane": {"plane", "seed", "rectangles"}, "random": {"random", "seed", "density"},
+        "movingai": {"movingai", "scenario", "scenario_file", "start", "goal"},
+        "pathmap": {"pathmap", "seed"}}
+"""The keys of each kind of map table, by the key that names the kind (the first of them in a
+table decides its kind)."""
 DEFAULT_DENSITY = 0.3
 """A random grid's share of obstacles when its entry names none."""
 PATH_MAP_SIZE = re.compile(r"(\d+)x(\d+)")
@@ -153,7 +154,7 @@ def resolve(entry, *, base_dir: Path | None = None, start: tuple | None = None,
     if start is not None or goal is not None:
         resolved = dataclasses.replace(resolved, start=start or resolved.start,
                                        goal=goal or resolved.goal)
-    resolved.task  # noqa: B018 (built here, so that a bad start or goal is refused here)
+    resolved.task  # noqa: B018 (builds the task: a start or goal off the map or blocked is refused)
     return resolved
 
 

@@ -7,10 +7,10 @@ import warnings
 from jaxswarm.maps import entry
 from jaxswarm.sweep import spec
 
-MOVED = {"SweepMap": ("jaxswarm.maps.entry.ResolvedMap", entry.ResolvedMap),
-         "check_map_entry": ("jaxswarm.maps.entry.check", entry.check),
-         "resolve_maps": ("jaxswarm.sweep.spec.resolve_maps", spec.resolve_maps),
-         "file_digests": ("jaxswarm.sweep.spec.file_digests", spec.file_digests)}
+_MOVED = {"SweepMap": ("jaxswarm.maps.entry.ResolvedMap", entry.ResolvedMap),
+          "check_map_entry": ("jaxswarm.maps.entry.check", entry.check),
+          "resolve_maps": ("jaxswarm.sweep.spec.resolve_maps", spec.resolve_maps),
+          "file_digests": ("jaxswarm.sweep.spec.file_digests", spec.file_digests)}
 """Each old name: where it lives now, and what it is."""
 
 
@@ -19,13 +19,13 @@ def _resolve_map(map_entry, base_dir=None) -> entry.ResolvedMap:
     return entry.resolve(map_entry, base_dir=base_dir)
 
 
-MOVED["resolve_map"] = ("jaxswarm.maps.entry.resolve", _resolve_map)
+_MOVED["resolve_map"] = ("jaxswarm.maps.entry.resolve", _resolve_map)
 
 
 def __getattr__(name: str):
-    if name not in MOVED:
+    if name not in _MOVED:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    home, value = MOVED[name]
+    home, value = _MOVED[name]
     warnings.warn(f"{__name__}.{name} is deprecated since jaxswarm 0.11.0: use {home}; the old "
                   "name goes in 0.12.0", DeprecationWarning, stacklevel=2)
     return value
