@@ -39,14 +39,15 @@ from pathlib import Path
 import jax
 
 from jaxswarm.dynamic.robot import MEMORY, check_world, dstar_robot, hidden_blocks, swarm_robot
-from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimal_length, optimum
-from jaxswarm.maps.named import NamedMap, named_map
+from jaxswarm.exact import astar, bidirectional_astar, dijkstra, optimum
+from jaxswarm.maps.entry import ResolvedMap, resolve
+from jaxswarm.maps.named import named_entry, named_label
 from jaxswarm.maps.paper import PAPER_MAPS
 from jaxswarm.multiagent import ORDERS, UNREACHABLE, load_instance, lower_bound, validate
 from jaxswarm.multiagent import registry as planners
 from jaxswarm.multiagent.limits import OptionError
 from jaxswarm.runtime.cpu import configure
-from jaxswarm.swarm import make, make_task, registry, run
+from jaxswarm.swarm import make, registry, run
 from jaxswarm.sweep.spec import DEFAULT_MAX_RUNS
 from jaxswarm.tune.spec import HELD_OUT_SETTINGS
 from jaxswarm.world.graph import Graph
@@ -305,7 +306,8 @@ def run_demo(args: argparse.Namespace) -> int:
 
     from jaxswarm.plot.graph import plot_solutions, plot_swarm_run
 
-    name, graph, start, goal = _load(args)
+    name, loaded = _load(args)
+    graph, start, goal = loaded.world, loaded.start, loaded.goal
     if args.repeats < 1:
         raise ValueError(f"--repeats must be at least 1, got {args.repeats}")
     height, width = graph.shape
@@ -321,12 +323,12 @@ def run_demo(args: argparse.Namespace) -> int:
         label = swarm_label(name_in_registry)
         config = {} if args.drops is None else dict(num_agents=args.drops)
         swarm = make(name_in_registry, **config)
-        state, trace, milliseconds = _run_swarm(swarm, graph, start, goal, args)
+        state, trace, milliseconds = _run_swarm(swarm, graph, loaded.task, args)
         solution = solutions[label] = swarm.best(state)
         traces[label] = (swarm, state, trace)
         rows.append((label, solution.cost, "-", int(trace.iterations), f"{milliseconds:.2f}"))
     # Gaps compare every path measured one way (float32, moves counted by kind), never below 0.
-    reference = optimal_length(graph, start, goal)
+    reference = loaded.optimum()
     print(_table(("planner", "length", "gap", "expanded", "iterations", "time [ms]"),
                  [(label, _fmt(cost), _gap(float(path_length(graph, solutions[label].path)),
                                            reference), *rest)
@@ -359,7 +361,8 @@ def run_robot(args: argparse.Namespace) -> int:
 
     from jaxswarm.plot.robot import animate_robot, plot_robot
 
-    name, graph, start, goal = _load(args)
+    name, loaded = _load(args)
+    graph, start, goal = loaded.world, loaded.start, loaded.goal
     for option in ("blocks", "iterations", "max_plans"):
         if getattr(args, option) < 1:
             raise ValueError(f"--{option.replace('_', '-')} must be at least 1, "
@@ -372,7 +375,7 @@ def run_robot(args: argparse.Namespace) -> int:
 
     def walk_swarm():
         return jax.block_until_ready(swarm_robot(
-            swarm, jax.random.key(args.seed), graph, make_task(graph, start, goal), hidden,
+            swarm, jax.random.key(args.seed), graph, loaded.task, hidden,
             swarm.default_params, iterations=args.iterations, max_plans=args.max_plans,
             memory=args.memory))
 
@@ -485,10 +488,9 @@ def _planner(args: argparse.Namespace):
         raise ValueError(f"{_flag(error.option)} {error.problem}") from None
 
 
-def _run_swarm(swarm, graph, start, goal, args):
+def _run_swarm(swarm, graph, task, args):
     """Run one swarm planner: compile once, then ``(state, trace, median ms)`` of
     ``args.repeats`` timed runs."""
-    task = make_task(graph, start, goal)
     key = jax.random.key(args.seed)
 
     def once():
@@ -504,15 +506,17 @@ def _run_swarm(swarm, graph, start, goal, args):
     return state, trace, statistics.median(times) * 1e3
 
 
-def _load(args) -> NamedMap:
-    """The map, start and goal of ``demo`` or ``robot``; ValueError when the start is the goal
-    (there is nothing to plan) or ``--out`` names a folder."""
+def _load(args) -> tuple[str, ResolvedMap]:
+    """The label and the resolved map (:func:`jaxswarm.maps.entry.resolve`) of ``demo``'s or
+    ``robot``'s ``--map``, ``--seed``, ``--start`` and ``--goal``; ValueError when the start is
+    the goal (there is nothing to plan) or ``--out`` names a folder."""
     _check_file_out("--out", args.out)
-    loaded = named_map(args.map, seed=args.seed, start=args.start, goal=args.goal)
-    if as_node(loaded.graph, loaded.start) == as_node(loaded.graph, loaded.goal):
+    entry = named_entry(args.map, seed=args.seed, start=args.start, goal=args.goal)
+    loaded = resolve(entry, start=args.start, goal=args.goal)
+    if int(loaded.task.start) == int(loaded.task.goal):
         raise ValueError(f"--start {loaded.start} and --goal {loaded.goal} are the same cell: "
                          "there is nothing to plan")
-    return loaded
+    return named_label(args.map), loaded
 
 
 def _check_file_out(option: str, path: Path | None) -> None:

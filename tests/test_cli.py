@@ -85,6 +85,7 @@ def test_robot_names_a_bad_option_in_a_line(capsys):
     (["--map", "nowhere"], "--map must be one of"),
     (["--map", "nosuch.map", "--start", "1,1", "--goal", "2,2"], "--map nosuch.map: no such file"),
     (["--map", "nosuch.map"], "--start and --goal are required with a .map file"),
+    (["--map", "maze20", "--start", "25,0"], "start (25, 0) is off the 20x20 map"),
     (["--swarms", "rfd,bees"], "unknown swarms ['bees']; registered on graphs: aco_star"),
 ])
 def test_demo_rejects_a_bad_map_or_swarm_in_a_line_with_exit_status_2(capsys, arguments, message):

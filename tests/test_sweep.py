@@ -21,6 +21,7 @@ import sizes
 
 from jaxswarm.exact import dijkstra, optimal_length
 from jaxswarm.exact.visibility import shortest_path
+from jaxswarm.maps.entry import resolve
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.maps.planes import paper_plane
 from jaxswarm.plot.sweep import heatmap_figure, line_figure, plot_sweep, summary
@@ -29,7 +30,6 @@ from jaxswarm import cli
 from jaxswarm.swarm import definition, make, make_task, registered, run
 from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_results, run_sweep,
                             spec_from_dict)
-from jaxswarm.sweep.maps import resolve_map
 from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.sweep import runner
@@ -91,6 +91,8 @@ def test_spec_grid_ranges_and_seeds():
     (dict(params={"sediment": [-1.0]}), "params.sediment: sediment must be non-negative"),
     (dict(sweep={"maps": ["mosaic30"]}), r"sweep.maps\[0\]: unknown map 'mosaic30'"),
     (dict(sweep={"maps": [{"random": 20}]}), r"sweep.maps\[0\]: seed = None"),
+    (dict(sweep={"maps": [{"movingai": "x.map", "start": [0, 0]}]}),
+     r"sweep.maps\[0\]: goal = None: must be \[x, y\]"),
     (dict(sweep={"seeds": 0}), "sweep.seeds: must be at least 1"),
     (dict(sweep={"iterations": 0}), "sweep.iterations: must be a positive integer"),
     (dict(sweep={"vmap_size": 0}), "sweep.vmap_size: must be a positive integer"),
@@ -643,7 +645,7 @@ def test_a_row_is_the_run_alone_on_any_thread_and_device_count_and_process(name,
         fingerprints.append(list(read_results(out)["fingerprint"]))
     spec = spec_from_dict(document)
     swarm = make(name, **spec.config)
-    sweep_map = resolve_map(spec.maps[0])
+    sweep_map = resolve(spec.maps[0])
     task = make_task(sweep_map.world, sweep_map.start, sweep_map.goal)
     alone = [hex_fingerprint(run_fingerprint(*run(
         swarm, jax.random.key(seed), sweep_map.world, task, swarm.default_params,

@@ -12,9 +12,9 @@ import sizes
 from repo_scripts import load_script
 
 from jaxswarm.cli import main
+from jaxswarm.maps.entry import resolve
 from jaxswarm.runtime.evolution import antithetic_gradient, centred_ranks
 from jaxswarm.sweep.batches import RunBatches
-from jaxswarm.sweep.maps import resolve_map
 from jaxswarm.swarm import make
 from jaxswarm.sweep.store import SAME_RESULTS_SINCE, ResultsStore
 from jaxswarm.tune import TuneSpecError, load_tune_spec, tune, tune_spec_from_dict
@@ -328,7 +328,7 @@ def test_a_small_call_is_fitted_to_a_share_of_the_chunk():
 def test_a_small_call_fitted_to_a_share_of_the_chunk_gives_the_same_runs():
     """Twin in the default tier: the call sizes above (a call's width is another batch width,
     whose one-key promise the conformance checks keep at width 3)."""
-    sweep_map = resolve_map("maze20")
+    sweep_map = resolve("maze20")
     seeds, params = np.array([3, 4, 5]), {"alpha": np.array([1.0, 2.0, 3.0])}
     outputs = [RunBatches("iwd", {"num_agents": 8}, 3, None, 16, log=lambda _: None,
                           fit_calls=fit).run(sweep_map, seeds, params)

@@ -1,5 +1,5 @@
-"""Maps named by a word: what a ``--map`` option, a study's ``--maps`` list or a sweep spec's map
-string may name, resolved in one place.
+"""Maps named by a word: what a ``--map`` option or a study's ``--maps`` list may name, as the map
+entry (:mod:`jaxswarm.maps.entry`) that builds it.
 
 Three kinds of name:
 
@@ -20,10 +20,9 @@ import re
 from pathlib import Path
 from typing import NamedTuple
 
-from jaxswarm.maps.movingai import load_map
-from jaxswarm.maps.paper import PAPER_MAPS, paper_map
-from jaxswarm.maps.random import random_path_map
-from jaxswarm.world.graph import Graph, path_map_graph
+from jaxswarm.maps.entry import PATH_MAP_SIZE, resolve
+from jaxswarm.maps.paper import PAPER_MAPS
+from jaxswarm.world.graph import Graph
 
 PAPER = "paper map"
 """The kind of a paper map's name."""
@@ -31,7 +30,7 @@ PATH_MAP = "path map"
 """The kind of a ``pathmapWxH`` name."""
 MAP_FILE = "map file"
 """The kind of a Moving AI ``.map`` file's name."""
-PATH_MAP_NAME = re.compile(r"pathmap(\d+)x(\d+)")
+PATH_MAP_NAME = re.compile("pathmap" + PATH_MAP_SIZE.pattern)
 """A path map's name; its groups are the width and the height in cells."""
 
 
@@ -62,14 +61,14 @@ def map_kind(name: str) -> str | None:
     return None
 
 
-def named_map(name: str, *, seed: int = 0, start: tuple[int, int] | None = None,
-              goal: tuple[int, int] | None = None) -> NamedMap:
-    """The map ``name`` names (see the module docstring), built afresh.
+def named_entry(name: str, *, seed: int = 0, start: tuple[int, int] | None = None,
+                goal: tuple[int, int] | None = None) -> str | dict:
+    """The map entry (:mod:`jaxswarm.maps.entry`) of the map ``name`` names.
 
     Args:
       name: a paper map, ``pathmapWxH`` or the path of a Moving AI ``.map`` file.
       seed: the seed of a path map's random walls (unused by the other kinds).
-      start, goal: (x, y) cells replacing the map's own; required with a ``.map`` file.
+      start, goal: (x, y) cells; required with a ``.map`` file (they go into its entry).
 
     Raises:
       ValueError: an unknown name, a missing ``.map`` file, or a ``.map`` file without a start
@@ -77,17 +76,39 @@ def named_map(name: str, *, seed: int = 0, start: tuple[int, int] | None = None,
     """
     kind = map_kind(name)
     if kind == PAPER:
-        chosen = paper_map(name)
-        return NamedMap(name, chosen.graph(), start or chosen.start, goal or chosen.goal)
+        return name
     if kind == PATH_MAP:
-        width, height = (int(v) for v in PATH_MAP_NAME.fullmatch(name).groups())
-        graph = path_map_graph(random_path_map(width, height, seed))
-        return NamedMap(name, graph, start or (0, 0), goal or (width - 1, height - 1))
+        return dict(pathmap=name.removeprefix("pathmap"), seed=seed)
     if kind == MAP_FILE:
         if start is None or goal is None:
             raise ValueError("--start and --goal are required with a .map file")
         if not Path(name).is_file():
             raise ValueError(f"--map {name}: no such file")
-        return NamedMap(Path(name).stem, load_map(name), start, goal)
+        return dict(movingai=str(Path(name).absolute()), start=list(start), goal=list(goal))
     raise ValueError(f"--map must be one of {', '.join(PAPER_MAPS)}, pathmapWxH or a .map "
                      f"file, got {name!r}")
+
+
+def named_map(name: str, *, seed: int = 0, start: tuple[int, int] | None = None,
+              goal: tuple[int, int] | None = None) -> NamedMap:
+    """The map ``name`` names (see the module docstring), built afresh by
+    :func:`jaxswarm.maps.entry.resolve` from its :func:`named_entry`.
+
+    Args:
+      name: a paper map, ``pathmapWxH`` or the path of a Moving AI ``.map`` file.
+      seed: the seed of a path map's random walls (unused by the other kinds).
+      start, goal: (x, y) cells replacing the map's own; required with a ``.map`` file.
+
+    Raises:
+      ValueError: an unknown name, a missing ``.map`` file, a ``.map`` file without a start
+        and a goal, or a start or goal off the map or blocked.
+    """
+    resolved = resolve(named_entry(name, seed=seed, start=start, goal=goal), start=start,
+                       goal=goal)
+    return NamedMap(named_label(name), resolved.world, resolved.start, resolved.goal)
+
+
+def named_label(name: str) -> str:
+    """The label tables and figures show for the map ``name``: the name, a ``.map`` file's
+    stem."""
+    return Path(name).stem if map_kind(name) == MAP_FILE else name

@@ -9,10 +9,10 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from jaxswarm.exact import dijkstra
-from jaxswarm.maps.movingai import load_map, load_scenarios
-from jaxswarm.maps.named import PAPER, PATH_MAP, map_kind, named_map
+from jaxswarm.maps.entry import MOVINGAI_DATA, ResolvedMap, resolve
+from jaxswarm.maps.movingai import load_scenarios
+from jaxswarm.maps.named import named_entry
 from jaxswarm.studies import provenance
-from jaxswarm.sweep.maps import MOVINGAI_DATA
 from jaxswarm.swarm import Task, make_task
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution
@@ -27,8 +27,8 @@ class Problem(NamedTuple):
       start, goal: (x, y) cells.
       task: the swarms' Task (start and goal as node indices, i32[] each).
       optimum: the exact planner's path length (a Python float).
-      entry: the sweep-spec map entry that builds the same graph, start and goal again
-        (:mod:`jaxswarm.sweep.maps`), or None for a map built otherwise.
+      entry: the map entry that builds the same graph, start and goal again
+        (:mod:`jaxswarm.maps.entry`), or None for a map built otherwise.
     """
 
     label: str
@@ -51,11 +51,9 @@ def make_problem(label: str, graph: Graph, start: tuple[int, int], goal: tuple[i
 def named_problem(name: str, *, seed: int = 0,
                   planner: Callable[..., Solution] = dijkstra) -> Problem:
     """The problem of the map ``name`` (a paper map or ``pathmapWxH`` seeded by ``seed``, see
-    :func:`jaxswarm.maps.named.named_map`) with its own start and goal."""
-    # The sweep map entry that builds the same map (kinds no entry can name get none).
-    entry = {PAPER: name, PATH_MAP: dict(pathmap=name.removeprefix("pathmap"), seed=seed)}.get(
-        map_kind(name))
-    return make_problem(*named_map(name, seed=seed), planner=planner, entry=entry)
+    :func:`jaxswarm.maps.named.named_entry`) with its own start and goal, labelled ``name``."""
+    entry = named_entry(name, seed=seed)
+    return _resolved_problem(name, resolve(entry), entry, planner)
 
 
 def movingai_folder() -> Path:
@@ -89,8 +87,16 @@ def scenario_problem(folder: Path, name: str, *,
     index = rows[len(rows) // 2]
     entry = dict(movingai=_entry_path(map_path), scenario=index,
                  scenario_file=scenario_path.name)
-    return make_problem(name, load_map(map_path), scenarios[index].start,
-                        scenarios[index].goal, planner=planner, entry=entry)
+    return _resolved_problem(name, resolve(entry, base_dir=movingai_folder().parent), entry,
+                             planner)
+
+
+def _resolved_problem(label: str, resolved: ResolvedMap, entry,
+                      planner: Callable[..., Solution]) -> Problem:
+    """The problem of a resolved map entry, labelled ``label``, its optimum ``planner``'s."""
+    optimum = float(planner(resolved.world, resolved.start, resolved.goal).cost)
+    return Problem(label, resolved.world, resolved.start, resolved.goal, resolved.task, optimum,
+                   entry)
 
 
 def _entry_path(map_path: Path) -> str:

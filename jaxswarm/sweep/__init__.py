@@ -1,7 +1,7 @@
-"""Parameter sweeps: specs as TOML data (``spec``) with their map entries (``maps``), a
-swarm's runs as compiled batches over the devices (``batches``), the resumable runner
-(``runner``), the Parquet results store (``store``), the run
-record a table row carries (``run_record``) and replaying a row alone (``replay``)."""
+"""Parameter sweeps: specs as TOML data (``spec``, their map entries resolved by
+:mod:`jaxswarm.maps.entry`), a swarm's runs as compiled batches over the devices (``batches``),
+the resumable runner (``runner``), the Parquet results store (``store``), the run record a table
+row carries (``run_record``) and replaying a row alone (``replay``)."""
 from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.sweep.runner import default_out, run_sweep
 from jaxswarm.sweep.spec import SpecError, SweepSpec, load_spec, spec_from_dict

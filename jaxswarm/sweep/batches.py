@@ -24,12 +24,12 @@ import jax.numpy as jnp
 import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
+from jaxswarm.maps.entry import ResolvedMap
 from jaxswarm.runtime.programs import release_if_crowded
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import with_room
 from jaxswarm.swarm.fingerprint import run_fingerprint
 from jaxswarm.swarm.walking import LANES
-from jaxswarm.sweep.maps import SweepMap
 from jaxswarm.sweep.spec import SEED_LIMIT
 
 SUCCESS_GAP = 1e-4
@@ -96,11 +96,11 @@ class RunBatches:
         """The swarm's default params (a NamedTuple of floats)."""
         return self.swarm.default_params
 
-    def run(self, sweep_map: SweepMap, seeds: np.ndarray, params: dict[str, np.ndarray],
+    def run(self, sweep_map: ResolvedMap, seeds: np.ndarray, params: dict[str, np.ndarray],
             optimum: float = np.inf) -> dict[str, np.ndarray]:
         """Run ``seeds`` (int[C], each in ``[0, SEED_LIMIT)``) with ``params`` (name -> f64[C];
         params not named keep the swarm's defaults) on ``sweep_map``, whose optimum is
-        ``optimum`` (:meth:`~jaxswarm.sweep.maps.SweepMap.optimum`), ``chunk_size`` runs a
+        ``optimum`` (:meth:`~jaxswarm.maps.entry.ResolvedMap.optimum`), ``chunk_size`` runs a
         call.
 
         Returns:
@@ -149,7 +149,7 @@ class RunBatches:
                 return size
         return self.padded
 
-    def _call(self, sweep_map: SweepMap, inputs, world, task,
+    def _call(self, sweep_map: ResolvedMap, inputs, world, task,
               target) -> tuple[dict[str, np.ndarray], float]:
         """One compiled call on ``inputs`` (seeds u32[C], params with leaves f32[C], sharded
         over the runs axis): ``(outputs, seconds)``, :data:`OUTPUTS` as host arrays, made again
@@ -172,7 +172,7 @@ class RunBatches:
             lambda x: jax.make_array_from_callback(x.shape, self._runs, lambda i, x=x: x[i]),
             host)
 
-    def _compiled_for(self, sweep_map: SweepMap, inputs, world, task, target, *, roomy: bool):
+    def _compiled_for(self, sweep_map: ResolvedMap, inputs, world, task, target, *, roomy: bool):
         """The program (``roomy``: with room for every move) compiled for ``sweep_map``'s
         shape: compiled and logged the first time a shape comes, reused after."""
         key = (_program_key(sweep_map.world), roomy, inputs[0].shape[0])

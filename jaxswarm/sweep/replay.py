@@ -25,11 +25,11 @@ import jax
 import numpy as np
 import pandas as pd
 
+from jaxswarm.maps.entry import ResolvedMap, resolve
 from jaxswarm.sweep.run_record import read_run_record
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.core import Swarm, Task, Trace
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
-from jaxswarm.sweep.maps import SweepMap, resolve_map
 from jaxswarm.sweep.spec import SEED_LIMIT, spec_from_record
 from jaxswarm.sweep.store import ResultsStore, read_results
 
@@ -57,7 +57,7 @@ class Replayed:
 
     row: dict
     swarm: Swarm
-    sweep_map: SweepMap
+    sweep_map: ResolvedMap
     task: Task
     state: Any
     trace: Trace
@@ -113,7 +113,7 @@ def replay_row(store, row: int) -> Replayed:
     _check_figures(stored, CHECKED, source)
     swarm = make(spec.algorithm, **spec.config)
     params = swarm.params_with(**{name: stored[name] for name in spec.params})
-    return _replayed(stored, swarm, params, resolve_map(spec.maps[int(stored["map_index"])]),
+    return _replayed(stored, swarm, params, resolve(spec.maps[int(stored["map_index"])]),
                      jax.random.key(int(stored["seed"])), spec.iterations, spec.patience,
                      CHECKED)
 
@@ -129,7 +129,7 @@ def _replay_table_row(table: Path, row: int) -> Replayed:
     stored = _stored_row(frame, row, table)
     record = read_run_record(stored["run_record"], source=f"{table} row {row}")
     _check_figures(stored, TABLE_CHECKED, f"{table} row {row}")
-    return _replayed(stored, record.swarm, record.params, resolve_map(record.entry), record.key,
+    return _replayed(stored, record.swarm, record.params, resolve(record.entry), record.key,
                      record.iterations, record.patience, TABLE_CHECKED)
 
 
@@ -199,7 +199,7 @@ def _stored_row(frame: pd.DataFrame, row: int, source: Path) -> dict:
     return frame.iloc[row].to_dict()
 
 
-def _replayed(stored: dict, swarm: Swarm, params, sweep_map: SweepMap, key: jax.Array,
+def _replayed(stored: dict, swarm: Swarm, params, sweep_map: ResolvedMap, key: jax.Array,
               iterations: int, patience: int | None, checked: tuple[str, ...]) -> Replayed:
     """Run ``swarm`` alone on ``sweep_map`` with ``key`` and compare ``checked`` figures with
     the ``stored`` row."""

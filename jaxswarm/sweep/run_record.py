@@ -3,7 +3,7 @@
 A table script that runs a swarm from its first memory writes, beside its own columns, the
 :data:`COLUMNS`: ``run_record``, a JSON record of everything the run depended on (the swarm's name,
 every Config field and every param, the map as a sweep-spec map entry
-(:mod:`jaxswarm.sweep.maps`), the key's data, the iteration budget and the patience), and
+(:mod:`jaxswarm.maps.entry`), the key's data, the iteration budget and the patience), and
 ``fingerprint``, the 64-bit fingerprint of its final state and trace
 (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`). :func:`jaxswarm.sweep.replay.replay_row`
 reads them back. A row whose map has no entry (a map built by the script itself) has an empty
@@ -17,10 +17,10 @@ from typing import Any, NamedTuple
 import jax
 import numpy as np
 
+from jaxswarm.maps.entry import check as check_map_entry
 from jaxswarm.swarm import Swarm, make
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.swarm.registry import config_record
-from jaxswarm.sweep.maps import check_map_entry
 
 COLUMNS = ("run_record", "fingerprint")
 """The columns a replayable table row carries."""
@@ -34,7 +34,7 @@ class RunRecord(NamedTuple):
     Attributes:
       swarm: the swarm, made again from its name and Config fields.
       params: its Params (float32 leaves), as the run had them.
-      entry: the map entry (:func:`jaxswarm.sweep.maps.resolve_map` builds the map again).
+      entry: the map entry (:func:`jaxswarm.maps.entry.resolve` builds the map again).
       key: the run's PRNG key (key[]).
       iterations, patience: the stop rules of :func:`jaxswarm.swarm.run`.
     """

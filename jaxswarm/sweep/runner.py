@@ -42,11 +42,11 @@ import numpy as np
 import pandas as pd
 from tqdm.auto import tqdm
 
+from jaxswarm.maps.entry import ResolvedMap
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
 from jaxswarm.sweep.batches import RunBatches, run_outcomes
-from jaxswarm.sweep.maps import SweepMap, file_digests, resolve_maps
-from jaxswarm.sweep.spec import SweepSpec
+from jaxswarm.sweep.spec import SweepSpec, file_digests, resolve_maps
 from jaxswarm.sweep.store import ResultsStore, read_results
 
 
@@ -176,7 +176,7 @@ class _SweepChunks:
     log: Callable[[str], None]
 
 
-def _set_up(spec: SweepSpec, maps: list[SweepMap], out: Path,
+def _set_up(spec: SweepSpec, maps: list[ResolvedMap], out: Path,
             log: Callable[[str], None]) -> _SweepChunks:
     """Open (or create) a sweep's store in ``out``, lay its runs out and set up its compiled
     batches.
@@ -209,7 +209,7 @@ def _unfinished_chunks(chunks: _SweepChunks, num_maps: int, out: Path) -> tuple[
     return todo, sum(_chunk_runs(c, spec.chunk_size, chunks.num_runs) for _, c in done)
 
 
-def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: SweepMap, todo: list[int],
+def _run_map(chunks: _SweepChunks, map_index: int, sweep_map: ResolvedMap, todo: list[int],
              bar, pace: _Pace) -> None:
     """Run the chunks ``todo`` of one map, write each to the store as it finishes, advance
     the progress bar and tell ``pace`` the first chunk's time."""
@@ -263,7 +263,7 @@ def provenance() -> dict:
         devices=[str(d) for d in jax.devices()], git_commit=_git_commit())
 
 
-def _metadata(spec: SweepSpec, maps: list[SweepMap], swarm, group: int) -> dict:
+def _metadata(spec: SweepSpec, maps: list[ResolvedMap], swarm, group: int) -> dict:
     return dict(
         provenance(), algorithm=spec.algorithm, config=spec.config, swarm=definition(swarm),
         seeds=list(spec.seeds), vmap_size=group,

@@ -24,11 +24,11 @@ product of lists or ranges), the seeds, the iteration budget and the static conf
     erosion = { start = 0.5, stop = 50, num = 3, log = true }  # geometric spacing
 
 Params not named keep the swarm's defaults. Maps: a paper map name (``mosaic20`` ...), a seeded
-random grid ``{ random = SIZE, seed = S, density = 0.3 }``, or a Moving AI map with one row of its
-scenario file ``{ movingai = "PATH.map", scenario = ROW, scenario_file = "even" }`` (see
-:mod:`jaxswarm.sweep.maps`; a relative PATH is looked up beside the spec, then in the folder
-``$JAXSWARM_MOVINGAI`` names). Every mistake raises :class:`SpecError` naming the file and the
-key; a map whose file, scenario row, start or goal is wrong is named with its entry when the
+random grid ``{ random = SIZE, seed = S, density = 0.3 }``, a Moving AI map with one row of its
+scenario file ``{ movingai = "PATH.map", scenario = ROW, scenario_file = "even" }`` and the other
+entries of :mod:`jaxswarm.maps.entry` (a relative PATH is looked up beside the spec, then in the
+folder ``$JAXSWARM_MOVINGAI`` names). Every mistake raises :class:`SpecError` naming the file and
+the key; a map whose file, scenario row, start or goal is wrong is named with its entry when the
 sweep starts, before anything is written. Seeds run from 0 to ``SEED_LIMIT - 1``, and a sweep of
 more than ``max_runs`` runs (``DEFAULT_MAX_RUNS``, a million, unless told otherwise) is refused
 before its grid is built.
@@ -44,9 +44,10 @@ from typing import Any
 
 import numpy as np
 
+from jaxswarm.maps import entry as map_entry
+from jaxswarm.maps.entry import ResolvedMap
 from jaxswarm.swarm import registry as swarm_registry
 from jaxswarm.swarm.core import ParamError
-from jaxswarm.sweep.maps import check_map_entry, entry_world
 
 SECTIONS = {"sweep", "config", "params"}
 SWEEP_KEYS = {"name", "algorithm", "maps", "seeds", "iterations", "patience", "chunk_size",
@@ -73,7 +74,7 @@ class SweepSpec:
     Attributes:
       name: the sweep's name (the default results directory).
       algorithm: a registered swarm name.
-      maps: map entries as written (str or dict), resolved by :mod:`jaxswarm.sweep.maps`.
+      maps: map entries as written (str or dict), resolved by :mod:`jaxswarm.maps.entry`.
       seeds: the integer seeds; run ``s`` uses ``jax.random.key(s)``.
       iterations: iteration budget of each run.
       patience: stop after this many iterations without improvement since the first path
@@ -276,11 +277,11 @@ def algorithm_and_name(table: dict, fail, section: str = "sweep") -> tuple[str, 
 
 def check_maps(maps: Any, fail, key: str = "sweep.maps") -> list:
     """The map entries at ``key``, a non-empty list of entries that
-    :func:`jaxswarm.sweep.maps.check_map_entry` accepts; ``fail(key, problem)`` raises."""
+    :func:`jaxswarm.maps.entry.check` accepts; ``fail(key, problem)`` raises."""
     if not isinstance(maps, list) or not maps:
         fail(key, "must be a non-empty list")
     for i, entry in enumerate(maps):
-        problem = check_map_entry(entry)
+        problem = map_entry.check(entry)
         if problem:
             fail(f"{key}[{i}]", problem)
     return maps
@@ -322,9 +323,37 @@ def configured_swarm(algorithm: str, config: Any, fail):
 def check_map_worlds(maps: list, swarm, algorithm: str, fail, key: str = "sweep.maps") -> None:
     """Every map at ``key`` is of the world the swarm plans on (a graph or a plane)."""
     for i, entry in enumerate(maps):
-        if entry_world(entry) is not swarm.world:
+        world = map_entry.world_kind(entry)
+        if world is not swarm.world:
             fail(f"{key}[{i}]", f"{algorithm} plans on a {swarm.world.__name__}, this map "
-                 f"is a {entry_world(entry).__name__}")
+                 f"is a {world.__name__}")
+
+
+def resolve_maps(entries: list, key: str, source: str,
+                 base_dir: Path | None = None) -> list[ResolvedMap]:
+    """Every map entry of ``entries`` (a spec's list at ``key``) resolved, start and goal
+    placed (:func:`jaxswarm.maps.entry.resolve`).
+
+    Raises:
+      ValueError: naming the spec file ``source``, the entry (``key[i] = ENTRY``) and the
+        problem.
+    """
+    maps = []
+    for i, entry in enumerate(entries):
+        try:
+            maps.append(map_entry.resolve(entry, base_dir=base_dir))
+        except ValueError as error:
+            raise ValueError(f"{source}: {key}[{i}] = {entry!r}: {error}") from None
+    return maps
+
+
+def file_digests(maps: list[ResolvedMap], key: str) -> dict:
+    """What the rows of ``maps`` (a spec's list at ``key``) depend on outside the spec: the
+    content of every file they were read from, ``"key[i].role"`` -> ``{"file": PATH, "sha256":
+    HEX}``, for a store to record and compare
+    (:class:`~jaxswarm.sweep.store.ResultsStore`'s ``depends_on``)."""
+    return {f"{key}[{i}].{role}": dict(file=path, sha256=digest)
+            for i, resolved in enumerate(maps) for role, (path, digest) in resolved.files.items()}
 
 
 def _params(params: Any, swarm, algorithm: str, fail,

@@ -66,7 +66,7 @@ class ResultsStore:
 
         Args:
           depends_on: what the rows depend on outside the spec, name -> a JSON record: a file's
-            ``{"file": PATH, "sha256": HEX}`` (:func:`jaxswarm.sweep.maps.file_digests`), or
+            ``{"file": PATH, "sha256": HEX}`` (:func:`jaxswarm.sweep.spec.file_digests`), or
             any other record (a tuner's version and sampler).
 
         Raises:

@@ -9,7 +9,7 @@ asks for the same batches in the same order: a batch the store holds is read bac
 run (after checking that it holds the same settings, with the same param values, on the same
 instances), so nothing is lost or run twice. The store records what else the settings and rows
 follow from (:func:`tuner_record`: the tuner's version and sampler; the content of every map
-file, :func:`~jaxswarm.sweep.maps.file_digests`) and refuses a resume across a change of any.
+file, :func:`~jaxswarm.sweep.spec.file_digests`) and refuses a resume across a change of any.
 
 Per run, the objective is a loss (lower is better):
 
@@ -35,8 +35,8 @@ import pandas as pd
 from jaxswarm.swarm import definition
 from jaxswarm.swarm.fingerprint import hex_fingerprint
 from jaxswarm.sweep.batches import RunBatches, run_outcomes
-from jaxswarm.sweep.maps import file_digests, resolve_maps
 from jaxswarm.sweep.runner import provenance
+from jaxswarm.sweep.spec import file_digests, resolve_maps
 from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.tune.spec import TuneSpec
 
@@ -106,7 +106,8 @@ class Evaluator:
 
     Attributes:
       spec: the tune.
-      maps: the training and held-out maps, resolved (phase -> list of SweepMap).
+      maps: the training and held-out maps, resolved (phase -> list of
+        :class:`~jaxswarm.maps.entry.ResolvedMap`).
       runs_spent: training runs made or read back so far (the budget counts these).
     """
 

@@ -92,7 +92,7 @@ class Instances:
     """Instances of a tune: every (map, seed) pair.
 
     Attributes:
-      maps: map entries as written (resolved by :mod:`jaxswarm.sweep.maps`).
+      maps: map entries as written (resolved by :mod:`jaxswarm.maps.entry`).
       seeds: the seeds; run ``s`` uses ``jax.random.key(s)``.
     """
 
