@@ -15,7 +15,7 @@ from jaxswarm.cli import main
 from jaxswarm.swarm import definition, make
 from jaxswarm.sweep import SpecError, load_spec, run_sweep, spec_from_dict
 from jaxswarm.sweep.batches import RunBatches
-from jaxswarm.sweep.maps import resolve_map
+from jaxswarm.maps.entry import resolve
 from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.runner import _Pace
 from jaxswarm.sweep.spec import SEED_LIMIT
@@ -123,7 +123,7 @@ def test_the_batches_refuse_a_seed_outside_the_range_before_compiling():
     batches = RunBatches("rfd_star", dict(sizes.CONFIG), sizes.ITERATIONS, None, 5,
                          log=lambda _: None)
     with pytest.raises(ValueError, match="seeds must be integers from 0 to 4294967295"):
-        batches.run(resolve_map("mosaic20"), np.array([0, 2**32]), {})
+        batches.run(resolve("mosaic20"), np.array([0, 2**32]), {})
 
 
 # Sizes -----------------------------------------------------------------------------------------

@@ -10,7 +10,7 @@ from jaxswarm.maps.named import named_map
 from jaxswarm.studies.problems import movingai_folder, named_problem, scenario_problem
 from jaxswarm.sweep.run_record import read_run_record, run_record
 from jaxswarm.swarm import make
-from jaxswarm.sweep.maps import check_map_entry, resolve_map
+from jaxswarm.maps.entry import check, resolve
 from jaxswarm.sweep.replay import replay_row
 
 
@@ -53,15 +53,15 @@ def test_a_broken_record_is_named(change, message):
 def test_a_seeded_path_map_is_a_map_entry_of_its_own():
     problem = named_problem("pathmap12x8", seed=4)
     assert problem.entry == {"pathmap": "12x8", "seed": 4}
-    resolved = resolve_map(problem.entry)
+    resolved = resolve(problem.entry)
     walls = named_map("pathmap12x8", seed=4).graph
     assert resolved.label == "pathmap12x8-s4"
     assert np.array_equal(np.asarray(resolved.world.open), np.asarray(walls.open))
     assert (resolved.start, resolved.goal) == ((0, 0), (11, 7))
     assert named_problem("maze20").entry == "maze20"
-    assert "size must be 'WxH'" in check_map_entry({"pathmap": "12", "seed": 0})
-    assert "non-negative integer seed" in check_map_entry({"pathmap": "12x8"})
-    assert "unknown keys ['walls']" in check_map_entry({"pathmap": "12x8", "seed": 0,
+    assert "size must be 'WxH'" in check({"pathmap": "12", "seed": 0})
+    assert "non-negative integer seed" in check({"pathmap": "12x8"})
+    assert "unknown keys ['walls']" in check({"pathmap": "12x8", "seed": 0,
                                                          "walls": 3})
 
 
@@ -70,7 +70,7 @@ def test_a_moving_ai_problem_names_the_scenario_row_it_took(movingai_dir):
     entry = problem.entry
     assert entry["movingai"] == "mapf/random-32-32-10.map"
     assert entry["scenario_file"] == "random-32-32-10-even-1.scen"
-    resolved = resolve_map(entry)
+    resolved = resolve(entry)
     assert (resolved.start, resolved.goal) == (problem.start, problem.goal)
 
 

@@ -18,7 +18,7 @@ import sizes
 
 from jaxswarm import cli
 from jaxswarm.sweep import StoreMismatchError, read_results, run_sweep, runner
-from jaxswarm.sweep.maps import SweepMap
+from jaxswarm.maps.entry import ResolvedMap
 from jaxswarm.sweep.spec import spec_from_dict
 from jaxswarm.sweep.store import SAME_RESULTS_SINCE, ResultsStore
 from jaxswarm.swarm import registered
@@ -70,7 +70,7 @@ def no_runs(monkeypatch):
                                                         "map_index": [map_index], "run": [0]})
 
     monkeypatch.setattr(runner, "_run_map", stand_in)
-    monkeypatch.setattr(SweepMap, "optimum", lambda self: 3.0)
+    monkeypatch.setattr(ResolvedMap, "optimum", lambda self: 3.0)
 
 
 def test_a_sweep_refuses_to_resume_after_its_map_file_changed(tmp_path, monkeypatch, no_runs):

@@ -1,6 +1,6 @@
 """Deprecated: the RFD paper's dynamic scenarios are :mod:`jaxswarm.studies.rfd_dynamic`.
 
-This old path gives their names with a ``DeprecationWarning`` until jaxswarm 0.11 and is
+This old path gives their names with a ``DeprecationWarning`` until jaxswarm 0.12.0 and is
 removed then: import them from :mod:`jaxswarm.studies.rfd_dynamic`.
 """
 from __future__ import annotations
@@ -17,7 +17,7 @@ def __getattr__(name: str):
     if name not in MOVED:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     warnings.warn(f"jaxswarm.dynamic.scenarios.{name} moved to jaxswarm.studies.rfd_dynamic."
-                  f"{name}; this path is removed in jaxswarm 0.11", DeprecationWarning,
+                  f"{name}; this path is removed in jaxswarm 0.12.0", DeprecationWarning,
                   stacklevel=2)
     from jaxswarm.studies import rfd_dynamic  # above dynamic/: the layers contract names it
 

@@ -51,8 +51,8 @@ def __getattr__(name: str):
     """``PLANNERS``, deprecated: name -> planner function with its variant's switches set, as
     :func:`jaxswarm.multiagent.registry.planner_functions` gives it."""
     if name == "PLANNERS":
-        warnings.warn("jaxswarm.multiagent.PLANNERS is deprecated and goes in the next minor "
-                      "release; use jaxswarm.multiagent.registry (make_planner, registered, "
+        warnings.warn("jaxswarm.multiagent.PLANNERS is deprecated since jaxswarm 0.11.0 and "
+                      "goes in 0.12.0; use jaxswarm.multiagent.registry (make_planner, registered, "
                       "entry)", DeprecationWarning, stacklevel=2)
         from jaxswarm.multiagent.registry import planner_functions
 
