@@ -198,5 +198,5 @@ def test_cbs_and_ecbs_check_their_limits_as_the_command_does(corridor, planner, 
                                                              error, message):
     graph = corridor[0]
     with pytest.raises(error) as raised:
-        registry.plan(planner, graph, [(0, 0)], [(2, 0)], **{limit: value})
+        registry.planner_functions()[planner](graph, [(0, 0)], [(2, 0)], **{limit: value})
     assert str(raised.value) == message
