@@ -4,7 +4,7 @@ Time is counted in steps: every agent moves along one edge or waits in each step
 edge's length, so distances here are hop counts. :func:`hop_fields` computes them for all agents
 by a compiled breadth-first search per goal (numba, as :mod:`jaxswarm.exact.kernels`): O(N) per
 agent, where the batched relaxation of :func:`jaxswarm.exact.distance_field` takes a sweep per
-step of the longest path (40 s for 1,000 agents on maze-128-128-10 against well under a second).
+step of the longest path (``docs/performance.md`` compares them).
 :func:`distance_fields` keeps the batched JAX call for fields in edge lengths.
 """
 from __future__ import annotations
