@@ -8,9 +8,10 @@ numba functions by dispatcher and signature), and so does every Python process a
 A file's programs are the programs its tests use, whatever ran before them: the process forgets
 its compiled programs when the next test is of another file and around each session fixture's
 set-up (:func:`program_hooks.forget`: JAX keeps their traces and lowered modules and the on-disk
-caches the programs, so forgetting costs a load, not a trace or a compile). A session fixture's programs are counted for the file that defines it,
-whichever test first asks for it. So a file's count is the same on any number of workers and in
-any order, and a test that adds a program to a file adds it to that file's count.
+caches the programs, so forgetting costs a load, not a trace or a compile). A session fixture's
+programs are counted for the file that defines it, whichever test first asks for it. So a
+file's count is the same on any number of workers and in any order, and a test that adds a
+program to a file adds it to that file's count.
 
 The controller joins the workers' records (a program built in two workers is one program) and,
 at the end of the run, prints the total and the ten files that built the most. In the default
