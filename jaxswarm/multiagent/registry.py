@@ -12,13 +12,10 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import numbers
 import types
 import typing
 from collections.abc import Callable, Mapping
 from typing import NamedTuple
-
-import numpy as np
 
 from jaxswarm.multiagent.cbs import CBSConfig, cbs
 from jaxswarm.multiagent.ecbs import ECBSConfig, ecbs, eecbs
@@ -28,6 +25,7 @@ from jaxswarm.multiagent.pibt import PIBTConfig, pibt
 from jaxswarm.multiagent.plan import Plan
 from jaxswarm.multiagent.prioritized import PrioritizedConfig, prioritized
 from jaxswarm.multiagent.report import ReportConfig, report_scheme
+from jaxswarm.runtime.options import typed_option
 from jaxswarm.world.graph import Graph
 
 
@@ -178,10 +176,10 @@ def config(name: str, **given):
             raise ValueError(f"unknown option {option!r} of {name}; its options: "
                              f"{', '.join(known) or 'none'}")
     kinds = typing.get_type_hints(entry(name).config)
-    for option, value in given.items():
-        _check_type(name, option, kinds[option], value)
+    checked = {option: typed_option(name, option, kinds[option], value)
+               for option, value in given.items()}
     try:
-        return entry(name).config(**given, **fixed)
+        return entry(name).config(**checked, **fixed)
     except OptionError as error:
         raise OptionError(error.option, f"{error.problem} (an option of {name})") from None
     except (TypeError, ValueError) as error:
@@ -211,32 +209,3 @@ def planner_functions() -> dict[str, Callable[..., Plan]]:
     set (the deprecated ``jaxswarm.multiagent.PLANNERS``)."""
     return {name: functools.partial(found.plan, **found.fixed) if found.fixed else found.plan
             for name, found in REGISTRY.items()}
-
-
-_KINDS = {int: ("an integer",
-                lambda v: isinstance(v, numbers.Integral) and not isinstance(v, bool)),
-          float: ("a number", lambda v: isinstance(v, numbers.Real) and not isinstance(v, bool)),
-          bool: ("True or False", lambda v: isinstance(v, (bool, np.bool_))),
-          str: ("a string", lambda v: isinstance(v, str))}
-"""A Config field's type -> (what the message asks for, whether a value is of it)."""
-
-
-def _check_type(name: str, option: str, annotation, value) -> None:
-    """Refuse ``value`` of ``option`` unless it is of its Config field's type: ``int``,
-    ``float``, ``bool``, ``str`` or a union of them, ``| None`` included. A field of another
-    type (``order``'s tuple of agents) is left to its Config's own check.
-
-    Raises:
-      TypeError: a value of another type (a bool is no number here), naming the planner and
-        the option.
-    """
-    union = typing.get_origin(annotation) in (typing.Union, types.UnionType)
-    kinds = typing.get_args(annotation) if union else (annotation,)
-    optional = type(None) in kinds
-    kinds = [kind for kind in kinds if kind is not type(None)]
-    if (value is None and optional) or not all(kind in _KINDS for kind in kinds):
-        return
-    if not any(_KINDS[kind][1](value) for kind in kinds):
-        wanted = " or ".join(_KINDS[kind][0] for kind in kinds)
-        raise TypeError(f"{option} of {name} must be {wanted}{' or None' * optional}, got "
-                        f"{value!r} ({type(value).__name__})")

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import numbers
 import typing
 from typing import Callable, NamedTuple
 
 import numpy as np
 
+from jaxswarm.runtime.options import typed_option
 from jaxswarm.swarm.aco import ant_system, improved, max_min
 from jaxswarm.swarm.bees import cabc
 from jaxswarm.swarm.core import Swarm, SwarmConfig
@@ -80,43 +80,13 @@ def make(name: str, **config) -> Swarm:
     if unknown:
         raise ValueError(f"unknown option {unknown[0]!r} of {name}; known: {', '.join(options)}")
     kinds = typing.get_type_hints(REGISTRY[name].config)
-    checked = {option: _typed(name, option, kinds[option], value)
+    checked = {option: typed_option(name, option, kinds[option], value)
                for option, value in config.items()}
     try:
         built = REGISTRY[name].config(**checked)
     except ValueError as error:
         raise ValueError(f"{error} (a config option of {name})") from None
     return _build(name, built)
-
-
-_KINDS = {int: ("an integer",
-                lambda v: isinstance(v, numbers.Integral) and not isinstance(v, bool), int),
-          float: ("a number",
-                  lambda v: isinstance(v, numbers.Real) and not isinstance(v, bool), float),
-          bool: ("True or False", lambda v: isinstance(v, (bool, np.bool_)), bool),
-          str: ("a string", lambda v: isinstance(v, str), str)}
-"""A Config field's type -> (what the message asks for, whether a value is of it, the Python
-type the Config holds: NumPy scalars become Python ones, so equal options give equal Configs and
-a config record stays JSON)."""
-
-
-def _typed(name: str, option: str, annotation, value):
-    """``value`` of ``option`` as its Config field's type (``int``, ``float``, ``bool``, ``str``,
-    or one of them ``| None``).
-
-    Raises:
-      TypeError: a value of another type (a bool is no number here), naming swarm and option.
-    """
-    kinds = [kind for kind in typing.get_args(annotation) or (annotation,)
-             if kind is not type(None)]
-    optional = len(kinds) < len(typing.get_args(annotation))
-    if value is None and optional:
-        return None
-    wanted, accepts, convert = _KINDS[kinds[0]]
-    if not accepts(value):
-        raise TypeError(f"{option} of {name} must be {wanted}{' or None' * optional}, got "
-                        f"{value!r} ({type(value).__name__})")
-    return convert(value)
 
 
 @functools.lru_cache(maxsize=None)
