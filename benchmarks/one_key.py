@@ -39,7 +39,8 @@ import numpy as np
 from jaxswarm.maps.planes import paper_plane
 from jaxswarm.studies.problems import movingai_folder, scenario_problem
 from jaxswarm.swarm import make, make_task
-from jaxswarm.swarm.testing import batched_params, run_batch
+from jaxswarm.swarm.executor import run_batch
+from jaxswarm.swarm.testing import batched_params
 
 name, map_name, runs, iterations, agents, repeats = sys.argv[1:7]
 runs, iterations, agents, repeats = int(runs), int(iterations), int(agents), int(repeats)

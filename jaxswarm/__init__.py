@@ -33,17 +33,19 @@ contract in ``pyproject.toml``, checked by the tests):
 * :mod:`jaxswarm.exact`: exact planners: :func:`dijkstra`, :func:`astar`,
   :func:`bidirectional_astar`, D* Lite (:func:`replanner`), batched queries, the optimum as the
   swarms measure it (:func:`optimal_length`), the JAX distance field, the plane's visibility graph.
-* :mod:`jaxswarm.swarm`: the swarm protocol and run loop (:func:`make_task`, :func:`run`), the
-  shared walker, the algorithms (RFD, ACO, IWD on graphs; the bees on planes), the registry of
-  names (:func:`make`, :func:`registered`) and the conformance suite every swarm passes.
-* :mod:`jaxswarm.dynamic`: worlds that change during a run: events and what each swarm's memory
-  does on them, a robot that re-plans.
+* :mod:`jaxswarm.swarm`: the swarm protocol and run loop (:func:`make_task`), the shared
+  walker, the algorithms (RFD, ACO, IWD on graphs; the bees on planes), the registry of names
+  (:func:`make`, :func:`registered`), the executor that runs them (:func:`run`, batches,
+  devices) and the conformance suite every swarm passes.
+* :mod:`jaxswarm.dynamic`: worlds that change during a run: events and each swarm's change rule
+  (what its memory does on them), a robot that re-plans.
 * :mod:`jaxswarm.multiagent`: many agents on one map: the A* report's two-robot scheme,
   prioritised space-time A*, Conflict-Based Search and its improvements, ECBS and EECBS, PIBT and
   LaCAM, one plan format and one validator.
 * :mod:`jaxswarm.sweep`: parameter sweeps: specs as TOML data, a swarm's runs as compiled
   batches over the devices, the resumable runner, the Parquet results store, replaying a row.
-* :mod:`jaxswarm.plot`: figures and animations, one module per world or subject.
+* :mod:`jaxswarm.plot`: figures and animations, one module per world or subject, and how each
+  swarm's memory is drawn.
 * :mod:`jaxswarm.tune`: tuning a swarm's open constants: search spaces, iterated racing, random
   search, the grid and evolution strategies, rescoring on held-out instances.
 * :mod:`jaxswarm.studies`: what the table scripts of ``sweeps/`` share (provenance, timed runs,

@@ -305,6 +305,7 @@ def run_demo(args: argparse.Namespace) -> int:
     from matplotlib import pyplot as plt
 
     from jaxswarm.plot.graph import plot_solutions, plot_swarm_run
+    from jaxswarm.plot.memory import memory_view
 
     name, loaded = _load(args)
     graph, start, goal = loaded.world, loaded.start, loaded.goal
@@ -344,8 +345,9 @@ def run_demo(args: argparse.Namespace) -> int:
     print(f"figure written to {figure}")
     for label, (swarm, state, trace) in traces.items():
         out = figure.with_name(f"{figure.stem}_{swarm.name}{figure.suffix}")
-        fig = plot_swarm_run(graph, swarm.memory(state), solutions[label], trace, start=start,
-                             goal=goal, optimum=reference, field_label=swarm.memory_label,
+        view = memory_view(swarm)
+        fig = plot_swarm_run(graph, view.of(state), solutions[label], trace, start=start,
+                             goal=goal, optimum=reference, field_label=view.label,
                              title=f"{name}: {label}", path=out)
         plt.close(fig)
         print(f"figure written to {out}")

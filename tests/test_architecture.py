@@ -4,6 +4,7 @@ functions and a light top level."""
 from __future__ import annotations
 
 import ast
+import dataclasses
 import importlib
 import importlib.metadata
 import json
@@ -13,6 +14,8 @@ import tomllib
 from pathlib import Path
 
 import jaxswarm
+from jaxswarm.swarm.bees import CABCConfig
+from jaxswarm.swarm.core import Swarm
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = ROOT / "jaxswarm"
@@ -67,6 +70,33 @@ def test_no_function_is_longer_than_60_lines():
                     long.append(f"{where} {node.name}: {lines} lines")
     assert not long, (f"{len(long)} functions longer than {MAX_FUNCTION_LINES} lines:\n"
                       + "\n".join(long))
+
+
+RUNNING = ("LANES", "lanes_for", "log_moves", "EVERY_MOVE", "room_blocks", "with_room")
+"""The walker's log capacity and lane count, and the retry with room: named only in
+``swarm/walking/`` and the executor (``swarm/executor/``)."""
+
+
+def test_only_the_walker_and_the_executor_name_log_room_and_lanes():
+    named = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        inside = path.relative_to(PACKAGE).parts[:2]
+        if inside in (("swarm", "walking"), ("swarm", "executor")):
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+            name = node.id if isinstance(node, ast.Name) else getattr(node, "attr", None)
+            if isinstance(node, ast.alias):
+                name = node.name
+            if name in RUNNING:
+                named.append(f"{path.relative_to(ROOT)}:{node.lineno} {name}")
+    assert not named, "\n".join(named)
+
+
+def test_a_swarm_is_five_functions_and_its_name_config_and_world():
+    fields = [field.name for field in dataclasses.fields(Swarm)]
+    assert fields == ["name", "config", "init", "step", "best", "default_params",
+                      "check_params", "world"]
+    assert "walker" not in {field.name for field in dataclasses.fields(CABCConfig)}
 
 
 def test_importing_jaxswarm_starts_no_backend():

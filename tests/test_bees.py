@@ -9,6 +9,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from jaxswarm.dynamic.rules import change_rule
 from jaxswarm.exact.visibility import shortest_path
 from jaxswarm.maps.planes import PLANE_CAPACITY, paper_plane
 from jaxswarm.swarm import make, make_task, run
@@ -305,8 +306,8 @@ def best_of(swarm, state):
 
 @functools.partial(jax.jit, static_argnames="swarm")
 def adapt(swarm, state, before, after, old_task, new_task, params):
-    """``swarm.adapt``, the change rule, in one program."""
-    return swarm.adapt(state, before, after, old_task, new_task, params)
+    """The swarm's change rule (:func:`jaxswarm.dynamic.rules.change_rule`), in one program."""
+    return change_rule(swarm)(state, before, after, old_task, new_task, params)
 
 
 def test_a_vehicle_with_no_feasible_candidate_stays():

@@ -9,9 +9,9 @@ import sizes
 from graphs import solved_paper_map
 from jitted import apply_event, change
 from jaxswarm.dynamic import events as events_module
-from jaxswarm.dynamic.events import (check_events, first_iteration_at, make_event, memory_frames,
-                                     replan)
+from jaxswarm.dynamic.events import check_events, first_iteration_at, make_event, replan
 from jaxswarm.plot.graph import animate_field
+from jaxswarm.plot.memory import memory_frames, memory_view
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.testing import Compilations
 from jaxswarm.world.graph import grid_graph
@@ -190,8 +190,8 @@ def test_memory_frames_and_their_gif(tmp_path):
                                                                    params, 4)
     frames = np.asarray(frames)
     assert frames.shape == (5, graph.num_nodes)
-    np.testing.assert_array_equal(frames[0], swarm.memory(state))
-    np.testing.assert_array_equal(frames[-1], swarm.memory(after))
+    np.testing.assert_array_equal(frames[0], memory_view(swarm).of(state))
+    np.testing.assert_array_equal(frames[-1], memory_view(swarm).of(after))
     gif = tmp_path / "sub" / "altitude.gif"
     animate_field(graph, np.minimum(frames, 100.0), gif, title="{frame}")
     assert gif.read_bytes()[:6] == b"GIF89a" and list(gif.parent.iterdir()) == [gif]

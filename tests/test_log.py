@@ -1,4 +1,6 @@
 """A walk's log of moves: what it holds, reading it, and the room it has (overflow and retry)."""
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -6,15 +8,16 @@ import pytest
 import sizes
 from jitted import rows_log
 
-from jaxswarm.dynamic.events import memory_frames
 from jaxswarm.dynamic.robot import hidden_blocks, swarm_robot
+from jaxswarm.plot.memory import memory_frames
 from jaxswarm.swarm import make, run
-from jaxswarm.swarm.core import with_room
-from jaxswarm.swarm.testing import _run_batch, batched_params, outcome, run_batch
+from jaxswarm.swarm.executor import run_batch, with_room
+from jaxswarm.swarm.executor.runs import _run_batch
+from jaxswarm.swarm.testing import batched_params, outcome
 from jaxswarm.swarm.walking import step_budget, walk
-from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same,
-                                        columns, default_log_moves, log_blocks, paths,
-                                        room_blocks)
+from jaxswarm.swarm.walking.log import (BLOCK, EVERY_MOVE, ROOM_FOR_EVERY_MOVE, WalkerOptions,
+                                        agent_path, all_same, columns, default_log_moves,
+                                        log_blocks, paths, room_blocks)
 from jaxswarm.world.graph import grid_graph
 
 SIDE = 16
@@ -33,7 +36,8 @@ def _walk(log_moves):
     a program of their own), the table as f32 (two Python floats would make it weakly typed)."""
     table = np.where(np.asarray(OPEN.nbr) >= 0, np.float32(0.0), np.float32(-np.inf))
     return walk(jax.random.key(0), OPEN, table, np.int32(0), np.int32(5 * SIDE + 5),
-                num_agents=AGENTS, max_steps=STEPS, log_moves=log_moves)
+                num_agents=AGENTS, max_steps=STEPS,
+                walker=WalkerOptions(log_moves=log_moves))
 
 
 # all_same in one program, shared by the tests: applied outside jit, each of its operations is
@@ -145,7 +149,7 @@ def cramped():
     the default room holds every move) it is the conformance checks' ACO*, whose programs its
     runs share."""
     graph, task = sizes.maze()
-    return make("aco_star", **sizes.CONFIG, log_moves=BLOCK), graph, task
+    return make("aco_star", **sizes.CONFIG, walker=WalkerOptions(log_moves=BLOCK)), graph, task
 
 
 def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
@@ -156,7 +160,8 @@ def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
     grid = batched_params(params, sizes.RUNS)
     # _run_batch is run_batch without its retry: jit of vmap of run, a caller who maps run and
     # so sees the flag (the same program as run_batch's first try below).
-    mapped = _run_batch(swarm, keys, graph, task, grid, iterations=sizes.ITERATIONS)
+    mapped = _run_batch(swarm, keys, graph, task, grid, iterations=sizes.ITERATIONS,
+                        patience=None)
     assert bool(np.asarray(mapped[1].overflowed).any())
     for key in keys:
         alone = run(swarm, key, graph, task, params, iterations=sizes.ITERATIONS)
@@ -169,12 +174,22 @@ def test_run_makes_a_run_whose_walk_overflowed_again_with_room(cramped):
     want = run_batch(roomy, keys, graph, task, grid, iterations=sizes.ITERATIONS)
     assert not bool(np.asarray(batch[1].overflowed).any())
     np.testing.assert_array_equal(batch[0].best_cost, want[0].best_cost)
-    assert with_room(swarm).config.log_moves == ROOM_FOR_EVERY_MOVE
+    assert with_room(swarm).config.walker == EVERY_MOVE
 
 
 def test_a_bad_log_room_is_refused():
-    with pytest.raises(ValueError, match="log_moves"):
-        make("aco_star", log_moves=0)
+    with pytest.raises(ValueError, match="log_moves must be at least 1"):
+        WalkerOptions(log_moves=0)
+    with pytest.raises(TypeError, match="walker must be WalkerOptions"):
+        make("aco_star", walker=16)
+
+
+def test_room_is_for_swarms_of_the_registry_that_walk():
+    with pytest.raises(ValueError, match="does not walk"):
+        with_room(make("cabc"))
+    by_hand = dataclasses.replace(make("aco_star", **sizes.CONFIG), name="my_colony")
+    with pytest.raises(ValueError, match="'my_colony' was not built by the registry"):
+        with_room(by_hand)
 
 
 @pytest.mark.slow  # the frames' and the robot's programs, cramped and roomy: about 45 s cold

@@ -378,9 +378,7 @@ def _late_arrival_swarm() -> Swarm:
                         found=jnp.isfinite(state[1]))
 
     return Swarm(name="late", config=None, init=init, step=step, best=best,
-                 default_params=None, check_params=lambda params: None,
-                 memory=lambda state: jnp.zeros(1), memory_label="",
-                 adapt=lambda state, *_: state)
+                 default_params=None, check_params=lambda params: None)
 
 
 LATE = _late_arrival_swarm()

@@ -33,7 +33,9 @@ from jaxswarm.sweep import (SpecError, StoreMismatchError, load_spec, read_resul
 from jaxswarm.sweep.replay import replay_row
 from jaxswarm.sweep.store import ResultsStore
 from jaxswarm.sweep import runner
-from jaxswarm.sweep.batches import group_size
+from jaxswarm.swarm.executor import group_size
+from jaxswarm.swarm.walking import WalkerOptions
+from jaxswarm.sweep.batches import RunBatches
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.swarm.rfd.river import gradients
 
@@ -246,13 +248,20 @@ def test_the_gradients_a_drop_draws_from_are_the_same_alone_and_in_a_batch():
 
 
 @pytest.mark.slow  # programs of a cramped log and of a roomy one, about 60 s cold
-def test_a_chunk_whose_walk_overflowed_its_log_is_made_again_with_room(finished, tmp_path):
+def test_a_chunk_whose_walk_overflowed_its_log_is_made_again_with_room(finished, tmp_path,
+                                                                     monkeypatch):
     """Twin in the default tier: test_log.py's run and batch made again with room (the retry this
-    runner shares)."""
+    runner shares). The swarm's walks get one block of room per drop, as no spec can ask."""
     _, _, frame = finished
     messages = []
-    cramped = run_sweep(spec_from_dict(tiny(config={"log_moves": 16})), tmp_path / "out",
-                        progress=False, log=messages.append)
+
+    def cramped_batches(algorithm, config, *args, **kwargs):
+        return RunBatches(algorithm, {**config, "walker": WalkerOptions(log_moves=16)}, *args,
+                          **kwargs)
+
+    monkeypatch.setattr(runner, "RunBatches", cramped_batches)
+    cramped = run_sweep(spec_from_dict(tiny()), tmp_path / "out", progress=False,
+                        log=messages.append)
     assert any("no room for its moves" in message for message in messages)
     pd.testing.assert_frame_equal(cramped[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
 

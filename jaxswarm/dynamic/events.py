@@ -11,7 +11,7 @@ event of the same size, and a batch of events vmaps::
 when the new optimum was first reached.
 
 :func:`change` applies the event to the map and the task (:func:`apply_event`), then the swarm's
-memory rule (``Swarm.adapt``, documented per swarm family: the RFD paper's
+change rule (:mod:`jaxswarm.dynamic.rules`, documented per swarm family: the RFD paper's
 :func:`jaxswarm.swarm.rfd.river.paper_altitude_rule`, ``rfd_graded``'s
 :func:`jaxswarm.swarm.rfd.graded.regrade` and the ant colonies'
 :func:`jaxswarm.swarm.aco.colony.pheromone_rule`), then forgets a best path the event made
@@ -27,7 +27,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, again_with_room, run
+from jaxswarm.dynamic.rules import change_rule
+from jaxswarm.swarm.core import Swarm, Task
+from jaxswarm.swarm.executor import run
 from jaxswarm.world.edits import block_cells, close_edges, open_edges, unblock_cells
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, is_valid_path
@@ -161,10 +163,10 @@ def change(swarm: Swarm, state, event: Event, graph: Graph, task: Task, params):
     """Apply ``event``: ``(state, graph, task)`` after it, the swarm's memory adapted by its rule
     and a best path the event made invalid forgotten (jittable, vmappable over events).
 
-    Check events on the host first (:func:`check_events`); :func:`~jaxswarm.swarm.core.run` does
+    Check events on the host first (:func:`check_events`); :func:`~jaxswarm.swarm.executor.run` does
     not."""
     after, new_task = apply_event(event, graph, task)
-    state = swarm.adapt(state, graph, after, task, new_task, params)
+    state = change_rule(swarm)(state, graph, after, task, new_task, params)
     return forget_invalid_best(state, after, new_task), after, new_task
 
 
@@ -186,24 +188,6 @@ def first_iteration_at(trace, cost: float, *, gap: float) -> int | None:
     return int(hits[0]) + 1 if hits.size else None
 
 
-def memory_frames(swarm: Swarm, state, graph: Graph, task: Task, params, iterations: int):
-    """Step a swarm ``iterations`` times from ``state`` (static count, no stop rule) and keep its
-    memory after each step: ``(state, f32[iterations + 1, N])``, the first row the memory
-    given (for a figure or a GIF of it re-forming after a change, see
-    :func:`jaxswarm.plot.graph.animate_field`). Stepped again with room for every move when a
-    walk overflowed its log (:func:`~jaxswarm.swarm.core.with_room`; concrete inputs)."""
-    def frames_of(swarm):
-        def one(state, _):
-            state, info = swarm.step(state, graph, task, params)
-            return state, (swarm.memory(state), info.overflowed)
-
-        after, (frames, overflowed) = jax.lax.scan(one, state, None, length=iterations)
-        return after, jnp.concatenate([swarm.memory(state)[None], frames]), jnp.any(overflowed)
-
-    after, frames, _ = again_with_room(frames_of, swarm, lambda result: result[2])
-    return after, frames
-
-
 def forget_invalid_best(state, graph: Graph, task: Task):
     """``state`` without its best path if that path is no longer a path from the start to the
     goal on ``graph`` (it crosses a blocked cell or edge, or ends at an old goal): its cost is
@@ -212,3 +196,14 @@ def forget_invalid_best(state, graph: Graph, task: Task):
     return dataclasses.replace(
         state, best_path=jnp.where(valid, state.best_path, NO_NODE),
         best_cost=jnp.where(valid, state.best_cost, jnp.inf))
+
+
+def __getattr__(name: str):
+    if name == "memory_frames":
+        import warnings
+
+        from jaxswarm.plot.memory import memory_frames
+        warnings.warn("jaxswarm.dynamic.events.memory_frames is jaxswarm.plot.memory_frames (this "
+                      "name goes in 0.12.0)", DeprecationWarning, stacklevel=2)
+        return memory_frames
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

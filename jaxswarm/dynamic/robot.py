@@ -31,7 +31,8 @@ import numpy as np
 
 from jaxswarm.dynamic.events import NO_NODE, Event, apply_event, change, make_event
 from jaxswarm.exact import astar, replanner
-from jaxswarm.swarm.core import Swarm, Task, again_with_room, make_task, run
+from jaxswarm.swarm.core import Swarm, Task, make_task
+from jaxswarm.swarm.executor import retried, run
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import as_node, path_length, step_slots
 
@@ -154,7 +155,7 @@ def swarm_robot(swarm: Swarm, key, known: Graph, task: Task, hidden: Event, para
         raise ValueError(f"unknown memory {memory!r}; choose one of {', '.join(MEMORY)}")
     if max_plans < 1:
         raise ValueError(f"max_plans must be at least 1, got {max_plans}")
-    return again_with_room(
+    return retried(
         lambda swarm: _swarm_robot(swarm, key, known, task, hidden, params, iterations,
                                    patience, max_plans, memory),
         swarm, lambda walk: walk.overflowed)

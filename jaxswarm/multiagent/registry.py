@@ -25,7 +25,7 @@ from jaxswarm.multiagent.pibt import PIBTConfig, pibt
 from jaxswarm.multiagent.plan import Plan
 from jaxswarm.multiagent.prioritized import PrioritizedConfig, prioritized
 from jaxswarm.multiagent.report import ReportConfig, report_scheme
-from jaxswarm.runtime.options import typed_option
+from jaxswarm.runtime.options import check_new_entry, typed_option
 from jaxswarm.world.graph import Graph
 
 
@@ -119,12 +119,7 @@ def register(name: str, entry: Entry) -> None:
       TypeError: ``entry`` is not an :class:`Entry`, or its config is not a dataclass.
       ValueError: ``name`` is taken, or ``fixed`` names an option the config does not have.
     """
-    if not isinstance(entry, Entry):
-        raise TypeError(f"entry of {name!r} must be an Entry, got {type(entry).__name__}")
-    if not dataclasses.is_dataclass(entry.config):
-        raise TypeError(f"config of {name!r} must be a dataclass, got {entry.config!r}")
-    if name in REGISTRY:
-        raise ValueError(f"planner {name!r} is registered already")
+    check_new_entry(REGISTRY, name, entry, Entry, "planner")
     fields = {field.name for field in dataclasses.fields(entry.config)}
     if set(entry.fixed) - fields:
         raise ValueError(f"fixed options {sorted(set(entry.fixed) - fields)} of {name!r} are "

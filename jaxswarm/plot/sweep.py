@@ -14,6 +14,7 @@ import pandas as pd
 from matplotlib import patheffects
 
 from jaxswarm.plot.graph import draw_trace, plot_swarm_run, save_png
+from jaxswarm.plot.memory import memory_view
 from jaxswarm.plot.plane import draw_plane, draw_trajectory
 from jaxswarm.sweep.replay import Replayed
 from jaxswarm.world.plane import Plane
@@ -132,9 +133,10 @@ def plot_replay(replayed: Replayed, path) -> Path:
         draw_trace(right, replayed.trace, optimum=row.get("optimum"))
         fig.suptitle(title)
     else:
-        fig = plot_swarm_run(world, replayed.swarm.memory(replayed.state), solution,
-                             replayed.trace, start=start, goal=goal, optimum=row.get("optimum"),
-                             field_label=replayed.swarm.memory_label, title=title)
+        view = memory_view(replayed.swarm)
+        fig = plot_swarm_run(world, view.of(replayed.state), solution, replayed.trace,
+                             start=start, goal=goal, optimum=row.get("optimum"),
+                             field_label=view.label, title=title)
     _save(fig, Path(path))
     return Path(path)
 

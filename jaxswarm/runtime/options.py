@@ -1,7 +1,9 @@
-"""A Config's options checked against their annotations: what both registries (the swarms' and
-the multi-agent planners') do with the options a user passes before building a Config."""
+"""A Config's options checked against their annotations, and a new registry entry checked: what
+both registries (the swarms' and the multi-agent planners') do with the options a user passes
+before building a Config, and with an entry a user registers."""
 from __future__ import annotations
 
+import dataclasses
 import numbers
 import types
 import typing
@@ -47,3 +49,21 @@ def typed_option(owner: str, option: str, annotation, value):
     wanted = " or ".join(KINDS[kind][0] for kind in kinds)
     raise TypeError(f"{option} of {owner} must be {wanted}{' or None' * optional}, got "
                     f"{value!r} ({type(value).__name__})")
+
+
+def check_new_entry(registry: dict, name: str, entry, entry_type: type, kind: str) -> None:
+    """Host-side: raise unless ``entry`` may join ``registry`` as ``name``: an ``entry_type``
+    whose ``config`` is a dataclass, under a name not taken (``kind`` says what the registry
+    holds, for the message).
+
+    Raises:
+      TypeError: ``entry`` is not an ``entry_type``, or its config is not a dataclass.
+      ValueError: ``name`` is taken.
+    """
+    if not isinstance(entry, entry_type):
+        raise TypeError(f"entry of {name!r} must be an {entry_type.__name__}, got "
+                        f"{type(entry).__name__}")
+    if not dataclasses.is_dataclass(entry.config):
+        raise TypeError(f"config of {name!r} must be a dataclass, got {entry.config!r}")
+    if name in registry:
+        raise ValueError(f"{kind} {name!r} is registered already")

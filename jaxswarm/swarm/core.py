@@ -1,5 +1,6 @@
 """The swarm protocol (:class:`Swarm`, :class:`Task`, :class:`StepInfo`, :class:`Trace`) and the
-run loop with its stop conditions; the names of the swarms are in :mod:`jaxswarm.swarm.registry`.
+run loop with its stop conditions (:func:`run_loop`, which :mod:`jaxswarm.swarm.executor` runs);
+the names of the swarms are in :mod:`jaxswarm.swarm.registry`.
 
 A swarm is a bundle of pure functions built by a factory that closes over a static, hashable
 ``Config`` (sizes and switches); the numbers a sweep varies live in a traced ``Params`` pytree; the
@@ -7,14 +8,13 @@ memory that persists between iterations (altitudes, pheromone) lives in a pytree
 
     swarm = jaxswarm.swarm.make("rfd_star", num_agents=256)
     task = make_task(world, start=(0, 0), goal=(19, 19))
-    state, trace = run(swarm, key, world, task, swarm.default_params, iterations=100)
+    state, trace = jaxswarm.swarm.run(swarm, key, world, task, swarm.default_params)
     swarm.best(state)  # Solution(path, cost, found)
 
-``run`` is jitted (the swarm and the iteration budget are static), so it vmaps over keys and over
-params and compiles once per map shape. The world (a graph or a plane) is an argument, never
+The run loop is jitted (the swarm and the iteration budget are static), so it vmaps over keys and
+over params and compiles once per map shape. The world (a graph or a plane) is an argument, never
 stored in the state, so a batch of runs shares one copy.
 """
-from __future__ import annotations
 
 import dataclasses
 import functools
@@ -24,8 +24,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.runtime.batching import one_at_a_time
-from jaxswarm.swarm.walking.log import ROOM_FOR_EVERY_MOVE, all_same, known_overflowed
+from jaxswarm.swarm.walking.log import WalkerOptions, all_same
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 from jaxswarm.world.plane import Plane, check_point
@@ -77,21 +76,22 @@ class StepInfo(NamedTuple):
       converged: bool[] every agent arrived along one and the same path.
       moves: i32[] moves the agents made (the useful work of the walk).
       lane_steps: i32[] lane-steps the walk's loop executed (a batch of runs shares one loop,
-        so under ``vmap`` each run gets the batch's total).
+        so under ``vmap`` each run gets the batch's total); None for a swarm that does not walk
+        (its trace counts 0).
       evaluations: i32[] fitness calls: complete paths whose length was evaluated (the agents
         that arrived; the IWD paper's "fitness function calls"), guided-function evaluations of
         the bees.
       overflowed: bool[] the walk's log had no room for all its moves (:mod:`~jaxswarm.swarm.
         walking.log`): what the iteration did is wrong, and the run must be made again with
-        more room (:func:`run` does).
+        more room (:func:`~jaxswarm.swarm.executor.run` does).
     """
 
     iteration_cost: jax.Array
     arrived: jax.Array
     converged: jax.Array
     moves: jax.Array
-    lane_steps: jax.Array
     evaluations: jax.Array
+    lane_steps: Any = None
     overflowed: Any = np.False_
 
 
@@ -99,10 +99,13 @@ class StepInfo(NamedTuple):
 class Swarm:
     """A swarm algorithm: pure functions over (State, World, Task, Params).
 
-    Hashable by identity (it is a static argument of ``run``); factories are cached per Config, so
-    equal configs give the same Swarm and share compiled code. ``init`` and ``step`` are jitted,
-    so stepping a swarm by hand (one iteration at a time, from Python) compiles once per map
-    shape too.
+    Hashable by identity (it is a static argument of the run loop); factories are cached per
+    Config, so equal configs give the same Swarm and share compiled code. ``init`` and ``step``
+    are jitted, so stepping a swarm by hand (one iteration at a time, from Python) compiles once
+    per map shape too. What else a family offers is declared where it is used, keyed by the
+    swarm's name: how its memory is drawn (:mod:`jaxswarm.plot.memory`), how it adapts to a
+    change (:mod:`jaxswarm.dynamic.rules`), how a batch of its runs is scheduled
+    (:mod:`jaxswarm.swarm.executor`).
 
     Attributes:
       name: registry name.
@@ -116,22 +119,8 @@ class Swarm:
       check_params: ``(params) -> None``, host-side; raises
         :class:`~jaxswarm.swarm.core.ParamError` (a ValueError) whose ``field`` names the bad
         param.
-      memory: ``(state) -> f32[...]``: what persists between iterations, for figures: the
-        memory per node (f32[N]: altitude, pheromone) of a graph swarm, the trajectory so far
-        (f32[L, 2]) of the bees' vehicle.
-      memory_label: what ``memory`` shows, for colorbars.
-      adapt: ``(state, before, after, old_task, new_task, params) -> State``: the memory rule of
-        a change of the map (``before`` to ``after``) or the task (see
-        :func:`jaxswarm.dynamic.events.change`); each family documents its own.
       world: the kind of world it plans in, :class:`~jaxswarm.world.graph.Graph` or
         :class:`~jaxswarm.world.plane.Plane`.
-      vmap_one_at_a_time: a ``vmap`` of :func:`run` (a sweep's group of runs,
-        :func:`~jaxswarm.swarm.testing.run_batch`) runs its members one after another
-        (:func:`~jaxswarm.runtime.batching.one_at_a_time`) instead of in lockstep: for a swarm
-        whose iterations branch on each run's own state, where lockstep would take every
-        branch for every run (IWD_PG's memory operators). The results are the same either way.
-      rebuild: ``(config) -> Swarm``: the same algorithm built with another Config (set by the
-        registry; None for a swarm built by hand).
     """
 
     name: str
@@ -141,12 +130,7 @@ class Swarm:
     best: Callable
     default_params: Any
     check_params: Callable
-    memory: Callable
-    memory_label: str
-    adapt: Callable
     world: type = Graph
-    vmap_one_at_a_time: bool = False
-    rebuild: Callable | None = None
 
     def params_with(self, **values: float):
         """The swarm's default params with the named ones set to ``values`` (NumPy float32
@@ -172,7 +156,7 @@ class Trace:
       evaluations: i32[T] fitness calls in each iteration (see
         :class:`~jaxswarm.swarm.core.StepInfo`).
       overflowed: bool[] a walk's log had no room for its moves (see
-        :class:`~jaxswarm.swarm.core.StepInfo`): the run is wrong and :func:`run` makes it
+        :class:`~jaxswarm.swarm.core.StepInfo`): the run is wrong and the executor makes it
         again with more room; set only in the trace of a run mapped by its caller.
     """
 
@@ -191,62 +175,26 @@ jax.tree_util.register_dataclass(
                         "lane_steps", "evaluations", "overflowed"], meta_fields=[])
 
 
-def run(swarm: Swarm, key: jax.Array, world: World, task: Task, params, *,
-        iterations: int = 100, patience: int | None = None, state=None, budget=None):
-    """Iterate a swarm until a stop condition holds, from fresh memory or from ``state``.
-
-    Stops after ``iterations`` iterations, or when the best cost has not improved for ``patience``
-    iterations (if given) since a first path was found, or when every agent of an iteration
-    followed the same path. Iterations before the first path do not count towards patience (the
-    RFD paper's "solution not improved in the last n loops" needs a solution): a swarm that needs
-    40 iterations to reach the goal is not stopped at 30, and an unreachable goal uses the whole
-    budget.
-
-    Args:
-      swarm: the algorithm (static).
-      key: PRNG key; the same key and inputs give bit-identical results.
-      world: a Graph, or a Plane for the swarms that plan on one (``swarm.world``).
-      task: start and goal (see :func:`~jaxswarm.swarm.core.make_task`).
-      params: the swarm's Params (traced: vmap over them, or sweep without recompiling).
-      iterations: the iteration budget T (static).
-      patience: stop after this many iterations without improvement of a path found
-        (static; None = never). A patience of ``iterations`` or more cannot stop a run early, so
-        it runs the program of None.
-      state: a State to continue from (the memory of an earlier run, after
-        :func:`jaxswarm.dynamic.events.change` when the map or the task changed); its key is
-        replaced by ``key``, which drives the continuation. None: fresh memory (``swarm.init``). The
-        iteration count and the patience count start again either way.
-      budget: i32[] stop after at most this many iterations (traced, so runs of different
-        budgets share one compiled program: replaying a run up to the iteration where something
-        happened); None: ``iterations``.
-
-    Returns:
-      ``(state, trace)``: the final State and a :class:`~jaxswarm.swarm.core.Trace`. Called
-      with concrete inputs, a run whose walk overflowed its log is made again with room for
-      every move (:func:`~jaxswarm.swarm.core.with_room`); mapped or traced by its caller, its
-      trace says so (``Trace.overflowed``).
+def check_run(swarm: Swarm, world: World, params, iterations: int,
+              patience: int | None) -> int | None:
+    """Host-side checks of a run's arguments (see :func:`jaxswarm.swarm.executor.run`): the
+    patience the run loop takes, None where ``patience`` cannot stop a run early (at least
+    ``iterations``). Params are checked in range only when concrete (outside ``jit``).
 
     Raises:
       TypeError: params that are not the swarm's Params, or a param that is not a real number.
-      ValueError: a world of the wrong kind, a param of another shape than its default's (a
-        scalar: a batch of runs maps ``run`` over params), or concrete params out of range
-        (checked on the host, outside jit).
+      ValueError: an iteration budget or a patience below 1, a world of the wrong kind, a param
+        of another shape than its default's, or concrete params out of range.
     """
     if iterations < 1:
         raise ValueError(f"iterations must be at least 1, got {iterations}")
     if patience is not None and patience < 1:
         raise ValueError(f"patience must be at least 1, got {patience}")
-    if patience is not None and patience >= iterations:
-        patience = None
     require_world(swarm, world)
     check_params_form(swarm, params)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
-    budget = jnp.int32(iterations if budget is None else budget)
-    return again_with_room(
-        lambda swarm: _run_program(swarm, iterations, patience)(key, world, task, params, state,
-                                                               budget),
-        swarm, lambda result: result[1].overflowed)
+    return None if patience is not None and patience >= iterations else patience
 
 
 def check_params_form(swarm: Swarm, params) -> None:
@@ -283,53 +231,14 @@ def check_params_form(swarm: Swarm, params) -> None:
                              "maps run over params (jax.vmap)")
 
 
-def again_with_room(call: Callable, swarm: Swarm, overflowed: Callable):
-    """``call(swarm)``, made again as ``call(with_room(swarm))`` when ``overflowed(result)``
-    (bool[...], concrete) says a walk had no room in its log; a traced flag is left to the
-    caller. How every entry that runs a swarm keeps no overflowed result."""
-    result = call(swarm)
-    if known_overflowed(overflowed(result)):
-        return call(with_room(swarm))
-    return result
-
-
-def with_room(swarm: Swarm) -> Swarm:
-    """``swarm`` with room in its walks' logs for every agent's whole step budget, so that no
-    walk overflows (:mod:`~jaxswarm.swarm.walking.log`); the same results, one more compiled
-    program. What :func:`run` and the sweep runner run a run again with when a walk
-    overflowed.
-
-    Raises:
-      ValueError: ``swarm`` cannot be built again (it was not built by the registry).
-    """
-    if swarm.rebuild is None:
-        raise ValueError(f"swarm {swarm.name!r} was not built by the registry, so it cannot be "
-                         "built again with room for every move: give it a larger log_moves")
-    return swarm.rebuild(dataclasses.replace(swarm.config, log_moves=ROOM_FOR_EVERY_MOVE))
-
-
-def _run_program(swarm, iterations: int, patience: int | None):
-    """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with
-    these statics (one after another under ``vmap`` for a swarm that asks for it)."""
-    if swarm.vmap_one_at_a_time:
-        return _run_alone(swarm, iterations, patience)
-    return functools.partial(_run, swarm, iterations=iterations, patience=patience)
-
-
-@functools.lru_cache(maxsize=None)
-def _run_alone(swarm, iterations: int, patience: int | None):
-    """``(key, world, task, params, state, budget) -> (state, trace)``: :func:`_run` with these
-    statics, whose ``vmap`` runs the batch's members one after another. Jitted, so that a run
-    called alone is traced once per shape (a ``custom_vmap`` function called outside ``jit`` is
-    traced again at every call)."""
-    def run_one(key, world, task, params, state, budget):
-        return _run(swarm, key, world, task, params, state, budget, iterations=iterations,
-                    patience=patience)
-    return jax.jit(one_at_a_time(run_one))
-
-
 @functools.partial(jax.jit, static_argnames=("swarm", "iterations", "patience"))
-def _run(swarm, key, world, task, params, state, budget, *, iterations, patience):
+def run_loop(swarm: Swarm, key: jax.Array, world: World, task: Task, params, state,
+             budget: jax.Array, *, iterations: int, patience: int | None):
+    """The run loop of :func:`jaxswarm.swarm.executor.run` (see there for the stop rules and
+    the arguments, checked by :func:`check_run`): ``(state, trace)``, the trace's
+    ``overflowed`` set where a walk had no room in its log (the executor makes such a run
+    again). ``state`` None: fresh memory; ``budget`` i32[].
+    """
     if state is None:
         state = swarm.init(key, world, task, params)
     else:
@@ -362,7 +271,8 @@ def _run(swarm, key, world, task, params, state, budget, *, iterations, patience
                       iteration_cost=trace.iteration_cost.at[t].set(info.iteration_cost),
                       arrived=trace.arrived.at[t].set(info.arrived),
                       iterations=t + 1, moves=trace.moves.at[t].set(info.moves),
-                      lane_steps=trace.lane_steps.at[t].set(info.lane_steps),
+                      lane_steps=(trace.lane_steps if info.lane_steps is None
+                                  else trace.lane_steps.at[t].set(info.lane_steps)),
                       evaluations=trace.evaluations.at[t].set(info.evaluations),
                       overflowed=trace.overflowed | info.overflowed)
         stale = jnp.where((after < before) | ~jnp.isfinite(after), 0, stale + 1)
@@ -381,20 +291,30 @@ class SwarmConfig:
       num_agents: agents (drops, ants) per iteration.
       max_steps: step budget of one walk (paths hold max_steps + 1 nodes); None = N - 1 (the
         longest walk without revisits) on general graphs and min(N - 1, 8 (H + W)) on grids.
-      log_moves: moves per agent, on average, a walk's log has room for; None:
-        :func:`~jaxswarm.swarm.walking.log.room_blocks`. Changes no result, only the
-        memory of a walk and how often a run is made again because a walk overflowed
-        (:mod:`~jaxswarm.swarm.walking.log`).
     """
 
     num_agents: int = 256
     max_steps: int | None = None
-    log_moves: int | None = None
 
     def __post_init__(self):
         check_sizes(self.num_agents, self.max_steps)
-        if self.log_moves is not None and self.log_moves < 1:
-            raise ValueError(f"log_moves must be at least 1, got {self.log_moves}")
+
+
+@dataclasses.dataclass(frozen=True)
+class WalkingConfig(SwarmConfig):
+    """The Config of a swarm whose agents walk the walker (:mod:`jaxswarm.swarm.walking`).
+
+    Attributes:
+      walker: how its walks are run, handed to the walker unread
+        (:class:`~jaxswarm.swarm.walking.log.WalkerOptions`); changes no result.
+    """
+
+    walker: WalkerOptions = WalkerOptions()
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not isinstance(self.walker, WalkerOptions):
+            raise TypeError(f"walker must be WalkerOptions, got {type(self.walker).__name__}")
 
 
 def default_params(params_type, **values):
@@ -482,3 +402,18 @@ def shown(value) -> str:
     """A param's value as a message shows it: ``-0.5`` for ``np.float32(-0.5)``, ``[1. 2.]``
     for an array."""
     return str(np.asarray(value))
+
+
+_MOVED = {"run": "run", "with_room": "with_room", "again_with_room": "retried"}
+"""Names that moved to :mod:`jaxswarm.swarm.executor` (forwarded until 0.12.0)."""
+
+
+def __getattr__(name: str):
+    if name in _MOVED:
+        import warnings
+
+        from jaxswarm.swarm import executor
+        warnings.warn(f"jaxswarm.swarm.core.{name} is jaxswarm.swarm.executor.{_MOVED[name]} "
+                      "(this name goes in 0.12.0)", DeprecationWarning, stacklevel=2)
+        return getattr(executor, _MOVED[name])
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

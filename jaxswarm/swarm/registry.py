@@ -15,10 +15,10 @@ from typing import Callable, NamedTuple
 
 import numpy as np
 
-from jaxswarm.runtime.options import typed_option
+from jaxswarm.runtime.options import check_new_entry, typed_option
 from jaxswarm.swarm.aco import ant_system, improved, max_min
 from jaxswarm.swarm.bees import cabc
-from jaxswarm.swarm.core import Swarm, SwarmConfig
+from jaxswarm.swarm.core import Swarm, SwarmConfig, WalkingConfig
 from jaxswarm.swarm.iwd import iwd, iwd_pg
 from jaxswarm.swarm.rfd import graded, paper
 
@@ -42,14 +42,14 @@ class Entry(NamedTuple):
 
 
 REGISTRY: dict[str, Entry] = {
-    "rfd": Entry(SwarmConfig, paper.build_rfd, "RFD", "RFD paper, eqs. 1-5"),
+    "rfd": Entry(WalkingConfig, paper.build_rfd, "RFD", "RFD paper, eqs. 1-5"),
     "rfd_star": Entry(paper.RFDStarConfig, paper.build_rfd_star, "RFD*",
                       "RFD paper, eq. 6 with eqs. 4-5"),
     "rfd_graded": Entry(graded.GradedConfig, graded.build_rfd_graded, "RFD graded",
                         "jaxswarm: RFD*'s eq. 6 over a graded river bed", faithful=False),
-    "ant_system": Entry(SwarmConfig, ant_system.build_ant_system, "Ant System",
+    "ant_system": Entry(WalkingConfig, ant_system.build_ant_system, "Ant System",
                         "RFD paper, eqs. 7-9"),
-    "aco_star": Entry(SwarmConfig, ant_system.build_aco_star, "ACO*",
+    "aco_star": Entry(WalkingConfig, ant_system.build_aco_star, "ACO*",
                       "RFD paper, ACO*: eq. 7 over the goal distance"),
     "max_min_aco": Entry(max_min.MaxMinConfig, max_min.build_max_min_aco, "Max-Min ACO",
                          "Max-Min ACO paper, section 4"),
@@ -91,8 +91,34 @@ def make(name: str, **config) -> Swarm:
 
 @functools.lru_cache(maxsize=None)
 def _build(name: str, config) -> Swarm:
-    return dataclasses.replace(REGISTRY[name].build(config),
-                               rebuild=functools.partial(_build, name))
+    return REGISTRY[name].build(config)
+
+
+def built_again(swarm: Swarm, config) -> Swarm:
+    """The registered swarm ``swarm`` built with another ``config`` of its Config class (how
+    the executor gives a swarm's walks more room).
+
+    Raises:
+      ValueError: ``swarm`` was not built by the registry.
+    """
+    if (swarm.name not in REGISTRY or type(swarm.config) is not REGISTRY[swarm.name].config
+            or _build(swarm.name, swarm.config) is not swarm):
+        raise ValueError(f"swarm {swarm.name!r} was not built by the registry, so it cannot be "
+                         "built again with another config")
+    return _build(swarm.name, config)
+
+
+def register(name: str, entry: Entry) -> None:
+    """Add the swarm ``entry`` as ``name``: :func:`make`, sweeps, tunes and the CLI offer it from
+    then on. What else it offers is declared where it is used, under the same name (its memory's
+    drawing, its change rule, its batch schedule; see :class:`~jaxswarm.swarm.core.Swarm`).
+
+    Raises:
+      TypeError: ``entry`` is not an :class:`Entry`, or its config is not a dataclass.
+      ValueError: ``name`` is taken.
+    """
+    check_new_entry(REGISTRY, name, entry, Entry, "swarm")
+    REGISTRY[name] = entry
 
 
 def config_options(name: str) -> tuple[str, ...]:
@@ -117,10 +143,10 @@ def definition(swarm: Swarm) -> dict:
 
 
 def config_record(config: SwarmConfig) -> dict:
-    """JSON-ready record of a swarm's Config: every field but ``log_moves``, the room of its
-    walks' logs, which changes no result."""
+    """JSON-ready record of a swarm's Config: every field but a walking swarm's ``walker``
+    options, which change no result."""
     record = dataclasses.asdict(config)
-    record.pop("log_moves")
+    record.pop("walker", None)
     return record
 
 

@@ -22,7 +22,7 @@ Each check raises ``AssertionError`` naming what failed:
   (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`) to compare with the run alone.
 
 The first three checks share two programs per swarm: one run, and one batch of ``runs`` runs
-with their keys and params batched (:func:`run_batch`); :func:`check_batch_invariant` adds one
+with their keys and params batched (:func:`~jaxswarm.swarm.executor.run_batch`); :func:`check_batch_invariant` adds one
 batch program per width.
 :class:`Compilations` counts the programs JAX builds while it is open, for checks of one's own
 (a change of the map that must not recompile, a grid of params).
@@ -40,7 +40,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.core import Swarm, Task, World, again_with_room, run
+from jaxswarm.swarm.core import Swarm, Task, World
+from jaxswarm.swarm.executor import ONE_AT_A_TIME, run, run_batch
 from jaxswarm.world.paths import is_valid_path, path_length
 from jaxswarm.world.plane import Plane, in_plane, trajectory_length, violations
 
@@ -84,24 +85,6 @@ class Compilations:
         jax.monitoring.unregister_event_duration_listener(self._listen)
 
 
-def run_batch(swarm: Swarm, keys: jax.Array, world: World, task: Task, params, *,
-              iterations: int):
-    """``vmap`` of :func:`~jaxswarm.swarm.core.run` over ``keys`` (key[N]) and ``params`` (a
-    Params tuple of f32[N] leaves) in one world (a Graph or a Plane) and task: ``(state,
-    trace)`` with a leading axis N on every leaf. The batch the checks share (one program per
-    swarm, N and iterations); made again with room for every move when a walk overflowed its
-    log (:func:`~jaxswarm.swarm.core.with_room`)."""
-    return again_with_room(
-        lambda swarm: _run_batch(swarm, keys, world, task, params, iterations=iterations),
-        swarm, lambda result: result[1].overflowed)
-
-
-@functools.partial(jax.jit, static_argnames=("swarm", "iterations"))
-def _run_batch(swarm: Swarm, keys, world, task, params, *, iterations: int):
-    return jax.vmap(lambda key, p: run(swarm, key, world, task, p, iterations=iterations))(
-        keys, params)
-
-
 def batched_params(params, runs: int):
     """``params`` (a Params tuple of scalars) repeated ``runs`` times: f32[runs] leaves."""
     return jax.tree_util.tree_map(lambda x: jnp.full((runs,), x, jnp.float32), params)
@@ -132,9 +115,9 @@ def outcome(result):
 def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
                        keys: int = 3, runs: int = 8) -> None:
     """Same key, same result; the first ``keys`` rows of a batch of ``runs`` runs
-    (:func:`run_batch`, every run another key) equal those runs one at a time (see
+    (:func:`~jaxswarm.swarm.executor.run_batch`, every run another key) equal those runs one at a time (see
     :func:`outcome`); keys differ. For a swarm whose ``vmap`` runs its members one at a time
-    (:attr:`~jaxswarm.swarm.core.Swarm.vmap_one_at_a_time`), each row's walks were its own:
+    (:data:`~jaxswarm.swarm.executor.ONE_AT_A_TIME`), each row's walks were its own:
     their lane-steps are those of the run alone (in lockstep they are the batch's)."""
     split = jax.random.split(jax.random.key(7), runs)
     params = swarm.default_params
@@ -147,12 +130,12 @@ def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: in
     for i in range(keys):
         assert leaves_equal(jax.tree_util.tree_map(lambda x: x[i], rows), outcome(one[i])), (
             f"{swarm.name}: vmap row {i} differs from run")
-        if swarm.vmap_one_at_a_time:
+        if swarm.name in ONE_AT_A_TIME:
             assert np.array_equal(np.asarray(batch[1].lane_steps)[i], one[i][1].lane_steps), (
                 f"{swarm.name}: vmap row {i} did not walk alone")
     # Another key walks other agents: the memory or the share that arrived differs.
-    assert not leaves_equal((swarm.memory(one[0][0]), one[0][1].arrived),
-                            (swarm.memory(one[1][0]), one[1][1].arrived)), (
+    assert not leaves_equal((dataclasses.replace(one[0][0], key=None), one[0][1].arrived),
+                            (dataclasses.replace(one[1][0], key=None), one[1][1].arrived)), (
         f"{swarm.name}: two keys gave the same run")
 
 
@@ -200,7 +183,7 @@ def check_unreachable_goal(swarm: Swarm, graph: World, task: Task, *,
     path: ``found`` is false, the cost infinite, the path all -1, no agent arrived in any
     iteration, and the run used all ``iterations`` (no agent arrived, so no iteration
     converged; patience counts only from the first path, which
-    :func:`~jaxswarm.swarm.core.run` applies alike to every swarm)."""
+    :func:`~jaxswarm.swarm.executor.run` applies alike to every swarm)."""
     state, trace = run(swarm, jax.random.key(0), graph, task, swarm.default_params,
                        iterations=iterations)
     solution = swarm.best(state)
@@ -228,7 +211,7 @@ def _check_trajectory(swarm: Swarm, plane: Plane, task: Task, solution) -> None:
 
 def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
                         runs: int = 8) -> None:
-    """A batch of ``runs`` runs (:func:`run_batch`) over valid values of the first param builds
+    """A batch of ``runs`` runs (:func:`~jaxswarm.swarm.executor.run_batch`) over valid values of the first param builds
     at most one program (none if an earlier check built it), and new values of the same shapes
     build none."""
     first = swarm.default_params._fields[0]
@@ -255,7 +238,7 @@ WIDTHS = (1, 3, 64)
 def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations: int = 8,
                           widths: tuple[int, ...] = WIDTHS, keys: int | None = None) -> None:
     """One key, one result: each of ``keys`` keys (default the widest width) run alone equals
-    the same key in vmapped batches (:func:`run_batch`) of each of ``widths``, every leaf of its
+    the same key in vmapped batches (:func:`~jaxswarm.swarm.executor.run_batch`) of each of ``widths``, every leaf of its
     final state and trace bit for bit (:func:`outcome`). A width's last batch is filled up with
     the last key."""
     count = max(widths) if keys is None else keys

@@ -2,15 +2,11 @@
 
 Per map, the runs are ordered combination-major (run ``r`` = combination ``r // S``, seed
 ``seeds[r % S]``) and cut into chunks of ``chunk_size``. A chunk is one call of the swarm's
-compiled batches (:class:`~jaxswarm.sweep.batches.RunBatches`): its runs are shared out over
-``jax.devices()`` (``shard_map``), and each device goes through its share a group of runs at a
-time, a ``vmap`` of :func:`jaxswarm.swarm.run` over keys and stacked params inside ``lax.map``.
-Under that ``vmap`` the walks of a group's runs share one queue of agents over the walker's lanes
-(:func:`jaxswarm.swarm.walking.walk`), and a run that stopped walks no more, so small swarms fill
-the lanes from many runs: the group is ``vmap_size`` runs, by default enough to fill the lanes
-(:func:`jaxswarm.sweep.batches.group_size`). A swarm whose ``vmap`` runs its members one at a
-time (:attr:`jaxswarm.swarm.core.Swarm.vmap_one_at_a_time`) goes through its group's runs one
-after another. Maps of the same shape share the compiled program; each compile is logged. A run
+compiled batches (:class:`~jaxswarm.sweep.batches.RunBatches`, through the executor's
+:class:`~jaxswarm.swarm.executor.ShardedRuns`): its runs are shared out over ``jax.devices()``,
+and each device goes through its share a group of ``vmap_size`` runs at a time (by default enough
+to fill the walker's lanes, :func:`jaxswarm.swarm.executor.group_size`). Maps of the same shape
+share the compiled program; each compile is logged. A run
 with seed ``s`` uses ``jax.random.key(s)``, so a row equals ``run(swarm, jax.random.key(s), ...)``
 bit for bit whatever the chunk size, the group size and the number of devices or threads (the
 arithmetic of :mod:`jaxswarm.runtime.arithmetic`); its ``fingerprint`` column says so

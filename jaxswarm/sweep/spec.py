@@ -83,7 +83,7 @@ class SweepSpec:
         resumed sweep skips).
       vmap_size: runs vmapped together on one device; a device goes through its share of a
         chunk that many at a time, the walks of a group sharing one queue of agents. None:
-        enough runs to fill the walker's lanes (:func:`jaxswarm.sweep.batches.group_size`). It
+        enough runs to fill the walker's lanes (:func:`jaxswarm.swarm.executor.group_size`). It
         changes speed, never results.
       config: static keyword arguments of the swarm factory.
       params: param name -> tuple of float values (swept params only).

@@ -29,7 +29,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.colony import colony, deposit
-from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
+from jaxswarm.swarm.core import Swarm, WalkingConfig, default_params
 from jaxswarm.swarm.walking import on_walk
 
 TAU_FLOOR = float(jnp.finfo(jnp.float32).tiny)
@@ -97,13 +97,13 @@ def _deposit_moves(rows, run, graph):
     return deposit(graph, pheromone, path[:, :-1], slots, amount)
 
 
-def build_ant_system(config: SwarmConfig) -> Swarm:
+def build_ant_system(config: WalkingConfig) -> Swarm:
     """Ant System (RFD paper eqs. 7-9), with :class:`AntSystemParams`."""
     return colony("ant_system", config, default_params=DEFAULT_ANT_SYSTEM,
                   update=ant_system_update)
 
 
-def build_aco_star(config: SwarmConfig) -> Swarm:
+def build_aco_star(config: WalkingConfig) -> Swarm:
     """ACO*: Ant System with the goal-distance heuristic, with :class:`ACOStarParams`."""
     return colony("aco_star", config, default_params=DEFAULT_ACO_STAR,
                   update=ant_system_update, goal_distance=True)

@@ -145,18 +145,15 @@ def colony(name: str, config, *, default_params, update: Update, init_best=None,
                                 goal_distance=goal_distance)
         ants = walk(walk_key, graph, table, task.start, task.goal,
                     num_agents=config.num_agents,
-                    max_steps=step_budget(graph, config.max_steps), log_moves=config.log_moves)
+                    max_steps=step_budget(graph, config.max_steps), walker=config.walker)
         best_path, best_cost, info = keep_best(ants, state.best_path, state.best_cost,
                                                ties=ties)
         pheromone = update(graph, state.pheromone, ants, best_path, best_cost, info, params)
         return ACOState(key=key, pheromone=pheromone, best_path=best_path,
                         best_cost=best_cost), info
 
-    adapt = pheromone_rule if init_best is None else first_path_rule(init_best)
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
-                 best=best_solution, default_params=default_params, check_params=check_params,
-                 memory=lambda state: ordered_sum(state.pheromone),
-                 memory_label="pheromone on a node's edges", adapt=adapt)
+                 best=best_solution, default_params=default_params, check_params=check_params)
 
 
 def first_path_rule(init_best):

@@ -23,8 +23,8 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.bug2 import first_ant_path
-from jaxswarm.swarm.aco.colony import colony, reinforce, transition_rule
-from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
+from jaxswarm.swarm.aco.colony import colony, first_path_rule, reinforce, transition_rule
+from jaxswarm.swarm.core import Swarm, WalkingConfig, default_params
 
 FIRST_ANTS = ("weighted", "greedy")
 """How the first ant chooses among its admissible moves: drawn by its weights (the paper), or
@@ -32,7 +32,7 @@ always the most likely one."""
 
 
 @dataclasses.dataclass(frozen=True)
-class ImprovedConfig(SwarmConfig):
+class ImprovedConfig(WalkingConfig):
     """Static switches of Improved Max-Min ACO, whose populations are of 50 ants (the paper's).
 
     Attributes:
@@ -77,8 +77,10 @@ DEFAULT_IMPROVED = default_params(ImprovedParams, rho=0.1, q=0.1, alpha=1.0, bet
 pheromone stays at tau0 while every other edge decays to the floor) and tau_min are ours."""
 
 
-def build_improved_max_min_aco(config: ImprovedConfig) -> Swarm:
-    """Improved Max-Min ACO (the Max-Min ACO paper's Algorithm 1), with :class:`ImprovedParams`."""
+def first_ant(config: ImprovedConfig):
+    """The Bug2-like first ant of ``config``: ``(key, graph, task, pheromone f32[N, K], params,
+    length) -> (path i32[length], cost f32[])``, its path and length (-1 and inf when it found
+    none or its path is longer than ``length``)."""
     def init_best(key, graph, task, pheromone, params, length):
         table = transition_rule(graph, task, pheromone, params, direction=True,
                                 beta=params.beta_first)
@@ -88,10 +90,21 @@ def build_improved_max_min_aco(config: ImprovedConfig) -> Swarm:
         path = jnp.pad(path, (0, max(length - path.shape[0], 0)), constant_values=-1)[:length]
         return jnp.where(fits, path, -1), jnp.where(fits, cost, jnp.inf).astype(jnp.float32)
 
+    return init_best
+
+
+def build_improved_max_min_aco(config: ImprovedConfig) -> Swarm:
+    """Improved Max-Min ACO (the Max-Min ACO paper's Algorithm 1), with :class:`ImprovedParams`."""
     def update(graph, pheromone, ants, best_path, best_cost, info, params):
         pheromone = jnp.maximum((1.0 - params.rho) * pheromone, params.tau_min)
         return reinforce(graph, pheromone, best_path,
                          jnp.where(jnp.isfinite(best_cost), params.q, 0.0))
 
     return colony("improved_max_min_aco", config, default_params=DEFAULT_IMPROVED,
-                  update=update, init_best=init_best, direction=True, ties=True)
+                  update=update, init_best=first_ant(config), direction=True, ties=True)
+
+
+def change_rule(config: ImprovedConfig):
+    """Improved Max-Min ACO's rule for a change of the map or the task
+    (:func:`~.colony.first_path_rule`): every re-plan begins with the first ant."""
+    return first_path_rule(first_ant(config))

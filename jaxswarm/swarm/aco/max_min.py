@@ -21,11 +21,11 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.aco.colony import colony, reinforce
-from jaxswarm.swarm.core import Swarm, SwarmConfig, default_params
+from jaxswarm.swarm.core import Swarm, WalkingConfig, default_params
 
 
 @dataclasses.dataclass(frozen=True)
-class MaxMinConfig(SwarmConfig):
+class MaxMinConfig(WalkingConfig):
     """Static switches of Max-Min ACO (the defaults are the paper's use of it).
 
     Attributes:

@@ -238,8 +238,8 @@ def _step(config: CABCConfig, state: CABCState, plane: Plane, task: Task,
     return after, info
 
 
-def _adapt(config: CABCConfig, state: CABCState, before: Plane, after: Plane, old_task: Task,
-           new_task: Task, params: CABCParams) -> CABCState:
+def change_rule(config: CABCConfig, state: CABCState, before: Plane, after: Plane,
+                old_task: Task, new_task: Task, params: CABCParams) -> CABCState:
     """cABC's rule for a change of the plane or the goal: the vehicle remembers nothing of the
     plane, so it goes on from where it stands, towards the (possibly new) goal; a new goal
     makes an arrived vehicle set out again."""
@@ -256,5 +256,4 @@ def build_cabc(config: CABCConfig) -> Swarm:
     return Swarm(name="cabc", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, config)), best=trajectory,
                  default_params=cabc_defaults(config.num_agents), check_params=check_cabc,
-                 memory=lambda state: state.waypoints, memory_label=WAYPOINTS_LABEL,
-                 adapt=functools.partial(_adapt, config), world=Plane)
+                 world=Plane)

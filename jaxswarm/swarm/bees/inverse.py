@@ -29,7 +29,7 @@ import optax
 
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.runtime.evolution import antithetic_gradient
-from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.core import Swarm, Task, run_loop
 from jaxswarm.world.plane import Plane
 
 WEIGHTS = ("w1", "w2", "w3")
@@ -78,7 +78,8 @@ def make_scorer(swarm: Swarm, plane: Plane, task: Task, params, seeds, *,
 
     def one(key, weights):
         chosen = params._replace(**{name: weights[i] for i, name in enumerate(WEIGHTS)})
-        state, _ = run(swarm, key, plane, task, chosen, iterations=iterations)
+        state, _ = run_loop(swarm, key, plane, task, chosen, None, jnp.int32(iterations),
+                            iterations=iterations, patience=None)
         solution = swarm.best(state)
         return solution.cost, solution.found
 

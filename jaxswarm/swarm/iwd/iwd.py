@@ -26,12 +26,12 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.runtime.arithmetic import ordered_sum
-from jaxswarm.swarm.core import (ParamError, Swarm, SwarmConfig, Task, best_solution,
+from jaxswarm.swarm.core import (ParamError, Swarm, Task, WalkingConfig, best_solution,
                                  check_positive, default_params, keep_best, shown)
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update,
                                      choice_log_weights, global_update, goal_log_desirability,
                                      walked_soil)
-from jaxswarm.swarm.walking import Walk, edge_table, fold_agents, step_budget, walk
+from jaxswarm.swarm.walking import Walk, WalkerOptions, edge_table, fold_agents, step_budget, walk
 from jaxswarm.swarm.walking.backtrack import backtracking_walk
 from jaxswarm.world.graph import Graph
 
@@ -41,7 +41,7 @@ LOCAL_UPDATES = ("arrived", "while_walking")
 
 
 @dataclasses.dataclass(frozen=True)
-class IWDConfig(SwarmConfig):
+class IWDConfig(WalkingConfig):
     """Static sizes and switches of IWD (the defaults are the paper's algorithm).
 
     Attributes:
@@ -178,10 +178,10 @@ def initial_soil(graph: Graph, params: IWDParams) -> jax.Array:
 
 def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_agents: int,
               max_steps: int | None, local_updates: str = "arrived",
-              backtrack: bool = False, log_moves: int | None = None) -> Walk:
+              backtrack: bool = False, walker: WalkerOptions = WalkerOptions()) -> Walk:
     """One iteration's drops walking from ``task.start`` over ``soil`` (f32[N, K]) with their
-    local updates (``local_updates`` and ``backtrack`` as in :class:`IWDConfig`, ``log_moves``
-    as in :class:`~jaxswarm.swarm.core.SwarmConfig`).
+    local updates (``local_updates`` and ``backtrack`` as in :class:`IWDConfig`, ``walker``
+    as in :class:`~jaxswarm.swarm.core.WalkingConfig`).
 
     Returns:
       The :class:`~jaxswarm.swarm.walking.Walk`, its ``memory`` the soil after the local
@@ -194,14 +194,14 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     if local_updates == "while_walking":
         return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                     max_steps=budget, hook=SOIL, memory=soil, hook_params=params,
-                    log_moves=log_moves)
+                    walker=walker)
     if backtrack:
         drops = backtracking_walk(key, graph, soil_choice(graph, table, soil, params),
                                   task.start, task.goal, num_agents=num_agents, max_steps=budget)
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params,
-                     log_moves=log_moves)
+                     walker=walker)
     lost = jnp.full(drops.arrived.shape, jnp.nan, jnp.float32)
     memory, velocity, carried = fold_agents(_arrived_drop, drops.log, (soil, lost, lost),
                                             (soil, params), graph, used=drops.arrived)
@@ -271,12 +271,11 @@ def build_iwd(config: IWDConfig) -> Swarm:
         drops = drop_walk(walk_key, graph, task, state.soil, params,
                           num_agents=config.num_agents, max_steps=config.max_steps,
                           local_updates=config.local_updates, backtrack=config.backtrack,
-                          log_moves=config.log_moves)
+                          walker=config.walker)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
         soil = soil_after_best(graph, drops, drops.agent_path, costs, params)
         return IWDState(key=key, soil=soil, best_path=best_path, best_cost=best_cost), info
 
     return Swarm(name="iwd", config=config, init=jax.jit(init), step=jax.jit(step),
-                 best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd,
-                 memory=soil_per_node, memory_label=SOIL_LABEL, adapt=soil_rule)
+                 best=best_solution, default_params=DEFAULT_IWD, check_params=check_iwd)

@@ -199,7 +199,7 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
     drops = drop_walk(walk_key, graph, task, state.soil, params,
                       num_agents=config.num_agents, max_steps=config.max_steps,
                       local_updates=config.local_updates, backtrack=config.backtrack,
-                      log_moves=config.log_moves)
+                      walker=config.walker)
     paths, lengths = _measured_paths(graph, drops, smooth=config.smooth)
     _, _, info = keep_best(drops, state.best_path, state.best_cost, paths=paths,
                            lengths=lengths)
@@ -544,7 +544,7 @@ def _section_spans(graph: Graph, paths, section, axis, sections: int):
     return jnp.minimum(begins, ends), ends
 
 
-def _adapt(state: IWDPGState, before: Graph, after: Graph, old: Task, new: Task,
+def change_rule(state: IWDPGState, before: Graph, after: Graph, old: Task, new: Task,
            params: IWDParams) -> IWDPGState:
     """IWD_PG's rule for a change of the map or the goal: the soil as IWD keeps it
     (:func:`~.iwd.soil_rule`), the memory emptied (its paths may cross the change)."""
@@ -564,5 +564,4 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
     setup = _Setup(config=config, local=local)
     return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, setup)), best=best_solution,
-                 default_params=STANDARD_IWD, check_params=check_iwd, memory=soil_per_node,
-                 memory_label=SOIL_LABEL, adapt=_adapt, vmap_one_at_a_time=True)
+                 default_params=STANDARD_IWD, check_params=check_iwd)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.swarm.core import Swarm, Task, run
+from jaxswarm.swarm.core import Swarm, Task, run_loop
 from jaxswarm.swarm.iwd.memory import prefix_lengths, splice
 from jaxswarm.swarm.iwd.smooth import IMPROVEMENT
 from jaxswarm.world.graph import Graph
@@ -19,8 +19,8 @@ from jaxswarm.world.paths import path_length
 def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations: int):
     """The best path of a small IWD run from node ``here`` to ``there``: ``(path i32[L], cost
     f32[] (inf if no drop arrived), evaluations i32[])``."""
-    state, trace = run(swarm, key, graph, Task(start=here, goal=there), params,
-                       iterations=iterations)
+    state, trace = run_loop(swarm, key, graph, Task(start=here, goal=there), params, None,
+                            jnp.int32(iterations), iterations=iterations, patience=None)
     return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
 
 

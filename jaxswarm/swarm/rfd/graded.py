@@ -45,7 +45,7 @@ import jax.numpy as jnp
 from jaxswarm.exact.field import distance_field
 from jaxswarm.runtime.arithmetic import ordered_cumsum
 from jaxswarm.runtime.batching import one_at_a_time
-from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
+from jaxswarm.swarm.core import Swarm, WalkingConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import RFDState, check_greedy_drops, gradients, river_swarm
 from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
@@ -67,7 +67,7 @@ lower to reduce-windows whose cost grows with the square of the block width on C
 
 
 @dataclasses.dataclass(frozen=True)
-class GradedConfig(SwarmConfig):
+class GradedConfig(WalkingConfig):
     """Static sizes and switches of ``rfd_graded``.
 
     Attributes:
@@ -259,4 +259,4 @@ def build_rfd_graded(config: GradedConfig) -> Swarm:
 
     return river_swarm("rfd_graded", config, transition=graded_transition, reshape=reshape,
                        greedy_drops=config.greedy_drops, default_params=DEFAULT_GRADED,
-                       check_params=_check_graded, adapt=regrade)
+                       check_params=_check_graded)

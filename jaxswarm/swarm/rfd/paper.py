@@ -42,7 +42,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.runtime.arithmetic import exp, ordered_sum
-from jaxswarm.swarm.core import Swarm, SwarmConfig, Task, check_positive, default_params
+from jaxswarm.swarm.core import Swarm, WalkingConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import (add_compensated, check_greedy_drops, gradients,
                                       river_swarm, sediment_where_stuck)
@@ -60,12 +60,12 @@ MAX_LOG_EROSION = 60.0
 """Cap on ``log(p_base ** gradient)`` in the exponential erosion (float32 overflows near 88)."""
 
 
-RFDConfig = SwarmConfig
+RFDConfig = WalkingConfig
 """The original RFD has only the sizes (``num_agents`` is D, the drops per iteration)."""
 
 
 @dataclasses.dataclass(frozen=True)
-class RFDStarConfig(SwarmConfig):
+class RFDStarConfig(WalkingConfig):
     """Static sizes and switches of RFD* (the defaults are the paper's algorithm).
 
     Attributes:
@@ -228,7 +228,7 @@ def _check_rfd_star(params: RFDStarParams) -> None:
     check_positive("sediment", params.sediment, allow_zero=True)
 
 
-def build_rfd(config: SwarmConfig) -> Swarm:
+def build_rfd(config: WalkingConfig) -> Swarm:
     """The original River Formation Dynamics (eqs. 1-5), with :class:`RFDParams`."""
     def reshape(graph, task, altitude, residual, table, drops, params):
         altitude, residual = add_compensated(

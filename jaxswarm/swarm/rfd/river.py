@@ -64,7 +64,7 @@ and what float32 rounding lost of them (see :func:`add_compensated`)."""
 
 
 def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
-                greedy_drops: int, default_params, check_params, adapt=None) -> Swarm:
+                greedy_drops: int, default_params, check_params) -> Swarm:
     """A river formation Swarm from its transition rule and its altitude update.
 
     Args:
@@ -75,8 +75,6 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
       greedy_drops: how many drops (the first ones) take their most likely move.
       default_params: the variant's default Params.
       check_params: host-side Params check.
-      adapt: the memory rule of a change (``Swarm.adapt``); default
-        :func:`paper_altitude_rule`.
     """
     def init(key, graph: Graph, task: Task, params) -> RFDState:
         altitude = jnp.full((graph.num_nodes,), params.initial_height,
@@ -92,7 +90,7 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
         drops = walk(walk_key, graph, table, task.start, task.goal,
                      num_agents=config.num_agents,
                      max_steps=step_budget(graph, config.max_steps),
-                     greedy_agents=greedy_drops, log_moves=config.log_moves)
+                     greedy_agents=greedy_drops, walker=config.walker)
         altitude, residual = reshape(graph, task, state.altitude, state.residual, table, drops,
                                      params)
         altitude = jnp.maximum(altitude, 0.0).at[task.goal].set(0.0)
@@ -102,9 +100,7 @@ def river_swarm(name: str, config, *, transition: Transition, reshape: Reshape,
                         best_cost=best_cost), info
 
     return Swarm(name=name, config=config, init=jax.jit(init), step=jax.jit(step),
-                 best=best_solution, default_params=default_params, check_params=check_params,
-                 memory=lambda state: state.altitude, memory_label="altitude",
-                 adapt=paper_altitude_rule if adapt is None else adapt)
+                 best=best_solution, default_params=default_params, check_params=check_params)
 
 
 def paper_altitude_rule(state: RFDState, before: Graph, after: Graph, old: Task, new: Task,

@@ -9,15 +9,15 @@ from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_LANES, LANES,
                                          SMALLEST_COMPACTION, STEPS_PER_REFILL, Walk,
                                          lanes_for, visited_nodes, walk)
-from jaxswarm.swarm.walking.log import MoveLog
+from jaxswarm.swarm.walking.log import EVERY_MOVE, MoveLog, WalkerOptions
 from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves, on_walk
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
                                            neighbour_slots, step_budget)
 
-__all__ = ["AGENTS_PER_LANE", "COMPACT_SHARE", "EdgeGroups", "FEWEST_LANES", "FORCED", "LANES",
-           "Move", "MoveLog", "SMALLEST_COMPACTION", "STEPS_PER_REFILL", "StepHook", "Walk",
-           "edge_groups", "edge_table", "fold_agents", "goal_log_distance", "heads", "lanes_for",
-           "move_widths", "neighbour_slots", "on_moves", "on_walk", "sample_masked",
-           "step_budget", "uniforms", "visited_nodes", "walk"]
+__all__ = ["AGENTS_PER_LANE", "COMPACT_SHARE", "EVERY_MOVE", "EdgeGroups", "FEWEST_LANES",
+           "FORCED", "LANES", "Move", "MoveLog", "SMALLEST_COMPACTION", "STEPS_PER_REFILL",
+           "StepHook", "Walk", "WalkerOptions", "edge_groups", "edge_table", "fold_agents",
+           "goal_log_distance", "heads", "lanes_for", "move_widths", "neighbour_slots", "on_moves",
+           "on_walk", "sample_masked", "step_budget", "uniforms", "visited_nodes", "walk"]

@@ -12,12 +12,11 @@ Capacity: the log of a walk of ``A`` agents has room for ``A`` times the blocks 
 the whole budget fit beside the many that stop early. Shapes are static, so a walk whose agents
 made more moves than that cannot keep them all: its log says so (``overflowed``), the moves of
 some agents are missing from it, and what is read from it is wrong. The run that made it is
-run again with room for every agent's whole budget (:func:`jaxswarm.swarm.core.run`,
-the sweep runner and :func:`~jaxswarm.swarm.testing.run_batch` do it; a caller who maps
-:func:`~jaxswarm.swarm.core.run` itself reads ``Trace.overflowed``): the log's size changes no
-move, so the result is the one a larger log would have given. :func:`default_log_moves` is the
-room a large walk gets when its swarm does not say (:func:`room_blocks`; a small one gets room
-for every move).
+run again with room for every agent's whole budget (:mod:`jaxswarm.swarm.executor` does it;
+a caller who maps a run inside a program of its own reads ``Trace.overflowed``): the log's size
+changes no move, so the result is the one a larger log would have given.
+:func:`default_log_moves` is the room a large walk gets when its swarm does not say
+(:func:`room_blocks`; a small one gets room for every move).
 
 Reading the log: :func:`paths` gives agents' paths and slots padded to a width (the columns a
 rule needs, cut as :func:`~jaxswarm.swarm.walking.moves.on_walk` cuts them), :func:`columns`
@@ -40,6 +39,29 @@ BLOCK = 16
 
 ROOM_FOR_EVERY_MOVE = 2 ** 31 - 1
 """A ``log_moves`` that gives every agent room for its whole step budget: no walk overflows."""
+
+
+@dataclasses.dataclass(frozen=True)
+class WalkerOptions:
+    """How a swarm's walks are run, as a walking family's Config holds it (its ``walker``
+    field) and hands it to :func:`~jaxswarm.swarm.walking.loop.walk` unread. Changes no result:
+    only the memory of a walk and how often a run is made again because a walk overflowed.
+
+    Attributes:
+      log_moves: moves per agent, on average, a walk's log has room for; None:
+        :func:`~jaxswarm.swarm.walking.log.room_blocks` (room for every move on
+        small maps).
+    """
+
+    log_moves: int | None = None
+
+    def __post_init__(self):
+        if self.log_moves is not None and self.log_moves < 1:
+            raise ValueError(f"log_moves must be at least 1, got {self.log_moves}")
+
+
+EVERY_MOVE = WalkerOptions(log_moves=ROOM_FOR_EVERY_MOVE)
+"""Walker options with room for every agent's whole step budget: no walk overflows."""
 
 SMALLEST_DEFAULT_ROOM = 8 * BLOCK
 """The fewest moves per agent :func:`default_log_moves` gives a walk's log (small maps, whose

@@ -61,8 +61,8 @@ from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
 from jaxswarm.swarm.walking.journal import Journal, append, empty_journal, ordered_logs
-from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path, known_overflowed, paths,
-                                        room_blocks)
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, WalkerOptions, agent_path,
+                                        known_overflowed, paths, room_blocks)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
@@ -163,8 +163,8 @@ def _padded(log: MoveLog):
     """
     if known_overflowed(log.overflowed):
         raise ValueError("the walk's log had no room for all its moves: walk again with a "
-                         "larger log_moves (jaxswarm.swarm.walking.log.ROOM_FOR_EVERY_MOVE "
-                         "has room for every move)")
+                         "larger log (jaxswarm.swarm.walking.log.EVERY_MOVE has room for "
+                         "every move)")
     return _written_out(log)
 
 
@@ -185,10 +185,10 @@ def visited_nodes(walk: Walk, num_nodes: int, which: jax.Array | None = None) ->
 
 
 @functools.partial(jax.jit, static_argnames=("num_agents", "max_steps", "greedy_agents", "hook",
-                                             "log_moves"))
+                                             "walker"))
 def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, num_agents: int,
          max_steps: int, greedy_agents: int = 0, hook: StepHook | None = None, memory=None,
-         hook_params=None, log_moves: int | None = None) -> Walk:
+         hook_params=None, walker: WalkerOptions = WalkerOptions()) -> Walk:
     """Walk ``num_agents`` agents from ``start`` towards ``goal``.
 
     Args:
@@ -206,20 +206,18 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       hook: memory that changes at every step (static; see :mod:`.hooks`), or None.
       memory: the hook's memory before the walk (a pytree).
       hook_params: the hook's numbers (a pytree of traced scalars).
-      log_moves: the moves per agent, on average, the walk's log has room for (static; None:
-        :func:`~.log.room_blocks`); more, and the log says it overflowed (:mod:`.log`).
+      walker: the room of the walk's log (static, :class:`~.log.WalkerOptions`); a walk that
+        made more moves says it overflowed (:mod:`.log`).
 
     Returns:
       A :class:`Walk`. One compiled program per set of static options and shapes, called alone
       or inside ``jit``; under ``vmap`` the walks of the batch share one queue (module
       docstring).
     """
-    if log_moves is not None and log_moves < 1:
-        raise ValueError(f"log_moves must be at least 1, got {log_moves}")
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
-    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, log_moves,
+    walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, walker.log_moves,
                           step_budget(graph, None))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
