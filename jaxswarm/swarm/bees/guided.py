@@ -7,14 +7,15 @@
 * ``f2`` (pushback, :func:`pushback`): the sum of ``reach - d`` over four rays from ``x`` along
   +x, -x, +y and -y, ``reach`` (half the sensor window) long, ``d`` where each first meets the
   rectangles' parts inside the window (``reach`` if none): in ``[0, 4 reach]``;
-* ``f3`` (smoothness, :func:`turn_angle`): the turn from the last move to ``here -> x``, in
-  ``turn_unit`` (one of :data:`TURN_UNITS`; degrees are cABC's default), 0 before the first move;
+* ``f3`` (smoothness, :func:`turn_angle`): the turn from the last move to ``here -> x``, 0 before
+  the first, in ``turn_unit`` (:data:`TURN_UNITS`): degrees by default, as in radians a turn
+  weighs less than a step towards the goal and f3 changes nothing;
 * ``w4 f4`` (ours, the paper's future work; :func:`revisits`): how many sensor windows of the
   vehicle's earlier positions contain ``x``.
 
-:func:`constraint_violations` counts eq. 6's violations (:func:`jaxswarm.world.plane.violations`),
-with ``forbid_crossing`` (ours) the rectangles the move passes through too. The text lost f2's and
-f3's formulas: ``docs/papers.md`` says how we read them, and why f3 is in degrees.
+:func:`constraint_violations` counts eq. 6's violations, with ``forbid_crossing`` (ours) also the
+rectangles the move passes through. The text lost f2's and f3's formulas; ``docs/papers.md`` says
+how we read them and what each unit of f3 gives.
 """
 from __future__ import annotations
 
