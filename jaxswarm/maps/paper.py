@@ -1,29 +1,15 @@
 """The RFD paper's nine test maps, rebuilt: maze, mosaic and alley at 20x20, 50x50 and 100x100.
 
-The paper (river formation dynamics vs. A*, Dijkstra and ant colonies; section 3, Figure 3,
-Table 1) never published its maps, only their kind, size, start and goal and the optimal
-(Dijkstra) path lengths. These are our own maps in the spirit of its Figure 3, with the paper's
-exact start and goal cells and optima of the same order as the paper's (see ``PAPER_OPTIMA``):
-
-* **maze**: corridors one cell wide with long detours. A perfect maze is carved on a lattice of
-  cells (every second row and column) by a randomized depth-first search with a fixed seed, and
-  a few extra walls are knocked out to make loops. Start and goal are opposite corners.
-* **mosaic**: a regular field of square blocks separated by two-cell lanes; every second block
-  column is shifted down by half a period (a staggered checkerboard). Vertical lanes run through,
-  horizontal ones do not, so a horizontal start-goal line weaves between the blocks.
-* **alley**: long vertical walls (perpendicular to the horizontal start-goal line) across the
-  whole map, each with one opening, alternately above and below the start-goal row, so the path
-  zigzags through the openings; the wall parts beyond the openings are blind alleys, and short
-  spurs sticking out of the walls clutter the corridors.
-
-Conventions (as in the rest of jaxswarm): ``obstacles`` is bool[H, W] indexed [y, x], True =
-blocked; points are (x, y) with x = column and y = row, 0-based from the top-left. The optima
-quoted in this module are for 8-connected moves of cost 1 (orthogonal) and sqrt(2) (diagonal)
-with no corner cutting (a diagonal move needs both orthogonally adjacent cells free).
-
-Everything is deterministic: the maze uses a seeded ``numpy.random.default_rng`` (no global
-state), and the layout constants below were chosen offline to bring each optimum close to the
-paper's.
+The paper (section 3, Figure 3, Table 1) published only its maps' kind, size, start and goal and
+the optimal (Dijkstra) path lengths. :func:`paper_map` builds our own maps in the spirit of its
+Figure 3, with the paper's start and goal cells and optima of the same order as the paper's
+(:data:`PAPER_OPTIMA`): a seeded perfect **maze** of one-cell corridors with a few loops, a
+staggered **mosaic** of square blocks between two-cell lanes, and **alley** walls across the
+map, each with one opening, alternately above and below the start-goal row (``docs/papers.md``
+says how each is laid out). ``obstacles`` is bool[H, W] indexed [y, x], True = blocked; points
+are (x, y), 0-based from the top-left; the optima are for 8-connected moves of cost 1 and
+sqrt(2) without corner cutting. Everything is deterministic (a seeded
+``numpy.random.default_rng``, no global state).
 """
 from __future__ import annotations
 

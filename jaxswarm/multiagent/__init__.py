@@ -1,34 +1,19 @@
-"""Many agents on one map: the A* report's two-robot scheme, prioritised space-time A*,
-Conflict-Based Search, PIBT and LaCAM, with one solution format and one validator.
+"""Many agents on one map, with one solution format (:class:`Plan`) and one validator.
 
-* :func:`report_scheme` (:mod:`~jaxswarm.multiagent.report`): A* per robot, then at a collision
-  one robot side-steps while the other waits, or one moves first (the report's section 5).
-* :func:`prioritized` (:mod:`~jaxswarm.multiagent.prioritized`): space-time A* per agent around a
-  reservation table, in a given, distance or seeded random order.
-* :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs;
-  ``prioritize`` and ``bypass`` switch on Boyarski et al.'s improvements, ``avoid`` the
-  conflict avoidance table's tie-break, with MDDs from :mod:`~jaxswarm.multiagent.mdd`; ``wdg``
-  the weighted dependency graph heuristic (:mod:`~jaxswarm.multiagent.dependency`), ``target``,
-  ``corridor`` and ``rectangle`` the symmetry reasoning of
-  :mod:`~jaxswarm.multiagent.constraints`, :mod:`~jaxswarm.multiagent.corridor` and
-  :mod:`~jaxswarm.multiagent.rectangle`.
-* :func:`ecbs` and :func:`eecbs` (:mod:`~jaxswarm.multiagent.ecbs`): Enhanced CBS and Explicit
-  Estimation CBS, within a factor ``w`` of the optimum.
-* :func:`pibt` (:mod:`~jaxswarm.multiagent.pibt`): priority inheritance with backtracking, one
-  step for all agents at a time; fast, incomplete.
-* :func:`lacam` (:mod:`~jaxswarm.multiagent.lacam`): LaCAM, a complete search over
-  configurations with PIBT as its generator, and LaCAM*'s generator (``swap``) and anytime
-  refinement (``refine``).
-* :mod:`~jaxswarm.multiagent.registry`: the planners by name (``icbs``, ``cbsh``, ``cbsh_tc``,
-  ``cbsh_rtc``, ``lacam_star``: the switches of their papers fixed), each with its Config,
-  label, paper and figure style; :func:`make_planner` checks a planner's options before any
-  search. The ``jaxswarm mapf`` command and the MAPF study read it.
-* :func:`validate` (:mod:`~jaxswarm.multiagent.validate`) checks any solution;
-  :func:`find_conflicts` (:mod:`~jaxswarm.multiagent.conflicts`) is its batched JAX conflict
-  check; :class:`Plan` (:mod:`~jaxswarm.multiagent.plan`) is the one result format.
+* :func:`report_scheme`: the A* report's two-robot scheme (its section 5).
+* :func:`prioritized`: space-time A* per agent around a reservation table, in a given, distance
+  or seeded random order.
+* :func:`cbs` (:mod:`~jaxswarm.multiagent.cbs`): Conflict-Based Search, optimal sum of costs,
+  with its papers' improvements as switches; :func:`ecbs` and :func:`eecbs`
+  (:mod:`~jaxswarm.multiagent.ecbs`): within a factor ``w`` of the optimum.
+* :func:`pibt`: one step for all agents at a time, fast and incomplete; :func:`lacam`
+  (:mod:`~jaxswarm.multiagent.lacam`): complete, with LaCAM*'s ``swap`` and ``refine``.
+* :mod:`~jaxswarm.multiagent.registry`: the planners by name, each with its Config, label, paper
+  and figure style (:func:`make_planner`), as the ``jaxswarm mapf`` command and the study read it.
+* :func:`validate` checks any solution; :func:`find_conflicts` is its batched JAX conflict check.
 
 Time is in steps: every agent moves along one edge or waits per step, and an agent's cost is the
-step from which it stays at its goal. On the MAPF benchmark maps (:func:`load_instance`, loaded
+step from which it stays at its goal; on the MAPF benchmark maps (:func:`load_instance`, loaded
 4-connected) that is the benchmark's sum of costs.
 """
 import warnings

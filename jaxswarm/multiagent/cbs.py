@@ -1,34 +1,17 @@
 """Conflict-Based Search (Sharon, Stern, Felner and Sturtevant, 2015): optimal sum of costs.
 
-The high level is a best-first search over constraint trees. A node holds, per agent, the
-constraints "not on node v at step t" and "not along u -> v from step t", and the agents'
-fewest-steps paths under them (space-time A*, :mod:`jaxswarm.multiagent.spacetime`). The node
-with the lowest sum of costs (then the fewest colliding pairs, then the oldest) is expanded: its
-earliest collision (:func:`jaxswarm.multiagent.conflicts.pair_collisions`; the lowest pair at
-equal steps) splits it into two children, each forbidding the collision to one of the two agents
-and re-planning only that agent. The first node without a collision is an optimal solution.
-
-Improvements, each a switch: ``prioritize`` splits on a cardinal collision first, then a
-semi-cardinal one, then any (Boyarski et al., IJCAI 2015, from the agents' MDDs,
-:mod:`jaxswarm.multiagent.mdd`), classifying every collision of every colliding pair and, at
-equal class, taking one that target or corridor reasoning resolves first, as CBSH2-RTC does (Li
-et al., AIJ 2021), then, with ``wdg``, one of the pair the heuristic weighs most (ours:
-CBSH2-RTC breaks that tie at random); ``bypass`` takes a child's path into its parent instead of
-splitting when the child costs no more and collides less (ibid.); ``avoid`` has the low level
-break ties between shortest paths toward the one meeting the fewest other agents (a conflict
-avoidance table, as CBS implementations do); ``wdg`` orders the high level by the sum of costs
-plus the weighted dependency graph heuristic (Li et al., IJCAI 2019;
-:mod:`jaxswarm.multiagent.dependency`), with pathmax, computed when a node first reaches the top
-of the frontier (most never do): CBSH-WDG with all four; ``target`` splits a collision on the
-goal of an agent resting there by when it finishes (target reasoning, Li et al., ICAPS 2020;
-:mod:`jaxswarm.multiagent.constraints`); ``corridor`` splits two agents meeting head-on in a
-corridor by which crosses first (corridor reasoning, ibid.;
-:mod:`jaxswarm.multiagent.corridor`); ``rectangle`` splits two agents crossing a rectangle of a
-grid on shortest paths by a barrier on each one's way out (rectangle reasoning, Li et al., AAAI
-2019; :mod:`jaxswarm.multiagent.rectangle`). All keep CBS optimal.
-
-CBS is for few agents: the number of nodes grows exponentially with the number of collisions
-that have to be resolved. ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
+:func:`cbs` searches constraint trees best first: a node holds each agent's constraints and its
+fewest-steps path under them (space-time A*, :mod:`jaxswarm.multiagent.spacetime`), and the node
+of the least sum of costs splits on its earliest collision into two children, each forbidding it
+to one agent. The improvements, each a switch (:data:`SWITCHES`), keep it optimal: ``prioritize``
+(cardinal collisions first, from MDDs, :mod:`jaxswarm.multiagent.mdd`) and ``bypass`` (Boyarski
+et al., IJCAI 2015); ``avoid`` (a conflict avoidance table breaks the low level's ties); ``wdg``
+(the weighted dependency graph heuristic, Li et al., IJCAI 2019,
+:mod:`jaxswarm.multiagent.dependency`); ``target`` and ``corridor`` (Li et al., ICAPS 2020,
+:mod:`jaxswarm.multiagent.constraints`, :mod:`jaxswarm.multiagent.corridor`); ``rectangle`` (Li
+et al., AAAI 2019, :mod:`jaxswarm.multiagent.rectangle`). ``docs/papers.md`` says how each
+works here. The nodes grow exponentially with the collisions to resolve, so CBS is for few
+agents: ``max_nodes`` and ``time_limit`` end it with a clean "not solved".
 """
 from __future__ import annotations
 

@@ -1,28 +1,14 @@
 """Enhanced CBS (Barer, Sharon, Stern and Felner, SoCS 2014): bounded-suboptimal, within a factor
-w of the least sum of costs.
+w of the least sum of costs; and Explicit Estimation CBS (Li, Ruml and Koenig, AAAI 2021).
 
-Both levels are focal searches. The low level plans one agent in space-time under its CBS
-constraints: of the states whose f = steps + steps to go is at most w times the least f open, it
-expands the one whose path so far collides least with the other agents' current paths (on a node
-at a step, or resting at their goals), then the lowest f. It returns the path and that least f,
-a lower bound on the agent's cost under its constraints. The high level keeps, per constraint-tree
-node, the sum of those bounds (LB) and the sum of costs; of the nodes whose cost is at most w
-times the least LB open, it splits the one with the fewest colliding pairs (then the lowest
-cost) on its earliest collision, as CBS does. The first node without collisions is a solution
-whose sum of costs is at most w times the least LB, itself at most the optimum: the bound it
-proves is ``stats["lower_bound"]``.
-
-Explicit Estimation CBS (:func:`eecbs`; Li, Ruml and Koenig, AAAI 2021) keeps the low level and
-replaces the high level's focal list by explicit estimation search (Thayer and Ruml, IJCAI
-2011). A node's cost to go is estimated from its colliding pairs d: d-hat = d / (1 - e_d)
-collisions left to resolve, each raising the sum of costs by e_h, so f-hat = cost + e_h d-hat;
-e_h and e_d are learnt online, the mean one-step errors of the expansions so far (the cost and
-the collisions a node's best child adds, the latter beyond the one it resolves). Of the open
-nodes it splits the one with the least d-hat among those within w of the least f-hat, if its
-cost is within w of the least LB; else the one of least f-hat, if within w of that; else the
-one of least LB, which raises the bound. Solutions keep ECBS's guarantee. The paper's EECBS
-also adds CBS's improvements (bypassing, prioritised collisions, the WDG heuristic, symmetry
-reasoning); this one has none of them (its admissible heuristic is 0).
+Both levels of :func:`ecbs` are focal searches: the low level plans one agent under its CBS
+constraints, preferring among the states within w of the least f the path that collides least,
+and returns a lower bound on the agent's cost; the high level splits, among the nodes within w
+of the least sum of those bounds (LB), the one with the fewest colliding pairs. The first node
+without collisions costs at most w times the least LB, itself at most the optimum
+(``stats["lower_bound"]``). :func:`eecbs` keeps the low level and replaces the high level's
+focal list by explicit estimation search (Thayer and Ruml, IJCAI 2011) with errors learnt online,
+without the CBS improvements its paper adds. ``docs/papers.md`` details both levels.
 """
 from __future__ import annotations
 

@@ -1,36 +1,17 @@
 """LaCAM: lazy constraint addition search over configurations (Okumura, AAAI 2023), and LaCAM*'s
 anytime refinement (Okumura, IJCAI 2023).
 
-A *configuration* is every agent's node at one step. The high level is a depth-first search over
-configurations; each configuration's successors are made lazily by PIBT
-(:mod:`jaxswarm.multiagent.pibt`) under *constraints*: a constraint tree per configuration whose
-node at depth d fixes the next nodes of the first d agents (in the configuration's priority
-order), and whose children are the d + 1-th agent's candidate nodes (its neighbours and its own,
-in a keyed random order). Each time a configuration is visited, the next node of its tree is
-taken, its constraints given to PIBT, and the resulting configuration pushed (or, if seen before,
-pushed again). Since every tree enumerates every combination of moves in the end, the search
-visits every configuration reachable from the starts: LaCAM is complete, and says "no solution"
-only after it has explored them all.
-
-LaCAM* (``refine``) keeps searching after the first solution, for a time budget: every
-configuration keeps its neighbours and its cost from the starts, where one step costs the number
-of agents not resting at their goals through it (the "sum of loss");
-a configuration reached again by a cheaper way passes the saving on to everything found from it
-(a Dijkstra update, :mod:`jaxswarm.multiagent.explored`), and each configuration whose cost falls
-below the best solution's is searched again (pushed back on the open stack, as the reference
-implementation does), while configurations that cannot beat the best solution are dropped. With a
-small probability a configuration generated again is replaced on the stack by the starts' (the
-reference implementation's random restart). When the search runs out, no solution of a smaller
-sum of loss exists (``stats["optimal"]``); the sum of costs, which also counts the steps an agent
-rests at its goal before it leaves it again, may be above its least. LaCAM*'s other change,
-its successor generator (``swap``: PIBT with the swap operation, which lets two agents meeting
-head on in a corridor trade places where it widens), is a switch of its own.
-
-The search runs compiled (numba, as PIBT's step): one call of its loop takes a few hundred steps
-over the arrays of :mod:`~jaxswarm.multiagent.explored` (the configurations, found by a hash of
-their nodes) and :mod:`~jaxswarm.multiagent.constraint_trees` (the trees, a constraint a few
-numbers), drawing the trees' orders and the restarts from one NumPy ``Generator`` seeded with
-``seed``; between calls Python checks the time, grows the arrays and records the solutions.
+A *configuration* is every agent's node at one step. :func:`lacam` searches configurations depth
+first, each one's successors made lazily by PIBT (:mod:`jaxswarm.multiagent.pibt`) under the
+constraints its constraint tree enumerates; it is complete, saying "no solution" only after
+every configuration reachable from the starts. ``refine`` (LaCAM*) keeps lowering the solution's
+sum of loss (the steps of agents not resting at their goals) for a time budget, by Dijkstra
+updates over the configurations found and random restarts; ``swap`` is LaCAM*'s successor
+generator, PIBT with the swap operation. The search loop runs compiled (numba), a few hundred
+steps a call over the arrays of :mod:`~jaxswarm.multiagent.explored` (the configurations) and
+:mod:`~jaxswarm.multiagent.constraint_trees` (the trees), drawing from one NumPy ``Generator``
+seeded with ``seed``; between calls Python checks the time, grows the arrays and records the
+solutions. ``docs/papers.md`` explains the trees and the refinement.
 """
 from __future__ import annotations
 

@@ -2,31 +2,13 @@
 AAAI 2019, and Li et al., AIJ 2021): one split for two agents whose shortest paths cross a
 rectangle, one from its bottom to its top and the other from its left to its right.
 
-Two such agents collide somewhere in the rectangle whichever of their many equally short paths
-they take, so plain CBS resolves the collision one cell at a time and keeps finding it again.
-Rectangle reasoning splits once, with a *barrier* per agent: a set of vertex constraints along
-the side of the rectangle where that agent leaves it, each at the step the agent would reach
-that cell on a shortest path.
-
-The papers take the barrier times from the agents' MDDs. Here they come from static distances,
-in a form whose split keeps every solution by the following argument. Mirror the grid so both
-agents move right and up. For agent ``i`` let ``D_i`` be the fewest steps from its start to each
-cell (no constraints), and take an *entry* ``S_i``: a cell its path visits at step ``D_i(S_i)``.
-The barrier of agent ``i`` holds the cells ``v`` of its exit side where
-``D_i(v) = D_i(S_i) + |v - S_i|_1`` and every fewest-steps path from its start to ``v`` passes
-``S_i``. A path on such a ``v`` at step ``D_i(v)`` is a fewest-steps path, so it passed ``S_i`` at
-step ``D_i(S_i)`` and went from there to ``v`` with moves right and up only. The rectangle's left
-column is the vertical agent's entry's and its bottom row the horizontal agent's entry's; the
-vertical entry lies at or below that row and the horizontal one at or left of that column. Its
-right column and top row are where the two agents' straight runs end, the vertical agent
-leaving through the top row and the horizontal one through the right column. So such a path of
-the vertical agent joins the bottom row to the top row inside the rectangle's columns, and one
-of the horizontal agent joins the left column to the right column inside its rows: the two
-share a cell ``w``. Both reach it at the step their entries and ``w`` give, which is the same
-step when ``D_V(S_V) - S_V.x - S_V.y = D_H(S_H) - S_H.x - S_H.y``. So two paths that both
-break their barriers collide, every solution keeps one of the two barriers, and the split keeps
-CBS complete and optimal. It is taken only where both agents' current paths break their barriers
-(so both children differ from the node); otherwise CBS splits as usual.
+Such agents collide in the rectangle whichever of their equally short paths they take, so plain
+CBS resolves the collision a cell at a time. :class:`Rectangles` splits once, with a *barrier*
+per agent: vertex constraints along the side where that agent leaves the rectangle, each at the
+step the agent would reach that cell on a shortest path. The papers time the barriers by the
+agents' MDDs; here static distances time them, in a form whose split keeps every solution
+(``docs/papers.md`` gives the argument). The split is taken only where both agents' current
+paths break their barriers; otherwise CBS splits as usual.
 """
 from __future__ import annotations
 

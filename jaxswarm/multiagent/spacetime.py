@@ -1,29 +1,16 @@
 """Space-time A*: one agent's fewest-steps path among reserved nodes and moves (compiled).
 
 A state is ``(node, step)``; each step the agent waits or moves along a valid edge, at a cost of
-one. What the other agents hold is a :class:`Reservations` table:
-
-* ``holder`` i32[H, N]: the agent on each node at each step ``t < H`` (-1 free, -2 a forbidden
-  node with no agent, CBS's vertex constraint). Moving u -> v from step t is a swap, and
-  forbidden, when the agent on v at t is on u at t + 1: the table doubles as the edge
-  reservations.
-* ``parked_from`` i32[N]: the step from which an agent stays on the node for good.
-* ``banned`` i32[M, 3]: single moves ``(t, u, v)`` forbidden from step t (CBS's edge
-  constraints).
-* ``earliest_finish``: the agent may not stay at its goal for good before this step, and
-  ``latest_finish``: it must stay there for good from this step or an earlier one (CBS's length
-  constraints of target reasoning).
-
-From step ``H`` on nothing moves any more, so the world is static: a state reaching step H is
-finished by the static shortest path that avoids the parked nodes (a breadth-first field from the
-goal), pushed with its exact cost. The search therefore stores at most (H + 1) * N states, ends
-on every instance, and finds the fewest steps to a goal that the agent can keep: its goal is
-accepted at step t only if no reservation touches it at t or later.
-
-The search is numba-compiled (as :mod:`jaxswarm.exact.kernels`): a heap of packed int64 keys
-``(f, agents met, -t, node)`` pops the lowest f, then (with a conflict avoidance table) the
-path meeting the fewest other agents, then the latest step, then the lowest node, so a solution is
-a pure function of its input.
+one. :func:`search` plans around a :class:`Reservations` table of what the other agents hold:
+each node at each step ``t < H`` (a move into a node whose holder comes the other way is a swap,
+forbidden), the nodes held for good, single forbidden moves (CBS's edge constraints) and the
+steps between which the agent must come to rest at its goal (target reasoning's length
+constraints). From step ``H`` on nothing moves, so a state reaching it is finished by the static
+shortest path around the parked nodes: the search stores at most ``(H + 1) N`` states, ends on
+every instance, and accepts the goal at step ``t`` only if no reservation touches it at ``t`` or
+later. The numba-compiled heap pops the lowest f, then (with a conflict avoidance table) the path
+meeting the fewest other agents, then the latest step, then the lowest node, so a solution is a
+pure function of its input.
 """
 from __future__ import annotations
 

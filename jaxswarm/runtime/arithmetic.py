@@ -2,63 +2,18 @@
 
 A key fixes a run only if every float that reaches a discrete choice (a draw, a comparison, a
 best path) is the same bit for bit alone, in a ``vmap`` of any width, on any thread or device
-count. XLA:CPU makes three kinds of result that depend on the program rather than on the
-arithmetic, each measured on x86-64 with jax 0.10.2:
+count. On XLA:CPU three things break that, and this module offers their remedies:
 
-* **Contraction.** A multiply and an add in one fusion become one fused multiply-add (one
-  rounding instead of two); whether they share a fusion depends on the program's shapes. No XLA
-  option turns contraction off, but without FMA instructions there is nothing to contract to:
-  :data:`ISA_FLAG` caps XLA's vector instructions at AVX, whose multiplies and adds each round
-  once. Every elementwise chain of IEEE operations (``+ - * /``, ``sqrt``, comparisons, integer
-  conversions) then gives one result in every program, with one exception: XLA rewrites a
-  division by an operand a batch shares (a map's distances under a ``vmap`` over runs) as a
-  multiplication by its reciprocal, so a quotient differs by an ulp between a run alone and
-  the same run in a batch. Divide by a shared operand as ``x * (1 / y)``, what every program
-  computes.
-* **Transcendentals.** XLA's ``exp`` takes another code path on some widths (1 of 8 results
-  differs in its last bit between a row of 3 and a row of 3,000); ``log``, ``pow``, ``tanh``,
-  ``log1p`` and ``expm1`` were the same on every width tried. :func:`exp` is built from IEEE
-  operations only, so it is one function on every width.
-* **Reductions.** A float sum over an axis adds in an order XLA picks per program (vector
-  accumulators when alone, one row at a time in a batch), and a cumulative sum is a reduce-window
-  XLA may rewrite by length. :func:`ordered_sum` and :func:`ordered_cumsum` add in an order fixed
-  by the axis length alone, as a sequence of elementwise adds XLA may not reassociate. Sums of
-  at most two terms, of small integers held as floats, and minima and maxima are exact in any
-  order and stay plain reductions.
-
-Scatter-adds of floats (erosion, soil, sediment) apply their updates in update order: XLA:CPU
-emits a scatter as one serial loop over the updates, and a batch adds an outer loop over the
-runs, so each run's updates reach an entry in the same order alone and in a batch.
-
-Where float arithmetic reaches a choice, and why the choice is the same in every program:
-
-* **Moves** (:func:`jaxswarm.swarm.walking.sampler.sample_masked`): weights are :func:`exp` of
-  log-weights minus their row's maximum (exact), summed slot by slot in slot order and compared
-  with a uniform made from integer hashes. The log-weights are elementwise chains (RFD's
-  gradients and ``p_base``, the colonies' ``alpha log tau + beta log eta``, IWD's ``-log(eps_s +
-  g(soil))``, the goal terms ``-alpha log d``) of IEEE operations and ``log``, one result under
-  the cap.
-* **Best paths** (:func:`jaxswarm.swarm.core.keep_best`, IWD_PG's memory): a path's length on a
-  grid or path map is its count of straight and of diagonal moves times two constants
-  (:func:`jaxswarm.world.lattice.lattice_length`), on a general graph an :func:`ordered_sum`; on
-  a plane :func:`jaxswarm.world.plane.trajectory_length` is an :func:`ordered_sum`. Comparisons,
-  minima and ``argmin`` are exact.
-* **Memory updates** that later draws read: IWD's velocities are an :func:`ordered_cumsum`, its
-  arrived drops' updates a scan in agent order, the soil a drop carries an :func:`ordered_sum`;
-  RFD's erosion, sediment and the colonies' deposits are scatter-adds (update order, above) and
-  elementwise chains, the eroded total shared out by eq. 5 an :func:`ordered_sum`; RFD's
-  exponential law uses :func:`exp`; IWD_PG's section lengths are a scatter-add of move
-  lengths, its fuzzy scores :func:`ordered_sum` s, its prefix lengths an :func:`ordered_cumsum`,
-  its roulette ``jax.random.categorical`` (``log`` and an ``argmax``).
-* **The bees' guided function** ``w1 f1 + w2 f2 + w3 f3``: three terms added left to right, the
-  pushback's four rays an :func:`ordered_sum`, the nearest obstacle a minimum, the turn an
-  ``arctan2`` (the same on every width tried; ``arctan`` was not, and is not used); the
-  onlookers' probabilities (eq. 10) divide by an :func:`ordered_sum` of the fitnesses.
-* Dot products of two-vectors (the Bug2 ant's direction cosine, distances between points) are
-  sums of two terms, the same in either order.
+* contraction of a multiply and an add into one rounding: :data:`ISA_FLAG` caps XLA at AVX,
+  which has no FMA (:func:`fixed_arithmetic_flags`, :func:`require_fixed_arithmetic`); divide
+  by an operand a batch shares as ``x * (1 / y)``, as XLA rewrites such a division;
+* XLA's ``exp``, whose last bit depends on the width: :func:`exp`, by IEEE operations only;
+* reductions in an order XLA picks per program: :func:`ordered_sum` and :func:`ordered_cumsum`,
+  in an order fixed by the axis length alone.
 
 The guarantee is "same key, same version, same platform" (x86-64 with AVX, or the same CPU family
-elsewhere): the cap is x86-64's, and another jax version may emit other code.
+elsewhere). ``docs/sweeps.md`` ("How one key gives one result") has what was measured and where
+in jaxswarm each float that reaches a choice comes from.
 """
 from __future__ import annotations
 

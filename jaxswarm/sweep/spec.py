@@ -1,37 +1,16 @@
 """Sweep specifications: a TOML file that names what to run, checked before any compute.
 
-A spec names one algorithm of the swarm registry, the maps, a grid of params (the Cartesian
-product of lists or ranges), the seeds, the iteration budget and the static config::
-
-    # What it asks, in a sentence or two.
-    [sweep]
-    name = "rfd_star_pbase_alpha"       # results go to out/sweeps/<name> unless --out is given
-    algorithm = "rfd_star"
-    maps = ["mosaic50", { random = 50, seed = 3 },
-            { movingai = "mapf/maze-32-32-2.map", scenario = 5 }]
-    seeds = 20                          # range(20), or an explicit list [0, 4, 9]
-    iterations = 100
-    patience = 30                       # optional: stop a run 30 iterations after its last gain
-    chunk_size = 64                     # optional: runs per compiled batch (bounds memory)
-    vmap_size = 16                      # optional: runs vmapped together (default: from the agents)
-
-    [config]                            # static: sizes and switches of the swarm factory
-    num_agents = 64
-
-    [params]                            # traced: every combination is one run per seed
-    p_base = [5, 10, 20]
-    alpha = { start = 1, stop = 10, num = 4 }             # inclusive linspace
-    erosion = { start = 0.5, stop = 50, num = 3, log = true }  # geometric spacing
-
-Params not named keep the swarm's defaults. Maps: a paper map name (``mosaic20`` ...), a seeded
-random grid ``{ random = SIZE, seed = S, density = 0.3 }``, a Moving AI map with one row of its
-scenario file ``{ movingai = "PATH.map", scenario = ROW, scenario_file = "even" }`` and the other
-entries of :mod:`jaxswarm.maps.entry` (a relative PATH is looked up beside the spec, then in the
-folder ``$JAXSWARM_MOVINGAI`` names). Every mistake raises :class:`SpecError` naming the file and
-the key; a map whose file, scenario row, start or goal is wrong is named with its entry when the
-sweep starts, before anything is written. Seeds run from 0 to ``SEED_LIMIT - 1``, and a sweep of
-more than ``max_runs`` runs (``DEFAULT_MAX_RUNS``, a million, unless told otherwise) is refused
-before its grid is built.
+Its ``[sweep]`` table names one algorithm of the swarm registry, the maps (the entries of
+:mod:`jaxswarm.maps.entry`), the seeds, the iteration budget and optionally ``patience``,
+``chunk_size`` and ``vmap_size``; ``[config]`` the swarm factory's static options; ``[params]``
+a grid of traced params, the Cartesian product of lists and ranges (``{ start, stop, num }``,
+with ``log = true`` for geometric spacing, or ``{ start, stop, step }``), every other param at
+the swarm's default. ``docs/sweeps.md`` shows a spec and what each key means. :func:`load_spec`
+reads a file, :func:`spec_from_dict` a parsed one; every mistake raises :class:`SpecError`
+naming the file and the key, and a map whose file, scenario row, start or goal is wrong is named
+with its entry when the sweep starts, before anything is written. Seeds run from 0 to
+``SEED_LIMIT - 1``, and a sweep of more than ``max_runs`` runs (``DEFAULT_MAX_RUNS``, a
+million, unless told otherwise) is refused before its grid is built.
 """
 from __future__ import annotations
 

@@ -1,27 +1,15 @@
 """Scoring settings on instances: the runs a tuner asks for, made once and stored.
 
-Every request of a tune (settings x instances) is one numbered batch of runs: the runs go through
-the swarm's compiled batches (:class:`~jaxswarm.sweep.batches.RunBatches`, one per value of the
-static params), and the batch's rows go to the tune's results store
-(:class:`~jaxswarm.sweep.store.ResultsStore`, one Parquet file per batch, written atomically).
-A tuner is deterministic given its spec and its results, so a tune killed and started again
-asks for the same batches in the same order: a batch the store holds is read back instead of
-run (after checking that it holds the same settings, with the same param values, on the same
-instances), so nothing is lost or run twice. The store records what else the settings and rows
-follow from (:func:`tuner_record`: the tuner's version and sampler; the content of every map
-file, :func:`~jaxswarm.sweep.spec.file_digests`) and refuses a resume across a change of any.
-
-Per run, the objective is a loss (lower is better):
-
-* ``success``: 0 when the run's path is within ``SUCCESS_GAP`` (1e-4) of the optimum, else 1;
-  reported as the success rate ``1 - mean``;
-* ``gap``: the relative gap to the optimum, ``unsolved_gap`` (10, a gap of 1,000 %: worse than
-  the paths these swarms find) for a run without a path;
-* ``time_to_target``: the iterations until the best path was within the gap of the optimum,
-  twice the iteration budget when it never was (PAR2, as algorithm configurators count a
-  timeout);
-* ``evaluations``: the fitness evaluations until then, twice the budget's
-  (``iterations x num_agents``) when never.
+:class:`Evaluator` runs each request of a tune (settings x instances) as one numbered batch
+through the swarm's compiled batches (:class:`~jaxswarm.sweep.batches.RunBatches`) and writes its
+rows to the tune's store (:class:`~jaxswarm.sweep.store.ResultsStore`, one Parquet file per
+batch). A batch the store holds is read back instead of run, once checked to hold the same
+settings on the same instances, so a killed tune resumes without losing or repeating a run; the
+store refuses a resume across a change of the tuner (:func:`tuner_record`) or of a map file
+(:func:`~jaxswarm.sweep.spec.file_digests`). Per run, the loss (:func:`run_losses`; lower is
+better) is ``success`` (0 within 1e-4 of the optimum, else 1), ``gap`` (``unsolved_gap`` without
+a path), ``time_to_target`` (the iterations until within the gap, twice the budget when never)
+or ``evaluations`` (the same in fitness evaluations); ``docs/tuning.md`` defines each.
 """
 from __future__ import annotations
 

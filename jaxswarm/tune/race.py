@@ -1,27 +1,15 @@
 """Iterated racing (irace; López-Ibáñez et al., Operations Research Perspectives 3, 2016).
 
-A tune of budget ``B`` runs over ``d`` free params makes ``N_iter = floor(2 + log2 d)`` iterations.
-Iteration ``j`` has a budget ``B_j = (B - spent) / (N_iter - j + 1)`` and races ``N_j = floor(B_j /
-(first_test + min(5, j)))`` settings (at least one more than the elites): in the first, the tune's
-baseline (the swarm's defaults, or the spec's ``[tune.baseline]``) and settings drawn uniformly;
-later, the elites of the race before and new settings drawn around them. A race takes the training
-instances (``(map, seed)`` pairs, in an order the tuner's key shuffles once: blocking, every setting
-sees the same instances in the same order) one after another, the settings still alive as one batch
-of runs; from the ``first_test``-th instance on, after each, the Friedman test on the ranks at level
-``alpha`` and, when it rejects, Conover's pairwise comparisons against the best
-(:func:`jaxswarm.tune.stats.race_step`) drop the settings worse than the best. A race ends when at
-most ``N_min = floor(2 + log2 d)`` settings are alive, when its budget cannot pay for the next
-instance, or when the instances run out; its survivors, best mean rank first, are the elites (at
-most ``N_min``). A setting keeps its results from race to race (an elite is not run again on an
-instance it has seen).
-
-New settings: a parent elite of rank ``r`` (of ``k``) is picked with probability ``(k - r + 1) / (k
-(k + 1) / 2)``; each numeric param is drawn from a normal around the parent's value on the unit
-scale of its range (log-scaled where the range is), truncated to it, whose deviation starts at 0.5
-and shrinks every iteration by ``(1 / N_j^new)^(1 / d)``; each choice from the parent's
-probabilities, which move towards the parent's value by ``(j - 1) / N_iter`` (irace's update) and
-pass to the child. irace's deviation is kept per elite; here one deviation per iteration serves
-every parent (a simplification, documented).
+:func:`iterated_race` makes ``N_iter = floor(2 + log2 d)`` iterations for ``d`` free params. Each
+races settings over the training instances, taken one after another in one shuffled order, the
+settings alive as one batch of runs: the tune's baseline and uniform draws in the first, the
+elites of the race before and settings drawn around them later. From the ``first_test``-th
+instance on, the Friedman test and Conover's comparisons against the best drop the worse
+settings (:func:`jaxswarm.tune.stats.race_step`); a race's survivors are the next elites. A new
+setting draws each number from a truncated normal around an elite picked by rank, on its range's
+unit scale, and each choice from probabilities that move towards the elite's value.
+``docs/tuning.md`` (The methods) gives the budgets, the formulas and where this differs from
+irace.
 """
 from __future__ import annotations
 

@@ -1,54 +1,17 @@
 """Tune specifications: a TOML file that names a swarm, its search space, the instances, a
-budget, an objective and a method, checked before any compute::
+budget, an objective and a method, checked before any compute.
 
-    # What it asks, in a sentence or two.
-    [tune]
-    name = "iwd_open_constants"      # results go to out/tune/<name> unless --out is given
-    algorithm = "iwd"
-    method = "race"                  # race | random | grid | es
-    budget = 1200                    # runs of the swarm, training instances only
-    objective = "gap"                # success | gap | time_to_target | evaluations
-    iterations = 100
-    patience = 30                    # optional, as in a sweep
-    seed = 0                         # the tuner's own key: draws and instance order
-    chunk_size = 64                  # optional: runs per compiled call
-
-    [tune.training]                  # instances = every (map, seed) pair
-    maps = ["maze20", "mosaic20", "alley20"]
-    seeds = 10
-
-    [tune.held_out]                  # rescored after the search, never searched on
-    maps = ["maze100"]
-    seeds = [1000, 1001, 1002]
-
-    [tune.race]                      # optional: irace's settings
-    first_test = 5                   # instances before the first test
-    alpha = 0.05                     # the tests' level
-
-    [tune.baseline]                  # optional: where the search starts, and what the
-    alpha = 1.0                      # held-out table compares against (default: the swarm's
-    rho_n = 0.9                      # defaults), for some or all searched params
-
-    [config]                         # static: the swarm factory's options
-    num_agents = 50                  # fixed
-    # num_agents = { choices = [16, 64] } would tune it: each value compiles on its own
-
-    [params]                         # traced
-    alpha = { low = 0.5, high = 4.0 }
-    beta = { tied = "alpha" }        # IWD's alpha = beta: one param of the space
-    rho_n = { low = 0.01, high = 0.99, log = true }
-    initial_soil = 10000             # fixed at a value (not searched)
-
-Also ``{ low = 1, high = 8, integer = true }`` and ``{ choices = [0.1, 0.5, 0.9] }``; under
-``[tune]`` ``grid_points`` (method grid: values per numeric param, default the most that fit
-the budget), ``es_pairs``, ``es_sigma`` and ``es_learning_rate`` (method es), and
-``unsolved_gap`` (objective gap: the gap a run without a path counts, default 10.0, worse than
-the paths these swarms find). A ``[tune.baseline]`` pins the setting a calibration started
-from once its best setting has become the swarm's default, so the study still runs as it ran
-(each value inside its param's range, or one of its choices). Every
+Its tables: ``[tune]`` (``name``, ``algorithm``, ``method`` of :data:`METHODS`, ``budget``,
+``objective`` of :data:`OBJECTIVES`, ``iterations``, ``patience``, ``seed``, ``chunk_size``,
+``grid_points``, ``es_pairs``, ``es_sigma``, ``es_learning_rate``, ``unsolved_gap``),
+``[tune.training]`` and ``[tune.held_out]`` (``maps``, ``seeds``), ``[tune.race]``
+(``first_test``, ``alpha``), ``[tune.baseline]``, ``[config]`` (the swarm factory's static
+options) and ``[params]`` (traced; a domain ``{ low, high }`` with ``log`` or ``integer``,
+``{ choices }``, ``{ tied }``, or a number). ``docs/tuning.md`` shows a spec and what each key
+means. :func:`load_tune_spec` reads a file, :func:`tune_spec_from_dict` a parsed one; every
 mistake raises :class:`TuneSpecError` naming the file and the key, among them a budget too small
-for the method (:func:`smallest_budget`), a grid larger than the budget, and a tune of more
-than ``max_runs`` runs (training and held-out; ``DEFAULT_MAX_RUNS``, a million, unless told
+for the method (:func:`smallest_budget`), a grid larger than the budget, and a tune of more than
+``max_runs`` runs (training and held-out; ``DEFAULT_MAX_RUNS``, a million, unless told
 otherwise), all before anything is built.
 """
 from __future__ import annotations

@@ -1,41 +1,21 @@
 """The guided function of the constrained ABC paper (eq. 4) and its constraints (eq. 6).
 
-``Phi(x) = w1 f1(x) + w2 f2(x) + w3 f3(x)`` scores a candidate next position ``x`` of the vehicle,
-which stands at ``here`` and came from ``previous``:
+``Phi(x) = w1 f1(x) + w2 f2(x) + w3 f3(x)`` (:func:`guided`) scores a candidate next position
+``x`` of the vehicle, which stands at ``here`` and came from ``previous``:
 
-* ``f1`` (eq. 1): the distance from ``x`` to the goal.
-* ``f2`` (pushback): the text lost the formula and defines it as "the sum of minimum distances to
-  obstacles in the current region", to be minimised so that the vehicle keeps away from them. We
-  cast four rays from ``x`` along the world axes (+x, -x, +y, -y), each reaching ``reach`` (half
-  the sensor window), and let each meet only the rectangles' parts inside the window (what the
-  sensor sees). A ray that meets an obstacle at distance ``d`` adds ``reach - d``; one that meets
-  nothing adds 0. So ``f2 = 4 reach - (sum of the four minimum distances)``, in ``[0, 4 reach]``:
-  the paper's sum with the sign that makes minimising ``Phi`` push the vehicle away.
-* ``f3`` (smoothness): the turn between the last move (``previous`` to ``here``) and the candidate
-  move (``here`` to ``x``), 0 to 180 degrees or 0 to pi radians; 0 before the first move. The text
-  lost the formula ("f3 defines the trajectory smoothness by preserving the smooth of the angle
-  between subsequent segments of movement") and with it the unit, which ``turn_unit`` (one of
-  :data:`TURN_UNITS`) declares. Degrees are cABC's default, the unit whose outcomes move as the
-  paper's text says f3 moves them (``results/bees_tables``, Tables 2-5, 20 runs a row, both units).
-  The text needs f3 to matter: on map #2, f1 and f2 alone "did not reach the target during all
-  experimental runs" (ours, Table 1's weights on map #2: 0 of 40 runs each), and with f3 the vehicle
-  leaves the trap "because the other two functions 'balance' the first one" (Tables 3 and 5: 1 to 16
-  of 20). In radians a turn weighs at most ``pi w3`` (0.03 to 0.6 for the paper's ``w3``), less than
-  one step's gain towards the goal (up to ``1.41 w1``), and f3 changes nothing: every row of map #2
-  reaches the goal in 0 of 20 runs, every row of map #1 in 20 of 20 with the path lengths of
-  ``w3 = 0`` (65 to 66). In degrees the vehicle leaves the trap of map #2 in 1 to 8 of 20 runs, the
-  fewest (1) at the paper's fewest (1, ``w3 = 0.01``); on map #1 f3 then costs more than the
-  paper's (1 to 6 of 20 against its 3 to 17) and, as in radians, the targets do not fall as ``w3``
-  grows within a table as the paper's do.
+* ``f1`` (eq. 1, :func:`goal_distance`): the distance from ``x`` to the goal;
+* ``f2`` (pushback, :func:`pushback`): the sum of ``reach - d`` over four rays from ``x`` along
+  +x, -x, +y and -y, ``reach`` (half the sensor window) long, ``d`` where each first meets the
+  rectangles' parts inside the window (``reach`` if none): in ``[0, 4 reach]``;
+* ``f3`` (smoothness, :func:`turn_angle`): the turn from the last move to ``here -> x``, 0 before
+  the first, in ``turn_unit`` (:data:`TURN_UNITS`): degrees by default, as in radians a turn
+  weighs less than a step towards the goal and f3 changes nothing;
+* ``w4 f4`` (ours, the paper's future work; :func:`revisits`): how many sensor windows of the
+  vehicle's earlier positions contain ``x``.
 
-The paper's future work, a vehicle that remembers the regions where it has been, adds
-``w4 f4`` (:func:`revisits`): ``f4`` counts the sensor windows of the vehicle's earlier positions
-that contain the candidate, so a vehicle going round in a trap pays more the longer it stays.
-
-A candidate violates eq. 6 for every rectangle it lies strictly inside
-(:func:`jaxswarm.world.plane.violations`); with ``forbid_crossing`` the move from ``here`` to it
-also violates for every rectangle it passes through (off in the paper's variant, whose vehicle
-only ever checks where it lands).
+:func:`constraint_violations` counts eq. 6's violations, with ``forbid_crossing`` (ours) also the
+rectangles the move passes through. The text lost f2's and f3's formulas; ``docs/papers.md`` says
+how we read them and what each unit of f3 gives.
 """
 from __future__ import annotations
 

@@ -1,42 +1,19 @@
-"""The equations of Intelligent Water Drops (Shah-Hosseini's IWD, as the IWD_PG paper uses it).
+"""The equations of Intelligent Water Drops (Shah-Hosseini's IWD, as the IWD_PG paper uses it),
+numbered as that paper numbers them. Soil lives on directed edge slots (``f32[N, K]``); a drop
+carries a velocity and the soil it has taken. Moving ``i -> j``:
 
-Soil lives on directed edge slots (``f32[N, K]``). A drop carries a velocity and the soil it has
-taken. Moving ``i -> j``, numbered as the IWD_PG paper numbers them:
+* choice (eqs. 1-3, :func:`choice_log_weights`): ``p(i, j) ~ f(soil(i, j))^alpha h(j)^beta``,
+  ``f(s) = 1 / (eps_s + g(s))``, ``g(s) = s - min(0, the least soil among the choices)``;
+* velocity (Shah-Hosseini's, unnumbered): ``vel += a_v / (b_v + c_v soil(i, j)^2)``;
+* soil taken (eq. 4, :func:`soil_taken`): ``dsoil = a_s / (b_s + c_s time^2)``, ``time = HUD(i,
+  j) / max(eps_v, vel)`` with the velocity after the move;
+* local update (eqs. 5, 6): ``soil(i, j) = (1 - rho_n) soil(i, j) - rho_n dsoil``, the drop's
+  ``soil += dsoil``; after the walk for the drops that arrived (:func:`arrived_update`) or as
+  they walk (:data:`SOIL`), as :mod:`.iwd`'s ``local_updates`` chooses;
+* global update (Shah-Hosseini's, :func:`global_update`) of the iteration-best path.
 
-* choice (eqs. 1-3): ``p(i, j)`` proportional to ``f(soil(i, j))^alpha * h(j)^beta`` over the
-  admissible unvisited ``j`` (eq. 1), ``f(s) = 1 / (eps_s + g(s))`` (eq. 2), ``g(s) = s`` when
-  the smallest soil among the choices is ``>= 0``, else ``s - min`` (eq. 3);
-* velocity (Shah-Hosseini's update; the IWD_PG paper does not number it): ``vel += a_v / (b_v +
-  c_v * soil(i, j)^2)``;
-* soil taken (eq. 4, "depends on speed of IWDs and heuristic functions"): ``dsoil = a_s / (b_s
-  + c_s * time^2)``, ``time = HUD(i, j) / max(eps_v, vel)`` with the velocity after the move;
-* local update (eqs. 5 and 6): the edge's ``soil(i, j) = (1 - rho_n) * soil(i, j) - rho_n *
-  dsoil`` (eq. 5), the drop's ``soil += dsoil`` (eq. 6);
-* global update of the iteration-best path (Shah-Hosseini's, unnumbered in the paper; ``N_IB``
-  nodes, its drop's soil ``soil_IB``), on its edges: ``soil = (1 + rho_IWD) * soil - rho_IWD *
-  soil_IB / (N_IB - 1)``.
-
-When the local updates apply is :mod:`.iwd`'s choice (``local_updates``): after the walk, for
-the drops that arrived only (:func:`arrived_update`; the drops read the soil as it was at the
-start of the iteration), or while the drops walk (:data:`SOIL`, the walker's per-step hook: all
-drops of a lockstep step read the soil as it was at its start, and drops crossing one edge in
-one step apply their updates one after another in the order of the walker's lanes, ``soil =
-(1 - rho_n)^c soil - rho_n * sum_r (1 - rho_n)^(c - 1 - r) dsoil_r`` over their ranks ``r``).
-
-Two functions the paper leaves open, and ours:
-
-* ``HUD(i, j)``, the heuristic undesirability of the move (Shah-Hosseini: the distance between
-  the cities), is ``hud_scale`` times the edge's length. With the standard constants and
-  ``hud_scale = 1`` (a cell's side is one unit), ``time^2`` is 2.5e-5 to 5e-5, far below
-  ``b_s = 0.01``: every edge loses 99.5-99.75 soil whatever its length, and only the global
-  update prefers short paths. The length matters once ``time`` nears ``sqrt(b_s / c_s) = 0.1``:
-  with ``hud_scale = 20`` (the map in units of a twentieth of a cell) a straight move at the
-  initial velocity 200 takes 50 soil and a diagonal one 33, so the soil removed per unit of
-  length falls with the edge's length. That is a reading of the units, within the standard
-  equations.
-* ``h(j)``, the goal desirability ("the closest node to the destination will be selected with
-  more probability"), is ``1 / d_j``, ``d_j`` the straight-line distance from ``j`` to the goal,
-  so a drop next to the goal moves into it (as ACO*'s ants do).
+Ours, where the paper leaves them open (``docs/papers.md`` says why): ``HUD(i, j) = hud_scale``
+times the edge's length, ``h(j) = 1 / d_j``, ``d_j`` the straight-line distance to the goal.
 """
 from __future__ import annotations
 

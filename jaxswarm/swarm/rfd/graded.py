@@ -1,38 +1,16 @@
 """``rfd_graded``: this project's river formation law (not a paper's algorithm).
 
 It keeps RFD*'s transition rule (eq. 6, ``p_base ** gradient / d_j ** alpha``, the goal taken
-whenever adjacent) and replaces the paper's erosion (eqs. 4 and 5) by a graded river bed:
-
-* **Carving.** A river cuts its bed down to a graded profile. A drop lowers every node ``i`` of
-  its path to ``E * r(i)`` when that is lower, where ``r(i)`` is the shortest way its own walk
-  offers from ``i`` to water: to the goal, or to any node ``m`` later on its path carved before
-  this iteration, plus ``altitude(m) / E`` (a tributary: the drop need not arrive, only drain
-  into a bed). The altitude of a carved node is then ``E`` times the shortest route to the goal
-  the swarm has walked from it, refined one walked edge at a time (an asynchronous Bellman-Ford
-  over the walks), and at a fork the branch with the shorter remainder is the steeper one.
-  Ground no drop has carved stays at ``initial_height`` (keep it above ``E`` times the longest
-  walk). No eq. 5 sediment: the profile is not levelled.
-* **Clipped gradients.** A drop in a bed climbs out as if the slope were at most ``climb``
-  steep, so it keeps looking for shortcuts beside its river; a drop on the plateau sees a bed as
-  no steeper than ``E``, so a river does not swallow every drop that passes beside it. Drops on
-  uncarved ground do not climb slopes steeper than ``climb``.
-* **Banks.** A carved node a drop visits is lowered to its lowest carved neighbour plus ``E``
-  times the edge (a high stretch of bed left by an early meandering walk is corrected by the
-  first drop that visits it).
-* **Blind alleys and settling.** A stuck drop fills the blind alley it ran into
-  (:func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`); a drop that did not arrive leaves
-  ``sediment`` on every uncarved node of its trail, and filled ground settles (:func:`settle`)
-  so that no filled node is a pit: ground explored in vain rises and slopes down to where no
-  drop has been yet, and the drops, which do not climb, cross it to the frontier.
-* **Greedy drops.** The first ``greedy_drops`` drops (1) take their most likely move, so a
-  formed river is walked exactly (one unlikely draw in 150 moves misses a 100 x 100 optimum).
-
-Why: with eqs. 4 and 5 an altitude difference travels back from the goal one node per iteration
-and reflects how often an edge was used rather than how short the paths through it were; on the
-paper's 50 x 50 and 100 x 100 maps the paper's RFD* converged to long paths within 100
-iterations for every setting we tried. With these defaults ``rfd_graded`` reaches the Dijkstra
-optimum in at least 19 of 20 seeds on each of the nine paper maps (``sweeps/rfd_static.py``,
-``tests/test_rfd_quality.py``), and in 59 of 60 runs on Moving AI maps it was never tuned on.
+whenever adjacent; :func:`graded_transition`, which clips the gradients between a bed and the
+plateau) and replaces the paper's erosion (eqs. 4 and 5) by a graded river bed
+(:func:`graded_reshape`): each drop carves its path down to ``E`` times the shortest way its
+walk offers to water, the goal or a bed carved before (:func:`carve`); a visited bed sinks to
+its lowest carved neighbour plus ``E`` times the edge (:func:`erode_banks`); a stuck drop fills
+its blind alley, a drop that did not arrive raises its uncarved trail by ``sediment``, and
+filled ground settles (:func:`settle`). Uncarved ground stays at ``initial_height``; the first
+``greedy_drops`` drops take their most likely move; :func:`regrade` is the memory rule for a
+changed map. ``docs/papers.md`` explains each rule, why eqs. 4 and 5 gave way, and what the law
+reaches.
 """
 from __future__ import annotations
 

@@ -1,37 +1,17 @@
 """River Formation Dynamics as the RFD paper writes it: the original RFD and the modified RFD*.
 
 Both walk their drops over the gradient of eq. 2, ``(altitude(i) - altitude(j)) / distance(i,
-j)``, among the neighbours a drop has not visited yet (the paper's per-drop sets ``V_k``,
-``U_k``, ``F_k``):
-
-* ``rfd`` (eqs. 1, 3): weight ``gradient`` downhill, ``omega / |gradient|`` uphill, ``delta``
-  flat.
-* ``rfd_star`` (eq. 6): weight ``p_base ** gradient / d_j ** alpha`` for every neighbour, with
-  ``d_j`` the straight-line distance from ``j`` to the goal. Eq. 6 divides by ``d_goal = 0``, so
-  the goal wins every draw when it is adjacent: we take it whenever adjacent.
-
-After the walk (Algorithm 1, lines 6-8), every move ``i -> j`` of each eroding path (by default
-the paths that reached the goal, see ``erode``) erodes node ``i`` by ``E / ((N - 1) * D) *
-gradient(i, j)`` (eq. 4; negative gradients erode nothing), and every node then gains
-``erosionProduced / (N - 1)`` (eq. 5). A drop that could not move deposits ``sediment`` on the
-node where it stands (the paper's "a fraction of carried sediment", without an amount: the
-parameter is that amount). Altitudes are kept non-negative and the goal stays at 0.
-
-Every change of the altitudes (sediment, erosion) is added by compensated summation
-(:func:`~jaxswarm.swarm.rfd.river.add_compensated`, the state's ``residual``).
-
-Options of ``rfd_star`` (``rfd`` erodes as their defaults do; how we read the paper's text for
-each, and where the defaults come from: ``docs/papers.md``):
-
-* ``erode``: whose paths erode: ``"arrived"`` (default), the drops that reached the goal, or
-  ``"travelled"``, every drop's.
-* ``erosion_law``: ``"linear"`` (eq. 4) or ``"exponential"``: ``p_base ** gradient`` in place of
-  the gradient (capped at ``exp(MAX_LOG_EROSION)``), and at most the node's altitude minus the
-  lowest altitude among the nodes its eroding moves go to.
-* additions of this project, each off in the paper's variant: ``greedy_drops`` (the first drops
-  take their most likely move), ``fill_blind_alleys`` (a stuck drop fills the whole blind alley
-  it ran into, :func:`~jaxswarm.swarm.rfd.alleys.blind_alleys`) and ``max_climb`` (no move
-  steeper uphill than this gradient).
+j)``, among the neighbours a drop has not visited yet (the paper's ``V_k``, ``U_k``, ``F_k``).
+``rfd`` weighs a move by eqs. 1 and 3 (``gradient`` downhill, ``omega / |gradient|`` uphill,
+``delta`` flat; :func:`rfd_transition`), ``rfd_star`` by eq. 6 (``p_base ** gradient / d_j **
+alpha``, ``d_j`` the straight-line distance to the goal; :func:`rfd_star_transition`), taking
+the goal whenever adjacent, where eq. 6 divides by 0. After the walk (Algorithm 1, lines 6-8)
+each move ``i -> j`` of an eroding path erodes ``i`` by ``E / ((N - 1) D) gradient(i, j)`` (eq.
+4; :func:`erode`) and every node gains ``erosionProduced / (N - 1)`` (eq. 5); a drop that could
+not move deposits ``sediment`` where it stands. Altitudes stay non-negative, the goal at 0, and
+every change is added by compensated summation (:func:`~jaxswarm.swarm.rfd.river.add_compensated`).
+``rfd_star``'s options (:class:`RFDStarConfig`) and how we read the paper for each and for its
+defaults: ``docs/papers.md``.
 """
 from __future__ import annotations
 
