@@ -11,40 +11,13 @@ reaches the goal, when it has no admissible neighbour ("stuck"), or when its ste
 That step of every lane is :func:`.lanes.step`; this module holds the queue that hands agents to
 lanes, the loop over blocks of steps, the results it writes and the batching rule.
 
-Agents do not each keep a lane until the slowest one finishes. The loop steps a fixed number of
-lanes (:func:`lanes_for`: one per ``AGENTS_PER_LANE`` agents, ``FEWEST_LANES`` to ``LANES``)
-``STEPS_PER_REFILL`` moves at a time; then the lanes whose agent stopped (at most half of the
-lanes, ``REFILL_SHARE``) hand its results to the output buffers and take the queue's next agents.
-Once the queue is empty and at most ``lanes // COMPACT_SHARE`` agents still walk, those go on in a
-batch of that many lanes, and so on each time a ``COMPACT_SHARE``-th of those lanes is left, down
-to ``SMALLEST_COMPACTION`` lanes: a walk's last agents (the few that wander for hundreds of
-steps) do not keep every lane stepping.
-
-Random streams belong to agents, not lanes: agent ``a``'s ``m``-th move draws a uniform hashed
-from the walk's key, ``a`` and ``m`` (:func:`.streams.uniforms`). So without a hook neither the
-number of lanes, nor the order in which agents get one, nor batching walks together changes any
-walk.
-
-Batching: :func:`walk` has its own ``vmap`` rule (``jax.custom_batching``). A ``vmap`` of walks
-(a batch of runs in a sweep, a batch of seeds) becomes one queue holding every run's agents over
-one set of lanes, instead of one lockstep loop per run that runs until the slowest run's slowest
-agent stops. A run whose walk starts at its goal adds no agent to the queue: the run loop
-starts a finished run of a batch there, so its lanes go to the runs still going.
-
-Memory that changes during a walk (water drops' soil) goes through a per-step hook
-(:mod:`.hooks`): ``walk(..., hook=, memory=, hook_params=)`` returns the memory after the walk and
-each agent's own state. When the hook writes the memory, every agent of the batch gets a lane at
-the first step and keeps it (no queue, no ``LANES`` cap): a run's agents then make their ``m``-th
-moves in the same step and write in agent order, whatever the batch, so such a walk too is one
-function of its key. Hook params shared by a batch stay one run's, so the lanes read them without
-a gather; with a hook that writes, the loop carries one i32 per node of every run to group each
-step's moves (:func:`.hooks.edge_groups`). A hook that only reads (no ``update``) groups nothing.
-
-Memory: the lanes' visited sets are bit sets ``u32[lanes, ceil(N / 32)]``; each agent's visited
-set (same layout) is written when it stops. Its moves go to a journal (:mod:`.journal`) as it
-makes them, one block of ``STEPS_PER_REFILL`` moves per lane and refill, and after the loop to
-each run's :class:`~.log.MoveLog`, agent by agent: a walk writes the moves its agents made,
-not rows padded to the step budget, in room that does not grow with the budget (:mod:`.log`).
+The loop steps a fixed number of lanes (:func:`lanes_for`) ``STEPS_PER_REFILL`` moves at a time,
+refills the lanes whose agent stopped from a queue, and compacts the last few walkers onto fewer
+lanes; random streams belong to agents, not lanes (:func:`.streams.uniforms`), so neither the
+lanes nor batching change any walk. :func:`walk`'s ``vmap`` rule puts every run's agents in one
+queue; a per-step hook (:mod:`.hooks`) carries memory that changes while the agents walk; moves
+go to a journal (:mod:`.journal`) and then to each run's :class:`~.log.MoveLog`.
+``docs/walker.md`` tells how each of these works and why.
 """
 from __future__ import annotations
 
@@ -370,7 +343,7 @@ def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):
     queue = _queue(inputs, count)
     initial = _initial_results(inputs, queue)
     writes = inputs.hook is not None and inputs.hook.writes
-    # Agents that write a memory they all read walk together (module docstring).
+    # Agents that write a memory they all read walk together (docs/walker.md).
     num_lanes = count if writes else lanes_for(count)
     claims = None if not writes else jnp.full(
         (inputs.start.shape[0] * inputs.graph.num_nodes,), UNCLAIMED, jnp.int32)
