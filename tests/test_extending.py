@@ -1,6 +1,9 @@
 """The extending guide's new swarm (``docs/examples/trail_swarm.py``): one file and one registry
 entry, and it passes the conformance suite every registered walker passes; what it does not
-declare (a drawing of its memory, a change rule) is a clear error where it is asked for."""
+declare (a drawing of its memory, a change rule) is a clear error where it is asked for; the
+names the protocol's reshaping moved forward with a warning."""
+import importlib
+import re
 import runpy
 
 import jax
@@ -71,3 +74,16 @@ def test_two_steps_lay_the_trail_as_computed_by_hand(maze):
         on[path[path >= 0]] = True
         expected = (np.float32(1) - params.decay) * expected + np.where(on, params.deposit, 0)
         np.testing.assert_allclose(np.asarray(state.trail), expected, rtol=1e-6)
+
+
+@pytest.mark.parametrize("old, new", [
+    ("jaxswarm.swarm.core.run", "jaxswarm.swarm.executor.run"),
+    ("jaxswarm.swarm.core.with_room", "jaxswarm.swarm.executor.with_room"),
+    ("jaxswarm.swarm.core.again_with_room", "jaxswarm.swarm.executor.retried"),
+    ("jaxswarm.dynamic.events.memory_frames", "jaxswarm.plot.memory.memory_frames")])
+def test_moved_names_forward_with_a_warning_until_0_12(old, new):
+    module, name = old.rsplit(".", 1)
+    home, moved = new.rsplit(".", 1)
+    with pytest.warns(DeprecationWarning, match=rf"{re.escape(old)} is .*0\.12\.0"):
+        found = getattr(importlib.import_module(module), name)
+    assert found is getattr(importlib.import_module(home), moved)

@@ -203,7 +203,7 @@ def __getattr__(name: str):
         import warnings
 
         from jaxswarm.plot.memory import memory_frames
-        warnings.warn("jaxswarm.dynamic.events.memory_frames is jaxswarm.plot.memory_frames (this "
-                      "name goes in 0.12.0)", DeprecationWarning, stacklevel=2)
+        warnings.warn("jaxswarm.dynamic.events.memory_frames is jaxswarm.plot.memory.memory_frames "
+                      "(this name goes in 0.12.0)", DeprecationWarning, stacklevel=2)
         return memory_frames
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,8 +22,8 @@ Each check raises ``AssertionError`` naming what failed:
   (:func:`jaxswarm.swarm.fingerprint.run_fingerprint`) to compare with the run alone.
 
 The first three checks share two programs per swarm: one run, and one batch of ``runs`` runs
-with their keys and params batched (:func:`~jaxswarm.swarm.executor.run_batch`); :func:`check_batch_invariant` adds one
-batch program per width.
+with their keys and params batched (:func:`~jaxswarm.swarm.executor.run_batch`);
+:func:`check_batch_invariant` adds one batch program per width.
 :class:`Compilations` counts the programs JAX builds while it is open, for checks of one's own
 (a change of the map that must not recompile, a grid of params).
 
@@ -115,10 +115,10 @@ def outcome(result):
 def check_reproducible(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
                        keys: int = 3, runs: int = 8) -> None:
     """Same key, same result; the first ``keys`` rows of a batch of ``runs`` runs
-    (:func:`~jaxswarm.swarm.executor.run_batch`, every run another key) equal those runs one at a time (see
-    :func:`outcome`); keys differ. For a swarm whose ``vmap`` runs its members one at a time
-    (:data:`~jaxswarm.swarm.executor.ONE_AT_A_TIME`), each row's walks were its own:
-    their lane-steps are those of the run alone (in lockstep they are the batch's)."""
+    (:func:`~jaxswarm.swarm.executor.run_batch`, every run another key) equal those runs one at a
+    time (see :func:`outcome`); keys differ. For a swarm whose ``vmap`` runs its members one at a
+    time (:data:`~jaxswarm.swarm.executor.ONE_AT_A_TIME`), each row's walks were its own: their
+    lane-steps are those of the run alone (in lockstep they are the batch's)."""
     split = jax.random.split(jax.random.key(7), runs)
     params = swarm.default_params
     one = [run(swarm, k, graph, task, params, iterations=iterations) for k in split[:keys]]
@@ -211,9 +211,9 @@ def _check_trajectory(swarm: Swarm, plane: Plane, task: Task, solution) -> None:
 
 def check_compiles_once(swarm: Swarm, graph: World, task: Task, *, iterations: int = 8,
                         runs: int = 8) -> None:
-    """A batch of ``runs`` runs (:func:`~jaxswarm.swarm.executor.run_batch`) over valid values of the first param builds
-    at most one program (none if an earlier check built it), and new values of the same shapes
-    build none."""
+    """A batch of ``runs`` runs (:func:`~jaxswarm.swarm.executor.run_batch`) over valid values of
+    the first param builds at most one program (none if an earlier check built it), and new
+    values of the same shapes build none."""
     first = swarm.default_params._fields[0]
     values = float(getattr(swarm.default_params, first)) * np.linspace(0.5, 1.0, runs)
     for value in values:  # valid values: every run of the sweep is one the swarm accepts
@@ -237,10 +237,10 @@ WIDTHS = (1, 3, 64)
 
 def check_batch_invariant(swarm: Swarm, world: World, task: Task, *, iterations: int = 8,
                           widths: tuple[int, ...] = WIDTHS, keys: int | None = None) -> None:
-    """One key, one result: each of ``keys`` keys (default the widest width) run alone equals
-    the same key in vmapped batches (:func:`~jaxswarm.swarm.executor.run_batch`) of each of ``widths``, every leaf of its
-    final state and trace bit for bit (:func:`outcome`). A width's last batch is filled up with
-    the last key."""
+    """One key, one result: each of ``keys`` keys (default the widest width) run alone equals the
+    same key in vmapped batches (:func:`~jaxswarm.swarm.executor.run_batch`) of each of
+    ``widths``, every leaf of its final state and trace bit for bit (:func:`outcome`). A width's
+    last batch is filled up with the last key."""
     count = max(widths) if keys is None else keys
     split = jax.random.split(jax.random.key(11), count)
     params = swarm.default_params
