@@ -266,6 +266,12 @@ def test_a_chunk_whose_walk_overflowed_its_log_is_made_again_with_room(finished,
     pd.testing.assert_frame_equal(cramped[OUTCOME_COLUMNS], frame[OUTCOME_COLUMNS])
 
 
+def test_batches_of_a_swarm_that_does_not_walk_need_no_room():
+    # Twin of the slow bees sweeps: the program with room is made only after an overflow.
+    batches = RunBatches("cabc", {}, 2, None, 4, log=lambda _: None)
+    assert batches.group >= 1 and batches.call_size(3) == 4
+
+
 def test_a_bees_spec_checks_its_params():
     document = {"sweep": {"algorithm": "cabc", "maps": [{"plane": "map1"}], "seeds": 1},
                 "params": {"inner_iterations": [2, 1.5]}}

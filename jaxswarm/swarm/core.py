@@ -15,7 +15,8 @@ The run loop is jitted (the swarm and the iteration budget are static), so it vm
 over params and compiles once per map shape. The world (a graph or a plane) is an argument, never
 stored in the state, so a batch of runs shares one copy.
 """
-
+# Annotations are evaluated here (no postponed annotations): WalkingConfig's ``walker`` field
+# then holds the class itself, which its subclasses in other modules resolve without importing it.
 import dataclasses
 import functools
 from typing import Any, Callable, NamedTuple

@@ -74,13 +74,9 @@ class ShardedRuns:
         self.padded = -(-self.chunk_size // len(devices)) * len(devices)
         self.group = min(self.vmap_size or group_size(self.swarm.config.num_agents),
                          self.padded // len(devices))
-        mesh = Mesh(np.asarray(devices), (RUNS_AXIS,))
-        self._runs = NamedSharding(mesh, P(RUNS_AXIS))
-        self._replicated = NamedSharding(mesh, P())
-        self._programs = {roomy: _program(with_room(self.swarm) if roomy else self.swarm,
-                                          self.summary, self.iterations, self.patience, mesh,
-                                          self.group)
-                          for roomy in (False, True)}
+        self._mesh = Mesh(np.asarray(devices), (RUNS_AXIS,))
+        self._runs = NamedSharding(self._mesh, P(RUNS_AXIS))
+        self._replicated = NamedSharding(self._mesh, P())
         self._compiled: dict = {}
 
     def run(self, seeds: np.ndarray, params, world: World, task: Task, extra=None, *,
@@ -154,8 +150,9 @@ class ShardedRuns:
             if release_if_crowded():  # the process holds too many programs' pages: drop ours
                 self._compiled.clear()
             began = time.perf_counter()
-            self._compiled[key] = self._programs[roomy].lower(
-                *inputs, world, task, extra).compile()
+            program = _program(with_room(self.swarm) if roomy else self.swarm, self.summary,
+                               self.iterations, self.patience, self._mesh, self.group)
+            self._compiled[key] = program.lower(*inputs, world, task, extra).compile()
             size = inputs[0].shape[0]
             self.log(f"compiled {self.swarm.name} for {label}'s shape, "
                      f"{size} runs per chunk on {len(jax.devices())} device(s), "
