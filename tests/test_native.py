@@ -158,7 +158,7 @@ def test_shard_map_over_two_devices_and_the_persistent_cache(tmp_path):
     assert first["devices"] == 2 and first["shards"] == 2 and first["calls"] == 1
     assert first["same"] and first["threaded"]
     assert "jit_native_draws" in first["written"] and not first["read"] and not first["hits"]
-    assert len(list((tmp_path / "cache" / "native").glob("uniforms-*.so"))) == 1
+    assert len(list((tmp_path / "cache" / "native").glob("kernels-*.so"))) == 1
     second = run_probe(tmp_path, environment)
     assert second["same"] and second["threaded"]
     assert "jit_native_draws" in second["read"] and not second["written"]

@@ -1,6 +1,6 @@
 """Native CPU kernels called from jitted programs through XLA's typed FFI (a spike, issue 67).
 
-A kernel is C++ (``uniforms.cc`` beside this module) written against the XLA FFI headers that
+A kernel is C++ (``uniforms.cc`` and ``walk.cc`` beside this module, built into one library) written against the XLA FFI headers that
 jaxlib ships (``jax.ffi.include_dir()``), compiled at first use into a cache folder, loaded with
 ``ctypes`` and registered with :func:`jax.ffi.register_ffi_target` for the ``cpu`` platform; a
 jitted program calls it with :func:`jax.ffi.ffi_call`, as one ``stablehlo.custom_call`` that
@@ -33,13 +33,16 @@ import jax.numpy as jnp
 from jaxswarm.runtime.atomic import atomic_path
 from jaxswarm.runtime.cache import VARIABLE as CACHE_VARIABLE
 
-SOURCE = Path(__file__).with_name("uniforms.cc")
-"""The kernels' C++ source."""
+SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"))
+"""The kernels' C++ sources, compiled together into one library."""
 UNIFORMS_TARGET = "jaxswarm_uniforms_v1"
 """The FFI target name of :func:`uniforms`. A compiled program names its kernels by target name
 only, so a change to a kernel's arguments or results must change its name (the ``_v1``): a
 program from the persistent cache would otherwise call a kernel that reads its buffers
 otherwise."""
+WALK_TARGET = "jaxswarm_walk_v1"
+"""The FFI target name of the plain walk (``walk.cc``; called by
+:mod:`jaxswarm.swarm.walking.native`), versioned as :data:`UNIFORMS_TARGET` is."""
 FLAGS = ("-O3", "-std=c++17", "-shared", "-fPIC", "-ffp-contract=off", "-w")
 """Compiler flags. No floating-point contraction: XLA:CPU's arithmetic has none (the uniforms
 have no multiply-add, but the walker's kernels will). No ``-march=native``: the library runs on
@@ -81,18 +84,19 @@ def compiler() -> str:
 
 
 def library_path(folder: str | os.PathLike | None = None) -> Path:
-    """Where the library built from :data:`SOURCE` with this compiler, these headers and
-    :data:`FLAGS` is (or will be): ``uniforms-<digest>.so`` in ``folder`` (default
+    """Where the library built from :data:`SOURCES` with this compiler, these headers and
+    :data:`FLAGS` is (or will be): ``kernels-<digest>.so`` in ``folder`` (default
     :func:`library_folder`)."""
     cxx = compiler()
     digest = hashlib.sha256()
-    digest.update(SOURCE.read_bytes())
+    for source in SOURCES:
+        digest.update(source.name.encode() + source.read_bytes())
     for header in sorted((Path(jax.ffi.include_dir()) / "xla" / "ffi" / "api").glob("*.h")):
         digest.update(header.name.encode() + header.read_bytes())
     digest.update(_compiler_version(cxx).encode())
     digest.update(" ".join(FLAGS + (platform.machine(),)).encode())
     root = Path(folder) if folder is not None else library_folder()
-    return root / f"uniforms-{digest.hexdigest()[:16]}.so"
+    return root / f"kernels-{digest.hexdigest()[:16]}.so"
 
 
 @functools.cache
@@ -102,7 +106,7 @@ def _compiler_version(cxx: str) -> str:
 
 
 def build(folder: str | os.PathLike | None = None) -> Path:
-    """Compile :data:`SOURCE` into :func:`library_path` unless it is there already.
+    """Compile :data:`SOURCES` into :func:`library_path` unless it is there already.
 
     Returns:
       The library's path.
@@ -115,10 +119,11 @@ def build(folder: str | os.PathLike | None = None) -> Path:
         return path
     with atomic_path(path) as temporary:
         done = subprocess.run(
-            [compiler(), *FLAGS, "-I", jax.ffi.include_dir(), str(SOURCE), "-o", str(temporary)],
+            [compiler(), *FLAGS, "-I", jax.ffi.include_dir(), *map(str, SOURCES), "-o",
+             str(temporary)],
             capture_output=True, text=True, check=False)
         if done.returncode != 0:
-            raise NativeUnavailable(f"compiling {SOURCE.name} failed:\n{done.stderr[-4000:]}")
+            raise NativeUnavailable(f"compiling {', '.join(s.name for s in SOURCES)} failed:\n{done.stderr[-4000:]}")
     return path
 
 
@@ -146,6 +151,8 @@ def register() -> ctypes.CDLL:
             except OSError as error:
                 raise NativeUnavailable(f"loading {path} failed: {error}") from error
             jax.ffi.register_ffi_target(UNIFORMS_TARGET, jax.ffi.pycapsule(library.JaxswarmUniforms),
+                                        platform="cpu")
+            jax.ffi.register_ffi_target(WALK_TARGET, jax.ffi.pycapsule(library.JaxswarmWalk),
                                         platform="cpu")
             _library = library
         return _library

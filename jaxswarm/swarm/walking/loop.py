@@ -190,8 +190,9 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
+    from jaxswarm.swarm.walking import native  # pylint: disable=import-outside-toplevel
     walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, walker.log_moves,
-                          step_budget(graph, None))(
+                          step_budget(graph, None), native.implementation(hook))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)
@@ -199,17 +200,24 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
 
 @functools.lru_cache(maxsize=None)
 def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None,
-                  log_moves: int | None, default_budget: int):
+                  log_moves: int | None, default_budget: int, implementation: str = "lanes"):
     """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R], memory,
     hook_params) -> Walk`` with a leading run axis R on everything but the graph (the table's
     may be 1), whose ``vmap`` folds the mapped axis into R; the room of each run's log as
-    :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``."""
+    :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``;
+    walked by the lanes (:func:`_walk_runs`) or, ``implementation="native"``, by the native
+    kernel (:func:`.native.walk_runs`, without a hook)."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
                  hook=hook, log_moves=log_moves, default_budget=default_budget)
+    if implementation == "native":
+        from jaxswarm.swarm.walking import native  # pylint: disable=import-outside-toplevel
+        walk_impl = native.walk_runs
+    else:
+        walk_impl = _walk_runs
 
     @custom_vmap
     def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
-        return _walk_runs(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
+        return walk_impl(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
 
     @walk_runs.def_vmap
     def batch_rule(axis_size, in_batched, seed, graph, log_weights, start, goal, memory,
@@ -217,7 +225,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         seed_b, graph_b, weights_b, start_b, goal_b, memory_b, params_b = in_batched
         if any(jax.tree_util.tree_leaves(graph_b)):
             # Walks on different maps cannot share a table of offsets: one loop per map.
-            plain = functools.partial(_walk_runs, **shape)
+            plain = functools.partial(walk_impl, **shape)
             axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
                          for b in in_batched)
             out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal, memory,

@@ -1,0 +1,125 @@
+"""The plain walk (no hook) as one native kernel call on CPU (issue 67; ``docs/native.md``).
+
+:func:`walk_runs` takes what the lanes' loop (:func:`.loop._walk_runs`) takes and returns the
+same :class:`~.loop.Walk`: the C++ handler ``walk.cc`` (:mod:`jaxswarm.runtime.native`) walks
+each agent of each run to its end in turn, with the lanes' arithmetic operation for operation,
+so every leaf is the lanes' bit for bit except ``lane_steps`` (see :func:`walk_runs`) and,
+when the batch's agents made more blocks of moves than the batch's logs hold together, the
+moves an overflowed log keeps. :data:`VARIABLE` picks the implementation when a walk is traced
+(:func:`implementation`).
+"""
+from __future__ import annotations
+
+import os
+import warnings
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxswarm.runtime import native
+from jaxswarm.swarm.walking.log import BLOCK, MoveLog, paths, room_blocks
+from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import slot_offsets, total_length
+
+VARIABLE = "JAXSWARM_WALKER"
+"""The environment variable that picks the walker's implementation when a walk is traced:
+``lanes`` (the XLA lanes, the reference) or ``native`` (this module's kernel, for walks without
+a hook on CPU). Unset: :data:`DEFAULT`."""
+
+IMPLEMENTATIONS = ("lanes", "native")
+"""The walker's implementations."""
+
+DEFAULT = "lanes"
+"""The implementation when :data:`VARIABLE` is unset (lanes on this branch for now)."""
+
+
+def implementation(hook=None) -> str:
+    """The implementation a walk traced now takes: :data:`VARIABLE`'s (else :data:`DEFAULT`);
+    ``native`` only for walks without a hook (``hook`` None) when the kernel can be built here,
+    else ``lanes`` (with a warning when the kernel cannot be built).
+
+    Raises:
+      ValueError: :data:`VARIABLE` names no implementation.
+    """
+    chosen = os.environ.get(VARIABLE, "").strip().lower() or DEFAULT
+    if chosen not in IMPLEMENTATIONS:
+        raise ValueError(f"{VARIABLE} must be one of {', '.join(IMPLEMENTATIONS)}, got "
+                         f"{chosen!r}")
+    if chosen == "native" and hook is not None:
+        return "lanes"  # the hooked walk has no native loop yet
+    if chosen == "native" and not native.available():
+        warnings.warn(f"{VARIABLE}=native but the native walker cannot be built here (no C++ "
+                      f"compiler?): walking on the lanes", RuntimeWarning, stacklevel=3)
+        return "lanes"
+    return chosen
+
+
+def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
+              num_agents: int, max_steps: int, greedy_agents: int, hook, log_moves: int | None,
+              default_budget: int):
+    """:func:`.loop._walk_runs` without a hook, as one native kernel call.
+
+    Every leaf of the :class:`~.loop.Walk` equals the lanes' bit for bit, but:
+
+    * ``lane_steps``: the kernel has no lanes; it counts the steps its agents took (a move, or
+      the last look round of an agent that stopped stuck), the batch's total in every run's
+      entry, so ``sum(moves) / lane_steps`` is at most 1 and close to it;
+    * when the batch's agents own more blocks of moves than the batch's logs hold together
+      (the lanes' journal then overflows), every run says it overflowed, as the lanes' do, but
+      the blocks an overflowed log keeps differ: the lanes lose the blocks written last in
+      their schedule, the kernel those past each run's room in agent order (an overflowed log
+      is never read: the run is made again with a larger log).
+
+    Args:
+      seed: u32[R, 2]; graph: the map; log_weights: f32[R or 1, N, K]; start, goal: i32[R];
+      memory, hook_params: None (no hook); the rest static, as :func:`.loop._walk_runs`'s.
+
+    Raises:
+      ValueError: a hook was given.
+    """
+    if hook is not None:
+        raise ValueError("the native walker walks without a hook only")
+    del memory, hook_params
+    native.register()
+    runs = start.shape[0]
+    blocks = room_blocks(num_agents, max_steps, log_moves, default_budget)
+    slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
+    neighbours = (jnp.asarray(slot_offsets(graph)) if graph.is_grid
+                  else jnp.asarray(graph.nbr, jnp.int32))
+    words = (graph.num_nodes + 31) // 32
+    per_agent = (runs, num_agents)
+    shapes = (
+        jax.ShapeDtypeStruct((runs, blocks, BLOCK), jnp.int32),  # nodes
+        jax.ShapeDtypeStruct((runs, blocks, BLOCK), slot_dtype),  # slots
+        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # offset
+        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # moves
+        jax.ShapeDtypeStruct((runs,), jnp.bool_),  # overflowed
+        jax.ShapeDtypeStruct(per_agent, jnp.float32),  # length
+        jax.ShapeDtypeStruct(per_agent, jnp.bool_),  # arrived
+        jax.ShapeDtypeStruct(per_agent, jnp.bool_),  # stuck
+        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # position
+        jax.ShapeDtypeStruct(per_agent + (words,), jnp.uint32),  # visited
+        jax.ShapeDtypeStruct((runs,), jnp.int32),  # steps
+    )
+    # "sequential": walks on different maps (a vmap the walker's batching rule does not fold)
+    # are one call each; the runs of one map come folded into R by that rule.
+    (nodes, slots, offset, moves, overflowed, length, arrived, stuck, position, visited,
+     steps) = jax.ffi.ffi_call(native.WALK_TARGET, shapes, vmap_method="sequential")(
+        jnp.asarray(seed, jnp.uint32), jnp.asarray(log_weights, jnp.float32),
+        jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours,
+        num_agents=np.int32(num_agents), max_steps=np.int32(max_steps),
+        greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks))
+    log = MoveLog(nodes=nodes, slots=slots, offset=offset, moves=moves, start=start,
+                  overflowed=overflowed, max_steps=max_steps)
+    if not graph.is_grid:  # general graphs: the edge costs summed from the log, as the lanes do
+        length = jax.vmap(lambda one: total_length(graph, *_moves_out_of(paths(one))))(log)
+    from jaxswarm.swarm.walking.loop import Walk  # pylint: disable=import-outside-toplevel
+    return Walk(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
+                visited=visited, moves=moves, lane_steps=steps)
+
+
+def _moves_out_of(rows):
+    """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
+    path, slots = rows
+    return path[:, :-1], slots
