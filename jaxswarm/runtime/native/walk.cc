@@ -4,12 +4,20 @@
 //
 //   seed u32[R, 2], log_weights f32[R or 1, N, K], start i32[R], goal i32[R],
 //   neighbours i32[K] (a grid or path map's slot offsets) or i32[N, K] (a graph's nbr table)
-//   attributes num_agents, max_steps, greedy_agents, blocks (each run's log's room)
+//   attributes num_agents, max_steps, greedy_agents, blocks (each run's log's room), and the
+//   lanes' schedule: lanes (loop.lanes_for of R * A), refill_share, compact_share,
+//   smallest_compaction (loop.REFILL_SHARE, COMPACT_SHARE, SMALLEST_COMPACTION)
 //   -> nodes i32[R, blocks, 16], slots i8 or i16[R, blocks, 16], offset i32[R, A],
 //      moves i32[R, A], overflowed pred[R], length f32[R, A] (grids; 0 on graphs, whose
 //      lengths the caller sums from the log), arrived pred[R, A], stuck pred[R, A],
-//      position i32[R, A], visited u32[R, A, ceil(N / 32)], steps i32[R] (the batch's
-//      agent-steps: moves made plus one for each agent that stopped stuck, in every entry)
+//      position i32[R, A], visited u32[R, A, ceil(N / 32)], lane_steps i32[R]
+//
+// The walks do not depend on the lanes' schedule, but two outputs do: the lane-steps the
+// lanes' loop executes, and, when the batch's agents own more blocks of moves than the batch's
+// logs hold together, which blocks the lanes' journal loses. Once every agent has walked, the
+// handler replays the loop's schedule (jaxswarm.swarm.walking.loop._walk_agents: the queue, the
+// refills, the narrowings) from each agent's step count alone, at one operation per lane and
+// block, and takes both from it.
 //
 // The arithmetic is the walker's operation for operation: jaxswarm.runtime.arithmetic.exp
 // (Cephes' polynomial, the same float32 constants, the same order), the masked sampler's sums
@@ -116,10 +124,111 @@ struct Map {
   int32_t num_nodes, degree, words;
 };
 
+// The lanes' loop's schedule (jaxswarm.swarm.walking.loop).
+struct Schedule {
+  int32_t lanes, refill_share, compact_share, smallest_compaction;
+};
+
+// Replays jaxswarm.swarm.walking.loop._walk_agents's schedule for agents that made moves[f]
+// moves and stopped stuck (stuck[f]) or not, row f = agent f % agents of run f / agents: the
+// queue (the rows of runs that do not start at their goal, in row order), the lanes taking
+// them, blocks of kBlock lockstep steps, refills of at most lanes / refill_share stopped lanes,
+// and the narrowings. Each block whose agent moved in it is appended to the journal in lane
+// order; the blocks past the journal's room (runs * blocks) are lost: their places in the logs
+// (laid out in agent order, offset[f] + the block's index, when within the run's room) are
+// emptied, as jaxswarm.swarm.walking.journal.ordered_logs leaves them. Returns the lane-steps
+// (int32, wrapping as XLA's sum does).
 template <typename Slot>
-ffi::Error WalkAll(const Map& map, const uint32_t* seed, const int32_t* start,
-                   const int32_t* goal, int64_t runs, int32_t agents, int32_t max_steps,
-                   int32_t greedy_agents, int64_t blocks, int32_t* nodes, Slot* slots,
+int32_t Replay(const Schedule& schedule, const int32_t* moves, const bool* stuck,
+               const int32_t* start, const int32_t* goal, int64_t runs, int32_t agents,
+               int64_t blocks, const int32_t* offset, int32_t* nodes, Slot* slots) {
+  const int64_t count = runs * agents, none = count, room = runs * blocks;
+  std::vector<int64_t> order;
+  for (int64_t f = 0; f < count; ++f) {
+    if (start[f / agents] != goal[f / agents]) order.push_back(f);
+  }
+  const int64_t live = static_cast<int64_t>(order.size());
+  auto steps_of = [&](int64_t f) { return static_cast<int64_t>(moves[f]) + (stuck[f] ? 1 : 0); };
+  int64_t width = schedule.lanes;
+  std::vector<int64_t> agent(width, none), done(width, 0);
+  std::vector<char> walking(width, 0);
+  for (int64_t l = 0; l < width && l < live; ++l) {
+    agent[l] = order[l];
+    walking[l] = 1;
+  }
+  int64_t next = std::min(width, live), written = 0;
+  uint32_t lane_steps = 0;
+  auto walking_count = [&]() {
+    int64_t n = 0;
+    for (int64_t l = 0; l < width; ++l) n += walking[l];
+    return n;
+  };
+  auto block = [&]() {
+    for (int64_t l = 0; l < width; ++l) {
+      if (agent[l] == none || !walking[l]) continue;
+      const int64_t f = agent[l], j = done[l];
+      if (moves[f] > j * kBlock) {  // the agent moved in this block: the lane appends it
+        if (written >= room) {     // lost: its place in the log stays empty
+          const int64_t place = offset[f] + j;
+          if (place < blocks) {
+            const int64_t at = ((f / agents) * blocks + place) * kBlock;
+            std::fill(nodes + at, nodes + at + kBlock, kNoNode);
+            std::fill(slots + at, slots + at + kBlock, static_cast<Slot>(-1));
+          }
+        }
+        ++written;
+      }
+      done[l] = j + 1;
+      walking[l] = steps_of(f) > (j + 1) * kBlock;
+    }
+    lane_steps += static_cast<uint32_t>(width) * static_cast<uint32_t>(kBlock);
+  };
+  auto flush = [&]() {
+    for (int64_t l = 0; l < width; ++l) {
+      if (agent[l] != none && !walking[l]) agent[l] = none;
+    }
+  };
+  int64_t few = width / schedule.compact_share;
+  while (next < live || walking_count() > few) {
+    block();
+    const int64_t cap = std::max<int64_t>(width / schedule.refill_share, 1);
+    int64_t taken = 0;
+    for (int64_t l = 0; l < width && taken < cap; ++l) {
+      if (agent[l] == none || walking[l]) continue;
+      const int64_t queued = next + taken++;
+      agent[l] = queued < live ? order[queued] : none;
+      walking[l] = queued < live;
+      done[l] = 0;
+    }
+    next = std::min(next + taken, live);
+  }
+  flush();
+  while (few) {
+    int64_t fewer = few / schedule.compact_share;
+    if (fewer < schedule.smallest_compaction) fewer = 0;
+    std::vector<int64_t> kept_agent(few, none), kept_done(few, 0);
+    std::vector<char> kept_walking(few, 0);
+    for (int64_t l = 0, k = 0; l < width && k < few; ++l) {
+      if (!walking[l]) continue;
+      kept_agent[k] = agent[l];
+      kept_done[k] = done[l];
+      kept_walking[k++] = 1;
+    }
+    agent.swap(kept_agent);
+    done.swap(kept_done);
+    walking.swap(kept_walking);
+    width = few;
+    while (walking_count() > fewer) block();
+    flush();
+    few = fewer;
+  }
+  return static_cast<int32_t>(lane_steps);
+}
+
+template <typename Slot>
+ffi::Error WalkAll(const Map& map, const Schedule& schedule, const uint32_t* seed,
+                   const int32_t* start, const int32_t* goal, int64_t runs, int32_t agents,
+                   int32_t max_steps, int32_t greedy_agents, int64_t blocks, int32_t* nodes, Slot* slots,
                    int32_t* offset, int32_t* moves_out, bool* overflowed, float* length,
                    bool* arrived_out, bool* stuck_out, int32_t* position, uint32_t* visited_out,
                    int32_t* steps_out) {
@@ -130,7 +239,7 @@ ffi::Error WalkAll(const Map& map, const uint32_t* seed, const int32_t* start,
   std::fill(slots, slots + runs * blocks * kBlock, static_cast<Slot>(-1));
   std::fill(visited_out, visited_out + runs * agents * W, 0u);
   const float inf = std::numeric_limits<float>::infinity();
-  int64_t steps = 0, owned_total = 0;
+  int64_t owned_total = 0;
   for (int64_t r = 0; r < runs; ++r) {
     const float* table = map.log_weights + (map.table_runs > 1 ? r : 0) * N * K;
     const uint32_t s0 = seed[2 * r], s1 = seed[2 * r + 1];
@@ -148,7 +257,6 @@ ffi::Error WalkAll(const Map& map, const uint32_t* seed, const int32_t* start,
       const int64_t first = owned;
       bool walking = !arrived;
       while (walking) {
-        ++steps;
         const float* row = table + static_cast<int64_t>(here) * K;
         float top = -inf;
         for (int32_t k = 0; k < K; ++k) {
@@ -211,20 +319,23 @@ ffi::Error WalkAll(const Map& map, const uint32_t* seed, const int32_t* start,
   // The XLA walker's journal has room for the batch's blocks together: when the batch's agents
   // own more, every run says it overflowed (jaxswarm.swarm.walking.journal.ordered_logs).
   if (owned_total > runs * blocks) std::fill(overflowed, overflowed + runs, true);
-  std::fill(steps_out, steps_out + runs, static_cast<int32_t>(steps));
+  const int32_t lane_steps = Replay(schedule, moves_out, stuck_out, start, goal, runs, agents,
+                                    blocks, offset, nodes, slots);
+  std::fill(steps_out, steps_out + runs, lane_steps);
   return ffi::Error::Success();
 }
 
 ffi::Error WalkImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::F32> log_weights,
                     ffi::Buffer<ffi::S32> start, ffi::Buffer<ffi::S32> goal,
                     ffi::Buffer<ffi::S32> neighbours, int32_t num_agents, int32_t max_steps,
-                    int32_t greedy_agents, int32_t blocks,
+                    int32_t greedy_agents, int32_t blocks, int32_t lanes,
+                    int32_t refill_share, int32_t compact_share, int32_t smallest_compaction,
                     ffi::ResultBuffer<ffi::S32> nodes, ffi::Result<ffi::AnyBuffer> slots,
                     ffi::ResultBuffer<ffi::S32> offset, ffi::ResultBuffer<ffi::S32> moves,
                     ffi::ResultBuffer<ffi::PRED> overflowed, ffi::ResultBuffer<ffi::F32> length,
                     ffi::ResultBuffer<ffi::PRED> arrived, ffi::ResultBuffer<ffi::PRED> stuck,
                     ffi::ResultBuffer<ffi::S32> position, ffi::ResultBuffer<ffi::U32> visited,
-                    ffi::ResultBuffer<ffi::S32> steps) {
+                    ffi::ResultBuffer<ffi::S32> lane_steps) {
   auto seed_dims = seed.dimensions();
   auto table_dims = log_weights.dimensions();
   auto neighbour_dims = neighbours.dimensions();
@@ -248,6 +359,10 @@ ffi::Error WalkImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::F32> log_weight
   if (N < 1 || K < 1 || num_agents < 1 || blocks < 0) {
     return ffi::Error::InvalidArgument("walk: empty map, no agents or negative room");
   }
+  if (lanes < 1 || refill_share < 1 || compact_share < 2 || smallest_compaction < 1) {
+    return ffi::Error::InvalidArgument("walk: the lanes' schedule needs lanes >= 1, "
+                                       "refill_share >= 1, compact_share >= 2");
+  }
   const int64_t words = (N + 31) / 32;
   const size_t per_agent = static_cast<size_t>(runs) * num_agents;
   const size_t log_entries = static_cast<size_t>(runs) * blocks * kBlock;
@@ -257,7 +372,7 @@ ffi::Error WalkImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::F32> log_weight
       length->element_count() != per_agent || arrived->element_count() != per_agent ||
       stuck->element_count() != per_agent || position->element_count() != per_agent ||
       visited->element_count() != per_agent * words ||
-      steps->element_count() != static_cast<size_t>(runs)) {
+      lane_steps->element_count() != static_cast<size_t>(runs)) {
     return ffi::Error::InvalidArgument("walk: an output's shape does not match the inputs");
   }
   const int32_t* starts = start.typed_data();
@@ -270,12 +385,13 @@ ffi::Error WalkImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::F32> log_weight
   FlushDenormals flush;
   const Map map{log_weights.typed_data(), table_dims[0], neighbours.typed_data(), grid,
                 static_cast<int32_t>(N), static_cast<int32_t>(K), static_cast<int32_t>(words)};
+  const Schedule schedule{lanes, refill_share, compact_share, smallest_compaction};
   auto run = [&](auto* slot_data) {
-    return WalkAll(map, seed.typed_data(), starts, goals, runs, num_agents, max_steps,
+    return WalkAll(map, schedule, seed.typed_data(), starts, goals, runs, num_agents, max_steps,
                    greedy_agents, blocks, nodes->typed_data(), slot_data, offset->typed_data(),
                    moves->typed_data(), overflowed->typed_data(), length->typed_data(),
                    arrived->typed_data(), stuck->typed_data(), position->typed_data(),
-                   visited->typed_data(), steps->typed_data());
+                   visited->typed_data(), lane_steps->typed_data());
   };
   switch (slots->element_type()) {
     case ffi::DataType::S8:
@@ -302,6 +418,10 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(JaxswarmWalk, WalkImpl,
                                   .Attr<int32_t>("max_steps")
                                   .Attr<int32_t>("greedy_agents")
                                   .Attr<int32_t>("blocks")
+                                  .Attr<int32_t>("lanes")
+                                  .Attr<int32_t>("refill_share")
+                                  .Attr<int32_t>("compact_share")
+                                  .Attr<int32_t>("smallest_compaction")
                                   .Ret<ffi::Buffer<ffi::S32>>()   // nodes
                                   .Ret<ffi::AnyBuffer>()          // slots
                                   .Ret<ffi::Buffer<ffi::S32>>()   // offset
@@ -312,5 +432,5 @@ XLA_FFI_DEFINE_HANDLER_SYMBOL(JaxswarmWalk, WalkImpl,
                                   .Ret<ffi::Buffer<ffi::PRED>>()  // stuck
                                   .Ret<ffi::Buffer<ffi::S32>>()   // position
                                   .Ret<ffi::Buffer<ffi::U32>>()   // visited
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // steps
+                                  .Ret<ffi::Buffer<ffi::S32>>()   // lane_steps
 );

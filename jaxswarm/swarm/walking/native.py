@@ -1,11 +1,11 @@
 """The plain walk (no hook) as one native kernel call on CPU (issue 67; ``docs/native.md``).
 
 :func:`walk_runs` takes what the lanes' loop (:func:`.loop._walk_runs`) takes and returns the
-same :class:`~.loop.Walk`: the C++ handler ``walk.cc`` (:mod:`jaxswarm.runtime.native`) walks
-each agent of each run to its end in turn, with the lanes' arithmetic operation for operation,
-so every leaf is the lanes' bit for bit except ``lane_steps`` (see :func:`walk_runs`) and,
-when the batch's agents made more blocks of moves than the batch's logs hold together, the
-moves an overflowed log keeps. :data:`VARIABLE` picks the implementation when a walk is traced
+same :class:`~.loop.Walk`, every leaf bit for bit: the C++ handler ``walk.cc``
+(:mod:`jaxswarm.runtime.native`) walks each agent of each run to its end in turn with the
+lanes' arithmetic operation for operation, then replays the lanes' schedule from the agents'
+step counts for the two outputs that depend on it (``lane_steps``, and the blocks an
+overflowed journal loses). :data:`VARIABLE` picks the implementation when a walk is traced
 (:func:`implementation`).
 """
 from __future__ import annotations
@@ -58,18 +58,9 @@ def implementation(hook=None) -> str:
 def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
               num_agents: int, max_steps: int, greedy_agents: int, hook, log_moves: int | None,
               default_budget: int):
-    """:func:`.loop._walk_runs` without a hook, as one native kernel call.
-
-    Every leaf of the :class:`~.loop.Walk` equals the lanes' bit for bit, but:
-
-    * ``lane_steps``: the kernel has no lanes; it counts the steps its agents took (a move, or
-      the last look round of an agent that stopped stuck), the batch's total in every run's
-      entry, so ``sum(moves) / lane_steps`` is at most 1 and close to it;
-    * when the batch's agents own more blocks of moves than the batch's logs hold together
-      (the lanes' journal then overflows), every run says it overflowed, as the lanes' do, but
-      the blocks an overflowed log keeps differ: the lanes lose the blocks written last in
-      their schedule, the kernel those past each run's room in agent order (an overflowed log
-      is never read: the run is made again with a larger log).
+    """:func:`.loop._walk_runs` without a hook, as one native kernel call: the same
+    :class:`~.loop.Walk`, every leaf bit for bit, ``lane_steps`` (the lane-steps the lanes'
+    loop would have executed, replayed) and an overflowed log's blocks included.
 
     Args:
       seed: u32[R, 2]; graph: the map; log_weights: f32[R or 1, N, K]; start, goal: i32[R];
@@ -81,6 +72,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
     if hook is not None:
         raise ValueError("the native walker walks without a hook only")
     del memory, hook_params
+    from jaxswarm.swarm.walking import loop  # pylint: disable=import-outside-toplevel
     native.register()
     runs = start.shape[0]
     blocks = room_blocks(num_agents, max_steps, log_moves, default_budget)
@@ -100,23 +92,25 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         jax.ShapeDtypeStruct(per_agent, jnp.bool_),  # stuck
         jax.ShapeDtypeStruct(per_agent, jnp.int32),  # position
         jax.ShapeDtypeStruct(per_agent + (words,), jnp.uint32),  # visited
-        jax.ShapeDtypeStruct((runs,), jnp.int32),  # steps
+        jax.ShapeDtypeStruct((runs,), jnp.int32),  # lane_steps
     )
     # "sequential": walks on different maps (a vmap the walker's batching rule does not fold)
     # are one call each; the runs of one map come folded into R by that rule.
     (nodes, slots, offset, moves, overflowed, length, arrived, stuck, position, visited,
-     steps) = jax.ffi.ffi_call(native.WALK_TARGET, shapes, vmap_method="sequential")(
+     lane_steps) = jax.ffi.ffi_call(native.WALK_TARGET, shapes, vmap_method="sequential")(
         jnp.asarray(seed, jnp.uint32), jnp.asarray(log_weights, jnp.float32),
         jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours,
         num_agents=np.int32(num_agents), max_steps=np.int32(max_steps),
-        greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks))
+        greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks),
+        lanes=np.int32(loop.lanes_for(runs * num_agents)),
+        refill_share=np.int32(loop.REFILL_SHARE), compact_share=np.int32(loop.COMPACT_SHARE),
+        smallest_compaction=np.int32(loop.SMALLEST_COMPACTION))
     log = MoveLog(nodes=nodes, slots=slots, offset=offset, moves=moves, start=start,
                   overflowed=overflowed, max_steps=max_steps)
     if not graph.is_grid:  # general graphs: the edge costs summed from the log, as the lanes do
         length = jax.vmap(lambda one: total_length(graph, *_moves_out_of(paths(one))))(log)
-    from jaxswarm.swarm.walking.loop import Walk  # pylint: disable=import-outside-toplevel
-    return Walk(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
-                visited=visited, moves=moves, lane_steps=steps)
+    return loop.Walk(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
+                visited=visited, moves=moves, lane_steps=lane_steps)
 
 
 def _moves_out_of(rows):
