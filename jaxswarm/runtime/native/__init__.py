@@ -1,14 +1,15 @@
 """Native CPU kernels called from jitted programs through XLA's typed FFI (a spike, issue 67).
 
-A kernel is C++ (``uniforms.cc`` and ``walk.cc`` beside this module, built into one library) written against the XLA FFI headers that
-jaxlib ships (``jax.ffi.include_dir()``), compiled at first use into a cache folder, loaded with
-``ctypes`` and registered with :func:`jax.ffi.register_ffi_target` for the ``cpu`` platform; a
-jitted program calls it with :func:`jax.ffi.ffi_call`, as one ``stablehlo.custom_call`` that
-XLA runs like any other kernel (no Python, no host callback), so the program is kept in JAX's
-persistent compilation cache like any other. See ``docs/native.md`` for the choices and
+A kernel is C++ (``uniforms.cc`` and ``walk.cc`` beside this module, built into one library)
+written against the XLA FFI headers that jaxlib ships (``jax.ffi.include_dir()``), compiled at
+first use into a cache folder, loaded with ``ctypes`` and registered with
+:func:`jax.ffi.register_ffi_target` for the ``cpu`` platform; a jitted program calls it with
+:func:`jax.ffi.ffi_call`, as one ``stablehlo.custom_call`` that XLA runs like any other kernel
+(no Python, no host callback), so the program is kept in JAX's persistent compilation cache
+like any other. See ``docs/native.md`` for the choices and
 measurements.
 
-The compiled library is named by a digest of everything it depends on (the source, the FFI
+The compiled library is named by a digest of everything it depends on (the sources, the FFI
 headers, the compiler's version and the flags), in ``$JAXSWARM_CACHE/native`` when
 ``JAXSWARM_CACHE`` is set, else ``$XDG_CACHE_HOME/jaxswarm/native`` (``~/.cache/jaxswarm/native``);
 a build writes a temporary file and moves it into place, so processes building at once do not
@@ -123,7 +124,8 @@ def build(folder: str | os.PathLike | None = None) -> Path:
              str(temporary)],
             capture_output=True, text=True, check=False)
         if done.returncode != 0:
-            raise NativeUnavailable(f"compiling {', '.join(s.name for s in SOURCES)} failed:\n{done.stderr[-4000:]}")
+            names = ", ".join(source.name for source in SOURCES)
+            raise NativeUnavailable(f"compiling {names} failed:\n{done.stderr[-4000:]}")
     return path
 
 
@@ -150,7 +152,8 @@ def register() -> ctypes.CDLL:
                 library = ctypes.CDLL(str(path))
             except OSError as error:
                 raise NativeUnavailable(f"loading {path} failed: {error}") from error
-            jax.ffi.register_ffi_target(UNIFORMS_TARGET, jax.ffi.pycapsule(library.JaxswarmUniforms),
+            jax.ffi.register_ffi_target(UNIFORMS_TARGET,
+                                        jax.ffi.pycapsule(library.JaxswarmUniforms),
                                         platform="cpu")
             jax.ffi.register_ffi_target(WALK_TARGET, jax.ffi.pycapsule(library.JaxswarmWalk),
                                         platform="cpu")

@@ -29,7 +29,7 @@ import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
-from jaxswarm.swarm.walking import bits
+from jaxswarm.swarm.walking import bits, native
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
@@ -190,7 +190,6 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     seed = jax.random.bits(key, (1, 2), jnp.uint32)
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
-    from jaxswarm.swarm.walking import native  # pylint: disable=import-outside-toplevel
     walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, walker.log_moves,
                           step_budget(graph, None), native.implementation(hook))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
@@ -209,11 +208,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
     kernel (:func:`.native.walk_runs`, without a hook)."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
                  hook=hook, log_moves=log_moves, default_budget=default_budget)
-    if implementation == "native":
-        from jaxswarm.swarm.walking import native  # pylint: disable=import-outside-toplevel
-        walk_impl = native.walk_runs
-    else:
-        walk_impl = _walk_runs
+    walk_impl = _native_walk_runs if implementation == "native" else _walk_runs
 
     @custom_vmap
     def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
@@ -323,6 +318,16 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
     return Walk(**{name: None if x is None else x.reshape((runs, num_agents) + x.shape[1:])
                    for name, x in per_agent.items()},
                 log=logs, lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
+
+
+def _native_walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
+                      **shape) -> Walk:
+    """:func:`_walk_runs` without a hook as one native kernel call (:func:`.native.walk_runs`),
+    which replays this module's schedule of lanes for the outputs that depend on it."""
+    schedule = (lanes_for(start.shape[0] * shape["num_agents"]), REFILL_SHARE, COMPACT_SHARE,
+                SMALLEST_COMPACTION)
+    return Walk(**native.walk_runs(seed, graph, log_weights, start, goal, memory, hook_params,
+                                   schedule=schedule, **shape))
 
 
 def _moves_out_of(rows):

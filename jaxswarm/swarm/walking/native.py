@@ -1,7 +1,7 @@
 """The plain walk (no hook) as one native kernel call on CPU (issue 67; ``docs/native.md``).
 
-:func:`walk_runs` takes what the lanes' loop (:func:`.loop._walk_runs`) takes and returns the
-same :class:`~.loop.Walk`, every leaf bit for bit: the C++ handler ``walk.cc``
+:func:`walk_runs` takes what the lanes' loop (``loop._walk_runs``) takes and returns the fields
+of the same :class:`~.loop.Walk`, every leaf bit for bit: the C++ handler ``walk.cc``
 (:mod:`jaxswarm.runtime.native`) walks each agent of each run to its end in turn with the
 lanes' arithmetic operation for operation, then replays the lanes' schedule from the agents'
 step counts for the two outputs that depend on it (``lane_steps``, and the blocks an
@@ -57,14 +57,17 @@ def implementation(hook=None) -> str:
 
 def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
               num_agents: int, max_steps: int, greedy_agents: int, hook, log_moves: int | None,
-              default_budget: int):
-    """:func:`.loop._walk_runs` without a hook, as one native kernel call: the same
-    :class:`~.loop.Walk`, every leaf bit for bit, ``lane_steps`` (the lane-steps the lanes'
-    loop would have executed, replayed) and an overflowed log's blocks included.
+              default_budget: int, schedule: tuple[int, int, int, int]) -> dict:
+    """``loop._walk_runs`` without a hook, as one native kernel call: the fields of the same
+    :class:`~.loop.Walk` (the loop builds it), every leaf bit for bit, ``lane_steps`` (the
+    lane-steps the lanes' loop would have executed, replayed) and an overflowed log's blocks
+    included.
 
     Args:
       seed: u32[R, 2]; graph: the map; log_weights: f32[R or 1, N, K]; start, goal: i32[R];
-      memory, hook_params: None (no hook); the rest static, as :func:`.loop._walk_runs`'s.
+      memory, hook_params: None (no hook); the rest static, as ``loop._walk_runs``'s, and
+      ``schedule``: the lanes' loop's ``(lanes_for(R * A), REFILL_SHARE, COMPACT_SHARE,
+      SMALLEST_COMPACTION)``, which the kernel replays.
 
     Raises:
       ValueError: a hook was given.
@@ -72,8 +75,8 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
     if hook is not None:
         raise ValueError("the native walker walks without a hook only")
     del memory, hook_params
-    from jaxswarm.swarm.walking import loop  # pylint: disable=import-outside-toplevel
     native.register()
+    lanes, refill_share, compact_share, smallest_compaction = schedule
     runs = start.shape[0]
     blocks = room_blocks(num_agents, max_steps, log_moves, default_budget)
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
@@ -102,14 +105,13 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours,
         num_agents=np.int32(num_agents), max_steps=np.int32(max_steps),
         greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks),
-        lanes=np.int32(loop.lanes_for(runs * num_agents)),
-        refill_share=np.int32(loop.REFILL_SHARE), compact_share=np.int32(loop.COMPACT_SHARE),
-        smallest_compaction=np.int32(loop.SMALLEST_COMPACTION))
+        lanes=np.int32(lanes), refill_share=np.int32(refill_share),
+        compact_share=np.int32(compact_share), smallest_compaction=np.int32(smallest_compaction))
     log = MoveLog(nodes=nodes, slots=slots, offset=offset, moves=moves, start=start,
                   overflowed=overflowed, max_steps=max_steps)
     if not graph.is_grid:  # general graphs: the edge costs summed from the log, as the lanes do
         length = jax.vmap(lambda one: total_length(graph, *_moves_out_of(paths(one))))(log)
-    return loop.Walk(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
+    return dict(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
                 visited=visited, moves=moves, lane_steps=lane_steps)
 
 
