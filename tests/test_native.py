@@ -1,5 +1,5 @@
-"""jaxswarm.runtime.native: a C++ kernel called from jitted programs through XLA's typed FFI
-(the spike of issue 67): bit for bit the walker's uniforms under jit, vmap, a custom_vmap rule
+"""jaxswarm.runtime.native: a C++ kernel called from jitted programs through XLA's typed FFI:
+bit for bit the walker's uniforms under jit, vmap, a custom_vmap rule
 and shard_map over two CPU devices, and its programs kept in JAX's persistent cache."""
 import json
 import os

@@ -1,4 +1,4 @@
-"""Native CPU kernels called from jitted programs through XLA's typed FFI (a spike, issue 67).
+"""Native CPU kernels called from jitted programs through XLA's typed FFI.
 
 A kernel is C++ (``uniforms.cc`` and ``walk.cc`` beside this module, built into one library)
 written against the XLA FFI headers that jaxlib ships (``jax.ffi.include_dir()``), compiled at

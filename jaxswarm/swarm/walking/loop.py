@@ -35,10 +35,10 @@ from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane
                                           start_visited, step)
 from jaxswarm.swarm.walking.journal import Journal, append, empty_journal, ordered_logs
 from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, WalkerOptions, agent_path,
-                                        known_overflowed, paths, room_blocks)
+                                        known_overflowed, paths, room_blocks, walked_lengths)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
-from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
+from jaxswarm.world.lattice import lattice_length, slot_offsets
 
 LANES = 1024
 """The most lanes one walk loop steps: more no longer speed a step up (their visited sets leave the
@@ -310,8 +310,7 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
     else:  # general graphs (small): the edge costs summed along the rows
-        length = jax.vmap(lambda log: total_length(graph, *_moves_out_of(paths(log))))(logs)
-        length = length.reshape(-1)
+        length = walked_lengths(graph, logs).reshape(-1)
     per_agent = dict(length=length, arrived=results.arrived, stuck=results.stuck,
                      position=results.position, visited=results.visited, moves=results.moves,
                      state=results.state)
@@ -328,12 +327,6 @@ def _native_walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook
                 SMALLEST_COMPACTION)
     return Walk(**native.walk_runs(seed, graph, log_weights, start, goal, memory, hook_params,
                                    schedule=schedule, **shape))
-
-
-def _moves_out_of(rows):
-    """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
-    path, slots = rows
-    return path[:, :-1], slots
 
 
 def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):

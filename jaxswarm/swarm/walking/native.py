@@ -18,9 +18,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.runtime import native
-from jaxswarm.swarm.walking.log import BLOCK, MoveLog, paths, room_blocks
+from jaxswarm.swarm.walking.log import BLOCK, MoveLog, room_blocks, walked_lengths
 from jaxswarm.world.graph import Graph
-from jaxswarm.world.lattice import slot_offsets, total_length
+from jaxswarm.world.lattice import slot_offsets
 
 VARIABLE = "JAXSWARM_WALKER"
 """The environment variable that picks the walker's implementation when a walk is traced:
@@ -31,7 +31,8 @@ IMPLEMENTATIONS = ("lanes", "native")
 """The walker's implementations."""
 
 DEFAULT = "lanes"
-"""The implementation when :data:`VARIABLE` is unset (lanes on this branch for now)."""
+"""The implementation when :data:`VARIABLE` is unset: the lanes, until the native loop walks
+every kind of walk (the hooked and the backtracking walks do not yet)."""
 
 
 def implementation(hook=None) -> str:
@@ -110,12 +111,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
     log = MoveLog(nodes=nodes, slots=slots, offset=offset, moves=moves, start=start,
                   overflowed=overflowed, max_steps=max_steps)
     if not graph.is_grid:  # general graphs: the edge costs summed from the log, as the lanes do
-        length = jax.vmap(lambda one: total_length(graph, *_moves_out_of(paths(one))))(log)
+        length = walked_lengths(graph, log)
     return dict(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
                 visited=visited, moves=moves, lane_steps=lane_steps)
 
-
-def _moves_out_of(rows):
-    """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
-    path, slots = rows
-    return path[:, :-1], slots
