@@ -33,6 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.world.graph import NO_NODE
+from jaxswarm.world.lattice import total_length
 
 BLOCK = 16
 """Moves per block: the moves a lane makes between two refills of the walk loop."""
@@ -232,6 +233,15 @@ def _one_agent(log: MoveLog, agent: jax.Array) -> MoveLog:
     known = jnp.minimum(agent, count - 1)
     return dataclasses.replace(log, offset=log.offset[known][None],
                                moves=jnp.where(agent < count, log.moves[known], 0)[None])
+
+
+def walked_lengths(graph, logs: MoveLog) -> jax.Array:
+    """f32[R, A]: each agent's walked length on a general graph, the edge costs summed along its
+    logged moves (``logs`` with a leading run axis R)."""
+    def one(log):
+        path, slots = paths(log)
+        return total_length(graph, path[:, :-1], slots)
+    return jax.vmap(one)(logs)
 
 
 def known_overflowed(flag: jax.Array) -> bool:

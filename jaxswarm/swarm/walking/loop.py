@@ -29,16 +29,16 @@ import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
-from jaxswarm.swarm.walking import bits
+from jaxswarm.swarm.walking import bits, native
 from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
 from jaxswarm.swarm.walking.journal import Journal, append, empty_journal, ordered_logs
 from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, WalkerOptions, agent_path,
-                                        known_overflowed, paths, room_blocks)
+                                        known_overflowed, paths, room_blocks, walked_lengths)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
-from jaxswarm.world.lattice import lattice_length, slot_offsets, total_length
+from jaxswarm.world.lattice import lattice_length, slot_offsets
 
 LANES = 1024
 """The most lanes one walk loop steps: more no longer speed a step up (their visited sets leave the
@@ -191,7 +191,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
     walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, walker.log_moves,
-                          step_budget(graph, None))(
+                          step_budget(graph, None), native.implementation(hook))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)
@@ -199,17 +199,20 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
 
 @functools.lru_cache(maxsize=None)
 def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: StepHook | None,
-                  log_moves: int | None, default_budget: int):
+                  log_moves: int | None, default_budget: int, implementation: str = "lanes"):
     """``(seed u32[R, 2], graph, log_weights f32[R, N, K], start i32[R], goal i32[R], memory,
     hook_params) -> Walk`` with a leading run axis R on everything but the graph (the table's
     may be 1), whose ``vmap`` folds the mapped axis into R; the room of each run's log as
-    :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``."""
+    :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``;
+    walked by the lanes (:func:`_walk_runs`) or, ``implementation="native"``, by the native
+    kernel (:func:`.native.walk_runs`, without a hook)."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
                  hook=hook, log_moves=log_moves, default_budget=default_budget)
+    walk_impl = _native_walk_runs if implementation == "native" else _walk_runs
 
     @custom_vmap
     def walk_runs(seed, graph, log_weights, start, goal, memory, hook_params):
-        return _walk_runs(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
+        return walk_impl(seed, graph, log_weights, start, goal, memory, hook_params, **shape)
 
     @walk_runs.def_vmap
     def batch_rule(axis_size, in_batched, seed, graph, log_weights, start, goal, memory,
@@ -217,7 +220,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
         seed_b, graph_b, weights_b, start_b, goal_b, memory_b, params_b = in_batched
         if any(jax.tree_util.tree_leaves(graph_b)):
             # Walks on different maps cannot share a table of offsets: one loop per map.
-            plain = functools.partial(_walk_runs, **shape)
+            plain = functools.partial(walk_impl, **shape)
             axes = tuple(jax.tree_util.tree_map(lambda b: 0 if b else None, b)
                          for b in in_batched)
             out = jax.vmap(plain, in_axes=axes)(seed, graph, log_weights, start, goal, memory,
@@ -307,8 +310,7 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
     if graph.is_grid:
         length = lattice_length(results.moves, results.diagonal)
     else:  # general graphs (small): the edge costs summed along the rows
-        length = jax.vmap(lambda log: total_length(graph, *_moves_out_of(paths(log))))(logs)
-        length = length.reshape(-1)
+        length = walked_lengths(graph, logs).reshape(-1)
     per_agent = dict(length=length, arrived=results.arrived, stuck=results.stuck,
                      position=results.position, visited=results.visited, moves=results.moves,
                      state=results.state)
@@ -317,10 +319,14 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
                 log=logs, lane_steps=jnp.full((runs,), lane_steps, jnp.int32), memory=memory)
 
 
-def _moves_out_of(rows):
-    """``(nodes, slots)`` of padded ``(path, slots)``: each move's node and slot."""
-    path, slots = rows
-    return path[:, :-1], slots
+def _native_walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
+                      **shape) -> Walk:
+    """:func:`_walk_runs` without a hook as one native kernel call (:func:`.native.walk_runs`),
+    which replays this module's schedule of lanes for the outputs that depend on it."""
+    schedule = (lanes_for(start.shape[0] * shape["num_agents"]), REFILL_SHARE, COMPACT_SHARE,
+                SMALLEST_COMPACTION)
+    return Walk(**native.walk_runs(seed, graph, log_weights, start, goal, memory, hook_params,
+                                   schedule=schedule, **shape))
 
 
 def _walk_agents(inputs: WalkInputs, count: int, blocks: int, memory):

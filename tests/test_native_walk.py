@@ -1,0 +1,187 @@
+"""The native plain walk (jaxswarm.swarm.walking.native, walk.cc) against the XLA walker's lanes:
+every leaf of the Walk bit for bit, on ACO*'s and rfd_graded's tables of the shared maze and of
+mosaic50, alone and in batches (the walker's vmap rule folds the runs into one kernel call),
+with a greedy agent, a run that starts at its goal, a walk whose lanes narrow twice, overflowed
+logs, and a general graph."""
+import os
+import shutil
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+import sizes
+from graphs import geometric_graph
+
+from jaxswarm.maps.paper import paper_map
+from jaxswarm.runtime import native
+from jaxswarm.swarm import aco, make, make_task, rfd
+from jaxswarm.swarm.walking import WalkerOptions, loop, walk
+from jaxswarm.swarm.walking import native as native_walk
+from jaxswarm.swarm.walking.tables import edge_table, step_budget
+
+pytestmark = pytest.mark.skipif(
+    not os.environ.get("CXX") and not any(shutil.which(c) for c in native.COMPILERS),
+    reason="no C++ compiler")
+
+KEYS = (0, 1, 2)
+"""The keys each program is called with (keys, not compiles: each is one more call)."""
+
+
+def tables(graph, task) -> list:
+    """ACO*'s and rfd_graded's transition tables of their first memory and of a memory with
+    noise (uneven weights, so the draws are not near-uniform)."""
+    out = []
+    noise = jax.random.uniform(jax.random.key(5), (graph.num_nodes,), minval=-1.0, maxval=1.0)
+    for name in ("aco_star", "rfd_graded"):
+        swarm = make(name, num_agents=sizes.AGENTS)
+        params = swarm.default_params
+        state = swarm.init(jax.random.key(0), graph, task, params)
+        if name == "aco_star":
+            rule = lambda memory: aco.transition_rule(graph, task, memory, params,  # noqa: E731
+                                                      goal_distance=True)
+            memories = (state.pheromone, state.pheromone * jnp.exp(noise)[:, None])
+        else:
+            rule = lambda memory: rfd.graded_transition(graph, task, memory, params)  # noqa: E731
+            memories = (state.altitude, state.altitude + noise * 0.5)
+        out += [rule(memory) for memory in memories]
+    return out
+
+
+def leaves(tree) -> dict:
+    return {jax.tree_util.keystr(path): np.asarray(leaf)
+            for path, leaf in jax.tree_util.tree_leaves_with_path(tree)}
+
+
+def assert_same(lanes, native_out, label=""):
+    """Every leaf of two Walks equal: shape, dtype and bytes."""
+    a, b = leaves(lanes), leaves(native_out)
+    assert a.keys() == b.keys()
+    differ = [k for k in a if a[k].shape != b[k].shape or a[k].dtype != b[k].dtype
+              or a[k].tobytes() != b[k].tobytes()]
+    assert not differ, f"{label}: leaves differ: {differ}"
+
+
+def walks(implementation, monkeypatch, graph, *, agents, steps, greedy=0, walker=WalkerOptions(),
+          runs=None):
+    """The jitted walk ``(key(s), table, start, goal(s)) -> Walk`` as ``walk`` traces it with
+    ``JAXSWARM_WALKER=implementation``: alone (``runs`` None) or under ``vmap`` over ``runs``
+    keys and goals (one folded batch). Returns ``(call, lower)``, each setting the variable
+    before the program is traced."""
+    traced = walk.__wrapped__  # traced afresh by this jit, so the variable is read then
+
+    def one(key, table, start, goal):
+        return traced(key, graph, table, start, goal, num_agents=agents, max_steps=steps,
+                      greedy_agents=greedy, walker=walker)
+
+    program = jax.jit(one if runs is None else jax.vmap(one, in_axes=(0, None, None, 0)))
+
+    def call(*args):
+        monkeypatch.setenv(native_walk.VARIABLE, implementation)
+        return program(*args)
+
+    def lower(*args):
+        monkeypatch.setenv(native_walk.VARIABLE, implementation)
+        return program.lower(*args)
+
+    return call, lower
+
+
+def compare(monkeypatch, graph, task, table_list, *, agents=sizes.AGENTS, greedy=0,
+            walker=WalkerOptions(), runs=None, goals=None):
+    """Both implementations on every table and key; returns the lanes' walks."""
+    steps = step_budget(graph, None)
+    shared = dict(agents=agents, steps=steps, greedy=greedy, walker=walker, runs=runs)
+    lanes, lower_lanes = walks("lanes", monkeypatch, graph, **shared)
+    natives, lower_natives = walks("native", monkeypatch, graph, **shared)
+    example = arguments(task, table_list[0], 0, runs, goals)
+    target = f"custom_call @{native.WALK_TARGET}("
+    assert lower_natives(*example).as_text().count(target) == 1  # the batch in one call
+    assert target not in lower_lanes(*example).as_text()
+    out = []
+    for t, table in enumerate(table_list):
+        for key in KEYS:
+            args = arguments(task, table, key, runs, goals)
+            reference = lanes(*args)
+            assert_same(reference, natives(*args), f"table {t}, key {key}")
+            out.append(reference)
+    return out
+
+
+def arguments(task, table, key, runs, goals):
+    if runs is None:
+        return jax.random.key(key), table, task.start, task.goal
+    keys = jax.random.split(jax.random.key(key), runs)
+    goal = jnp.full((runs,), task.goal, jnp.int32) if goals is None else jnp.asarray(goals)
+    return keys, table, task.start, goal
+
+
+@pytest.fixture(scope="module")
+def maze():
+    graph, task = sizes.maze()
+    return graph, task, tables(graph, task)
+
+
+@pytest.fixture(scope="module")
+def mosaic():
+    chosen = paper_map("mosaic50")
+    graph = chosen.graph()
+    task = make_task(graph, chosen.start, chosen.goal)
+    return graph, task, tables(graph, task)
+
+
+@pytest.mark.parametrize("world", ["maze", "mosaic"])
+def test_one_run_equals_the_lanes(world, request, monkeypatch):
+    graph, task, table_list = request.getfixturevalue(world)
+    walked = compare(monkeypatch, graph, task, table_list)
+    assert any(int(w.arrived.sum()) for w in walked) and any(int(w.stuck.sum()) for w in walked)
+
+
+@pytest.mark.parametrize("world", ["maze", "mosaic"])
+def test_a_batch_of_three_with_a_greedy_agent_equals_the_lanes(world, request, monkeypatch):
+    """Three runs under vmap, folded into one kernel call; one greedy agent per run; the third
+    run starts at its goal (its agents do not walk)."""
+    graph, task, table_list = request.getfixturevalue(world)
+    goals = [task.goal, task.goal, task.start]
+    walked = compare(monkeypatch, graph, task, table_list, greedy=1, runs=3, goals=goals)
+    for w in walked:
+        assert bool(np.all(w.arrived[2])) and not np.any(w.moves[2])
+
+
+def test_narrowing_lanes_and_a_shared_count_equal_the_lanes(maze, monkeypatch):
+    """3 x 1,024 agents: 384 lanes, narrowed to 96 and then 24 as agents stop (lane_steps
+    depends on that schedule, which the kernel replays)."""
+    graph, task, table_list = maze
+    assert loop.lanes_for(3 * 1024) // loop.COMPACT_SHARE ** 2 >= loop.SMALLEST_COMPACTION
+    compare(monkeypatch, graph, task, table_list[:2], agents=1024, runs=3)
+
+
+@pytest.mark.parametrize("runs", [None, 3])
+def test_an_overflowed_log_equals_the_lanes(maze, monkeypatch, runs):
+    """Room for 16 moves an agent: the logs overflow, and the blocks the lanes' journal lost
+    (the last in the lanes' schedule) are the kernel's too."""
+    graph, task, table_list = maze
+    walked = compare(monkeypatch, graph, task, table_list, walker=WalkerOptions(log_moves=16),
+                     runs=runs)
+    overflowed = [bool(np.all(w.log.overflowed)) for w in walked]  # all runs: the journal did
+    assert sum(overflowed) >= len(KEYS), overflowed
+
+
+def test_a_general_graph_equals_the_lanes(monkeypatch):
+    """A random directed graph (its nbr table, its lengths summed from the log)."""
+    graph = geometric_graph(np.random.default_rng(3), 60, radius=3.0, density=0.7,
+                            stretch=(1.0, 1.5))
+    task = make_task(graph, 0, 59)
+    table = edge_table(graph, jax.random.normal(jax.random.key(2), graph.nbr.shape))
+    compare(monkeypatch, graph, task, [table], runs=3)
+
+
+def test_the_switch(monkeypatch):
+    monkeypatch.setenv(native_walk.VARIABLE, "native")
+    assert native_walk.implementation() == "native"
+    assert native_walk.implementation(hook=object()) == "lanes"  # no hooked loop yet
+    monkeypatch.delenv(native_walk.VARIABLE)
+    assert native_walk.implementation() == native_walk.DEFAULT == "lanes"
+    monkeypatch.setenv(native_walk.VARIABLE, "fast")
+    with pytest.raises(ValueError, match="JAXSWARM_WALKER"):
+        native_walk.implementation()
