@@ -15,8 +15,8 @@ from jaxswarm.swarm.executor import run_batch, with_room
 from jaxswarm.swarm.executor.runs import _run_batch
 from jaxswarm.swarm.testing import batched_params, outcome
 from jaxswarm.swarm.walking import step_budget, walk
-from jaxswarm.swarm.walking.log import (BLOCK, EVERY_MOVE, ROOM_FOR_EVERY_MOVE, WalkerOptions,
-                                        agent_path, all_same, columns, default_log_moves,
+from jaxswarm.swarm.walking import EVERY_MOVE, WalkerOptions
+from jaxswarm.swarm.walking.log import (BLOCK, ROOM_FOR_EVERY_MOVE, agent_path, all_same, columns, default_log_moves,
                                         log_blocks, paths, room_blocks)
 from jaxswarm.world.graph import grid_graph
 

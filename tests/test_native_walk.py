@@ -16,6 +16,7 @@ from graphs import geometric_graph
 from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime import native
 from jaxswarm.swarm import aco, make, make_task, rfd
+from jaxswarm.swarm.executor import with_room
 from jaxswarm.swarm.walking import WalkerOptions, loop, walk
 from jaxswarm.swarm.walking import native as native_walk
 from jaxswarm.swarm.walking.tables import edge_table, step_budget
@@ -185,3 +186,19 @@ def test_the_switch(monkeypatch):
     monkeypatch.setenv(native_walk.VARIABLE, "fast")
     with pytest.raises(ValueError, match="JAXSWARM_WALKER"):
         native_walk.implementation()
+
+
+def test_a_swarm_picks_its_implementation_with_its_walker_options(monkeypatch):
+    monkeypatch.setenv(native_walk.VARIABLE, "lanes")
+    assert native_walk.implementation(requested="native") == "native"  # before the variable
+    with pytest.raises(ValueError, match="implementation must be one of lanes, native"):
+        WalkerOptions(implementation="fast")
+    chosen = WalkerOptions(log_moves=16, implementation="native")
+    assert chosen.with_room() == WalkerOptions(log_moves=2 ** 31 - 1, implementation="native")
+    swarm = make("aco_star", **sizes.CONFIG, walker=chosen)
+    assert with_room(swarm).config.walker.implementation == "native"
+    graph, task = sizes.maze()
+    lowered = jax.jit(swarm.step).lower(
+        swarm.init(jax.random.key(0), graph, task, swarm.default_params), graph, task,
+        swarm.default_params).as_text()
+    assert native.WALK_TARGET in lowered

@@ -25,7 +25,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.walking.log import WalkerOptions, all_same
+from jaxswarm.swarm.walking.log import all_same
+from jaxswarm.swarm.walking.options import WalkerOptions
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import Solution, as_node
 from jaxswarm.world.plane import Plane, check_point
@@ -307,7 +308,7 @@ class WalkingConfig(SwarmConfig):
 
     Attributes:
       walker: how its walks are run, handed to the walker unread
-        (:class:`~jaxswarm.swarm.walking.log.WalkerOptions`); changes no result.
+        (:class:`~jaxswarm.swarm.walking.options.WalkerOptions`); changes no result.
     """
 
     walker: WalkerOptions = WalkerOptions()

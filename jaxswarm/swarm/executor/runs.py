@@ -21,7 +21,7 @@ import numpy as np
 from jaxswarm.runtime.batching import one_at_a_time
 from jaxswarm.swarm import registry
 from jaxswarm.swarm.core import Swarm, Task, World, check_run, run_loop
-from jaxswarm.swarm.walking.log import EVERY_MOVE, known_overflowed
+from jaxswarm.swarm.walking.log import known_overflowed
 
 ONE_AT_A_TIME: set[str] = {"iwd_pg"}
 """Swarms whose ``vmap`` of runs goes through the batch's members one after another
@@ -176,4 +176,5 @@ def with_room(swarm: Swarm) -> Swarm:
     if not hasattr(swarm.config, "walker"):
         raise ValueError(f"swarm {swarm.name!r} does not walk the walker, so its walks cannot "
                          "overflow")
-    return registry.built_again(swarm, dataclasses.replace(swarm.config, walker=EVERY_MOVE))
+    return registry.built_again(
+        swarm, dataclasses.replace(swarm.config, walker=swarm.config.walker.with_room()))

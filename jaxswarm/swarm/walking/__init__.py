@@ -9,7 +9,8 @@ from jaxswarm.swarm.walking.hooks import EdgeGroups, Move, StepHook, edge_groups
 from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_LANES, LANES,
                                          SMALLEST_COMPACTION, STEPS_PER_REFILL, Walk,
                                          lanes_for, visited_nodes, walk)
-from jaxswarm.swarm.walking.log import EVERY_MOVE, MoveLog, WalkerOptions
+from jaxswarm.swarm.walking.log import MoveLog
+from jaxswarm.swarm.walking.options import EVERY_MOVE, WalkerOptions
 from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves, on_walk
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms

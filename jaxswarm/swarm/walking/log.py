@@ -41,29 +41,6 @@ BLOCK = 16
 ROOM_FOR_EVERY_MOVE = 2 ** 31 - 1
 """A ``log_moves`` that gives every agent room for its whole step budget: no walk overflows."""
 
-
-@dataclasses.dataclass(frozen=True)
-class WalkerOptions:
-    """How a swarm's walks are run, as a walking family's Config holds it (its ``walker``
-    field) and hands it to :func:`~jaxswarm.swarm.walking.loop.walk` unread. Changes no result:
-    only the memory of a walk and how often a run is made again because a walk overflowed.
-
-    Attributes:
-      log_moves: moves per agent, on average, a walk's log has room for; None:
-        :func:`~jaxswarm.swarm.walking.log.room_blocks` (room for every move on
-        small maps).
-    """
-
-    log_moves: int | None = None
-
-    def __post_init__(self):
-        if self.log_moves is not None and self.log_moves < 1:
-            raise ValueError(f"log_moves must be at least 1, got {self.log_moves}")
-
-
-EVERY_MOVE = WalkerOptions(log_moves=ROOM_FOR_EVERY_MOVE)
-"""Walker options with room for every agent's whole step budget: no walk overflows."""
-
 SMALLEST_DEFAULT_ROOM = 8 * BLOCK
 """The fewest moves per agent :func:`default_log_moves` gives a walk's log (small maps, whose
 budgets are short, get room for every move)."""

@@ -34,7 +34,8 @@ from jaxswarm.swarm.walking.hooks import UNCLAIMED, StepHook
 from jaxswarm.swarm.walking.lanes import (Lanes, WalkInputs, initial_state, lane_status,
                                           start_visited, step)
 from jaxswarm.swarm.walking.journal import Journal, append, empty_journal, ordered_logs
-from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, WalkerOptions, agent_path,
+from jaxswarm.swarm.walking.options import WalkerOptions
+from jaxswarm.swarm.walking.log import (BLOCK, MoveLog, agent_path,
                                         known_overflowed, paths, room_blocks, walked_lengths)
 from jaxswarm.swarm.walking.tables import step_budget
 from jaxswarm.world.graph import NO_NODE, Graph
@@ -136,7 +137,7 @@ def _padded(log: MoveLog):
     """
     if known_overflowed(log.overflowed):
         raise ValueError("the walk's log had no room for all its moves: walk again with a "
-                         "larger log (jaxswarm.swarm.walking.log.EVERY_MOVE has room for "
+                         "larger log (jaxswarm.swarm.walking.EVERY_MOVE has room for "
                          "every move)")
     return _written_out(log)
 
@@ -179,8 +180,9 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
       hook: memory that changes at every step (static; see :mod:`.hooks`), or None.
       memory: the hook's memory before the walk (a pytree).
       hook_params: the hook's numbers (a pytree of traced scalars).
-      walker: the room of the walk's log (static, :class:`~.log.WalkerOptions`); a walk that
-        made more moves says it overflowed (:mod:`.log`).
+      walker: the room of the walk's log and the implementation that walks (static,
+        :class:`~.options.WalkerOptions`); a walk that made more moves than its log has room
+        for says it overflowed (:mod:`.log`).
 
     Returns:
       A :class:`Walk`. One compiled program per set of static options and shapes, called alone
@@ -191,7 +193,7 @@ def walk(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *, n
     memory, hook_params = (jax.tree_util.tree_map(lambda x: jnp.asarray(x)[None], tree)
                            for tree in (memory, hook_params))  # one run
     walks = _batched_walk(num_agents, max_steps, greedy_agents, hook, walker.log_moves,
-                          step_budget(graph, None), native.implementation(hook))(
+                          step_budget(graph, None), native.implementation(hook, walker.implementation))(
         seed, graph, log_weights[None], jnp.asarray(start, jnp.int32)[None],
         jnp.asarray(goal, jnp.int32)[None], memory, hook_params)
     return jax.tree_util.tree_map(lambda x: x[0], walks)

@@ -19,6 +19,7 @@ import numpy as np
 
 from jaxswarm.runtime import native
 from jaxswarm.swarm.walking.log import BLOCK, MoveLog, room_blocks, walked_lengths
+from jaxswarm.swarm.walking.options import IMPLEMENTATIONS
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import slot_offsets
 
@@ -27,23 +28,21 @@ VARIABLE = "JAXSWARM_WALKER"
 ``lanes`` (the XLA lanes, the reference) or ``native`` (this module's kernel, for walks without
 a hook on CPU). Unset: :data:`DEFAULT`."""
 
-IMPLEMENTATIONS = ("lanes", "native")
-"""The walker's implementations."""
-
 DEFAULT = "lanes"
 """The implementation when :data:`VARIABLE` is unset: the lanes, until the native loop walks
 every kind of walk (the hooked and the backtracking walks do not yet)."""
 
 
-def implementation(hook=None) -> str:
-    """The implementation a walk traced now takes: :data:`VARIABLE`'s (else :data:`DEFAULT`);
-    ``native`` only for walks without a hook (``hook`` None) when the kernel can be built here,
-    else ``lanes`` (with a warning when the kernel cannot be built).
+def implementation(hook=None, requested: str | None = None) -> str:
+    """The implementation a walk traced now takes: ``requested`` (a swarm's
+    :class:`~jaxswarm.swarm.walking.options.WalkerOptions`), else :data:`VARIABLE`'s, else
+    :data:`DEFAULT`; ``native`` only for walks without a hook (``hook`` None) when the kernel
+    can be built here, else ``lanes`` (with a warning when the kernel cannot be built).
 
     Raises:
       ValueError: :data:`VARIABLE` names no implementation.
     """
-    chosen = os.environ.get(VARIABLE, "").strip().lower() or DEFAULT
+    chosen = requested or os.environ.get(VARIABLE, "").strip().lower() or DEFAULT
     if chosen not in IMPLEMENTATIONS:
         raise ValueError(f"{VARIABLE} must be one of {', '.join(IMPLEMENTATIONS)}, got "
                          f"{chosen!r}")
