@@ -1,6 +1,8 @@
 """IWD_PG's parts: the smooth operator, the memory and its path surgery, the intersection
 operators, the fuzzy section scores (against a hand computation), local search, and the swarm
 with each stage switched off."""
+import functools
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -9,11 +11,13 @@ import pytest
 from jaxswarm.exact import dijkstra
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import fuzzy
+from jaxswarm.swarm.iwd.iwd import STANDARD_IWD, IWDConfig, build_iwd
 from jaxswarm.swarm.iwd.intersect import (closest_inner_pair, first_intersection,
                                           second_intersection)
+from jaxswarm.swarm.iwd.local import connect
 from jaxswarm.swarm.iwd.memory import empty_memory, join, remember, reverse, splice
 from jaxswarm.swarm.iwd.smooth import smooth_path
-from jaxswarm.swarm.walking import edge_table, walk
+from jaxswarm.swarm.walking import WalkerOptions, edge_table, walk
 from jaxswarm.world.graph import grid_graph
 from jaxswarm.world.paths import is_valid_path, pad, path_length, trim
 
@@ -263,3 +267,15 @@ def test_bad_iwd_pg_options_are_named():
         make("iwd_pg", memory_size=1)
     with pytest.raises(ValueError, match="sections"):
         make("iwd_pg", sections=0)
+
+
+def test_a_local_search_whose_walk_overflowed_says_so():
+    # Corner to corner of an open 32 x 32 grid every arrived drop makes at least 31 moves: a log
+    # with room for 16 moves a drop cannot hold them, and the search says so (IWD_PG's step
+    # then reports it, and the executor makes the run again with room).
+    graph = grid_graph(np.zeros((32, 32), bool))
+    cramped = build_iwd(IWDConfig(num_agents=8, walker=WalkerOptions(log_moves=16)))
+    search = jax.jit(functools.partial(connect, swarm=cramped, iterations=2))
+    *_, overflowed = search(jax.random.key(0), graph, jnp.int32(0), jnp.int32(32 * 32 - 1),
+                            STANDARD_IWD)
+    assert bool(overflowed)

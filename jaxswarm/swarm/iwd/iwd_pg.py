@@ -209,14 +209,15 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
     stale = jnp.where(memory.costs[0] < state.best_cost, 0, state.stale + 1)
     run_operators = (stale >= config.operator_patience) & jnp.isfinite(memory.costs[0])
     walked = memory
-    memory, extra = jax.lax.cond(
+    memory, extra, overflowed = jax.lax.cond(
         run_operators, lambda m: _operators(setup, operator_key, graph, m, params),
-        lambda m: (m, jnp.int32(0)), memory)
+        lambda m: (m, jnp.int32(0), jnp.array(False)), memory)
     stale = jnp.where(memory.costs[0] < state.best_cost, 0, stale)
     # Drops that all took one path have converged only if the operators found nothing.
     converged = info.converged & ~(memory.costs[0] < walked.costs[0])
     return (IWDPGState(key=key, soil=soil, memory=memory, stale=stale),
-            info._replace(evaluations=info.evaluations + extra, converged=converged))
+            info._replace(evaluations=info.evaluations + extra, converged=converged,
+                          overflowed=info.overflowed | overflowed))
 
 
 def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool):
@@ -236,11 +237,13 @@ class _Found(NamedTuple):
     Attributes:
       paths: i32[B, L] each search's best path; costs: f32[B] its length (inf for none);
       calls: i32[B] its fitness calls.
+      overflowed: bool[B] a walk of the search had no room in its log.
     """
 
     paths: jax.Array
     costs: jax.Array
     calls: jax.Array
+    overflowed: jax.Array
 
 
 class _Stage(NamedTuple):
@@ -263,12 +266,12 @@ class _Stage(NamedTuple):
 
 def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
     """The memory operators that are switched on, the intersection operators first, then the
-    section local search: ``(memory, evaluations i32[])``, the memory sorted again without
-    duplicates. When both ask for local searches, a loop of two turns runs them through one
-    batch of searches (one compiled program of the small runs; a turn's batch is padded with
-    runs from node 0 to itself, which walk no drop and are dropped). A run's result does not
-    depend on the others of its batch: its drops read its own soil, which changes after their
-    walk (``local_updates="arrived"``)."""
+    section local search: ``(memory, evaluations i32[], overflowed bool[])`` (a local search's
+    walk had no room in its log), the memory sorted again without duplicates. When both ask for
+    local searches, a loop of two turns runs them through one batch of searches (one compiled
+    program of the small runs; a turn's batch is padded with runs from node 0 to itself, which
+    walk no drop and are dropped). A run's result does not depend on the others of its batch:
+    its drops read its own soil, which changes after their walk (``local_updates="arrived"``)."""
     config = setup.config
     intersection_key, section_key = jax.random.split(key)
     stages = []
@@ -278,14 +281,18 @@ def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDPara
         stages.append(_section_stage(setup, section_key, graph))
     search = functools.partial(_search, setup, graph, params)
     if sum(stage.searches > 0 for stage in stages) < 2:
-        evaluations = jnp.int32(0)
+        evaluations, overflowed = jnp.int32(0), jnp.array(False)
         for stage in stages:
             searches, plan = stage.ask(memory) if stage.searches else (None, None)
-            memory, count = stage.apply(memory, plan, search(*searches) if searches else None)
+            found = search(*searches) if searches else None
+            memory, count = stage.apply(memory, plan, found)
             evaluations += count
+            if found is not None:
+                overflowed |= jnp.any(found.overflowed)
     else:
-        memory, evaluations = _stage_loop(stages, search, memory)
-    return remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs), evaluations
+        memory, evaluations, overflowed = _stage_loop(stages, search, memory)
+    return (remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs),
+            evaluations, overflowed)
 
 
 def _search(setup: _Setup, graph: Graph, params: IWDParams, keys, heres, theres) -> _Found:
@@ -295,9 +302,9 @@ def _search(setup: _Setup, graph: Graph, params: IWDParams, keys, heres, theres)
 
 
 def _stage_loop(stages, search, memory: Memory):
-    """The ``stages`` applied in turn, each turn's local searches through one batch of the
-    most searches a stage asks for: ``(memory, evaluations i32[])``. A turn carries every
-    stage's plan from its ask to its apply (zeros for the other stages')."""
+    """The ``stages`` applied in turn, each turn's local searches through one batch of the most
+    searches a stage asks for: ``(memory, evaluations i32[], overflowed bool[])``. A turn
+    carries every stage's plan from its ask to its apply (zeros for the other stages')."""
     size = max(stage.searches for stage in stages)
     plans = [jax.tree_util.tree_map(lambda s: jnp.zeros(s.shape, s.dtype), jax.eval_shape(
         lambda memory, stage=stage: stage.ask(memory)[1], memory)) for stage in stages]
@@ -318,15 +325,16 @@ def _stage_loop(stages, search, memory: Memory):
         return apply
 
     def turn(index, carry):
-        memory, evaluations = carry
+        memory, evaluations, overflowed = carry
         searches, turn_plans = jax.lax.switch(
             index, [asking(i, stage) for i, stage in enumerate(stages)], memory)
+        found = search(*searches)
         memory, count = jax.lax.switch(
             index, [applying(i, stage) for i, stage in enumerate(stages)], memory, turn_plans,
-            search(*searches))
-        return memory, evaluations + count
+            found)
+        return memory, evaluations + count, overflowed | jnp.any(found.overflowed)
 
-    return jax.lax.fori_loop(0, len(stages), turn, (memory, jnp.int32(0)))
+    return jax.lax.fori_loop(0, len(stages), turn, (memory, jnp.int32(0), jnp.array(False)))
 
 
 class _Crossing(NamedTuple):
@@ -560,7 +568,7 @@ def build_iwd_pg(config: IWDPGConfig) -> Swarm:
     stages sharing one local-search swarm."""
     local = build_iwd(IWDConfig(num_agents=config.local_agents, max_steps=config.max_steps,
                                 local_updates=config.local_updates,
-                                backtrack=config.backtrack))
+                                backtrack=config.backtrack, walker=config.walker))
     setup = _Setup(config=config, local=local)
     return Swarm(name="iwd_pg", config=config, init=jax.jit(functools.partial(_init, config)),
                  step=jax.jit(functools.partial(_step, setup)), best=best_solution,

@@ -18,16 +18,19 @@ from jaxswarm.world.paths import path_length
 
 def connect(key, graph: Graph, here, there, params, *, swarm: Swarm, iterations: int):
     """The best path of a small IWD run from node ``here`` to ``there``: ``(path i32[L], cost
-    f32[] (inf if no drop arrived), evaluations i32[])``."""
+    f32[] (inf if no drop arrived), evaluations i32[], overflowed bool[])``, the last set where
+    a walk of the run had no room in its log (the run is then wrong: its caller's run must be
+    made again with room, as :class:`~jaxswarm.swarm.core.StepInfo` says)."""
     state, trace = run_loop(swarm, key, graph, Task(start=here, goal=there), params, None,
                             jnp.int32(iterations), iterations=iterations, patience=None)
-    return state.best_path, state.best_cost, jnp.sum(trace.evaluations)
+    return state.best_path, state.best_cost, jnp.sum(trace.evaluations), trace.overflowed
 
 
 def connect_all(keys, graph: Graph, heres, theres, params, *, swarm: Swarm, iterations: int):
     """Small IWD runs (one batch through the walker) from the nodes ``heres`` to ``theres``
-    (i32[B]), with ``keys`` (key[B]): ``(paths i32[B, L], costs f32[B], evaluations i32[B])`` as
-    :func:`connect` gives them. A run's result does not depend on the others of its batch."""
+    (i32[B]), with ``keys`` (key[B]): ``(paths i32[B, L], costs f32[B], evaluations i32[B],
+    overflowed bool[B])`` as :func:`connect` gives them. A run's result does not depend on the
+    others of its batch."""
     return jax.vmap(lambda k, here, there: connect(
         k, graph, here, there, params, swarm=swarm, iterations=iterations))(keys, heres, theres)
 
