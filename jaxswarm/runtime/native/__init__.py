@@ -36,6 +36,8 @@ from jaxswarm.runtime.cache import VARIABLE as CACHE_VARIABLE
 
 SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"))
 """The kernels' C++ sources, compiled together into one library."""
+HEADERS = (Path(__file__).with_name("streams.h"),)
+"""The headers the sources share (beside them; part of the library's digest)."""
 UNIFORMS_TARGET = "jaxswarm_uniforms_v1"
 """The FFI target name of :func:`uniforms`. A compiled program names its kernels by target name
 only, so a change to a kernel's arguments or results must change its name (the ``_v1``): a
@@ -90,7 +92,7 @@ def library_path(folder: str | os.PathLike | None = None) -> Path:
     :func:`library_folder`)."""
     cxx = compiler()
     digest = hashlib.sha256()
-    for source in SOURCES:
+    for source in SOURCES + HEADERS:
         digest.update(source.name.encode() + source.read_bytes())
     for header in sorted((Path(jax.ffi.include_dir()) / "xla" / "ffi" / "api").glob("*.h")):
         digest.update(header.name.encode() + header.read_bytes())

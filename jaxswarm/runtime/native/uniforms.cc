@@ -15,25 +15,13 @@
 
 #include "xla/ffi/api/ffi.h"
 
+#include "streams.h"
+
 namespace ffi = xla::ffi;
 
 namespace {
 
-inline uint32_t Fmix32(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x85EBCA6Bu;
-  x ^= x >> 13;
-  x *= 0xC2B2AE35u;
-  x ^= x >> 16;
-  return x;
-}
-
-inline float Uniform(uint32_t s0, uint32_t s1, uint32_t agent, uint32_t move) {
-  uint32_t counter = (agent * 0x9E3779B1u) ^ move;
-  uint32_t mixed = Fmix32(Fmix32(counter ^ s0) ^ s1);
-  // (mixed >> 8) < 2**24 is exact in f32, and the product by 2**-24 is exact: no rounding.
-  return static_cast<float>(mixed >> 8) * 0x1p-24f;
-}
+using jaxswarm::Uniform;
 
 ffi::Error UniformsImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::S32> agent,
                         ffi::Buffer<ffi::S32> move, ffi::ResultBuffer<ffi::F32> out) {

@@ -43,6 +43,8 @@
 
 #include "xla/ffi/api/ffi.h"
 
+#include "streams.h"
+
 namespace ffi = xla::ffi;
 
 namespace {
@@ -99,21 +101,7 @@ inline float Exp(float x) {
   return std::isnan(x) ? x : value;
 }
 
-inline uint32_t Fmix32(uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x85EBCA6Bu;
-  x ^= x >> 13;
-  x *= 0xC2B2AE35u;
-  x ^= x >> 16;
-  return x;
-}
-
-// jaxswarm.swarm.walking.streams.uniforms.
-inline float Uniform(uint32_t s0, uint32_t s1, uint32_t agent, uint32_t move) {
-  uint32_t counter = (agent * 0x9E3779B1u) ^ move;
-  uint32_t mixed = Fmix32(Fmix32(counter ^ s0) ^ s1);
-  return static_cast<float>(mixed >> 8) * 0x1p-24f;
-}
+using jaxswarm::Uniform;  // jaxswarm.swarm.walking.streams.uniforms
 
 // What one call reads.
 struct Map {
