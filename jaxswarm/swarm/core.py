@@ -196,6 +196,12 @@ def check_run(swarm: Swarm, world: World, params, iterations: int,
     check_params_form(swarm, params)
     if not any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(params)):
         swarm.check_params(params)
+    return effective_patience(iterations, patience)
+
+
+def effective_patience(iterations: int, patience: int | None) -> int | None:
+    """The patience the run loop takes: None where ``patience`` cannot stop a run of
+    ``iterations`` early (it is at least ``iterations``), so such runs share None's program."""
     return None if patience is not None and patience >= iterations else patience
 
 

@@ -24,7 +24,7 @@ import numpy as np
 from jax.sharding import Mesh, NamedSharding, PartitionSpec as P
 
 from jaxswarm.runtime.programs import release_if_crowded
-from jaxswarm.swarm.core import Swarm, Task, World, check_run
+from jaxswarm.swarm.core import Swarm, Task, World, check_run, effective_patience
 from jaxswarm.swarm.executor.runs import first_row, run_program, with_room
 from jaxswarm.swarm.walking import LANES
 
@@ -167,8 +167,7 @@ def _program(swarm: Swarm, summary: Summary, iterations: int, patience: int | No
     {output: [C, ...]}`` (the summary's and ``overflowed``), C a multiple of the mesh size, the
     runs sharded over the mesh's ``RUNS_AXIS``; each device maps over its runs ``group`` at a
     time."""
-    patience = None if patience is not None and patience >= iterations else patience
-    loop = run_program(swarm, iterations, patience)
+    loop = run_program(swarm, iterations, effective_patience(iterations, patience))
 
     def one(run_input, world, task, extra):
         seed, params = run_input
