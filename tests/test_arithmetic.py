@@ -8,7 +8,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxswarm.runtime.arithmetic import (ISA_FLAG, exp, fixed_arithmetic_flags, ordered_cumsum,
+from jaxswarm.runtime.arithmetic import (ISA_FLAG, exp, fixed_arithmetic_flags, integer_power,
+                                         log, ordered_cumsum,
                                          ordered_sum)
 from jaxswarm.swarm.fingerprint import fingerprint, hex_fingerprint
 
@@ -56,6 +57,38 @@ def test_exp_is_within_one_ulp_and_the_same_bits_on_every_width():
         np.testing.assert_array_equal(in_rows(exp, x[:700], width), got[:700])
     special = np.array([-np.inf, -200.0, 0.0, 89.0, np.inf, np.nan], np.float32)
     np.testing.assert_array_equal(jax.jit(exp)(special), [0.0, 0.0, 1.0, np.inf, np.inf, np.nan])
+
+
+def test_log_is_within_one_ulp_and_the_same_bits_on_every_width():
+    rng = np.random.default_rng(2)
+    x = np.concatenate([rng.random(20_000) * 2, np.exp(rng.random(20_000) * 170 - 85),
+                        np.float32(2.0) ** np.arange(-126, 128)]).astype(np.float32)
+    got = np.asarray(jax.jit(log)(x))
+    want = np.log(x.astype(np.float64)).astype(np.float32)
+    ulps = np.abs(got.view(np.int32).astype(np.int64) - want.view(np.int32).astype(np.int64))
+    assert ulps.max() <= 1
+    for width in (1, 3, 7, 64):
+        np.testing.assert_array_equal(in_rows(log, x[:700], width), got[:700])
+    special = np.array([0.0, 1e-40, -1.0, 1.0, np.inf, np.nan], np.float32)
+    np.testing.assert_array_equal(jax.jit(log)(special),
+                                  [-np.inf, -np.inf, np.nan, 0.0, np.inf, np.nan])
+
+
+def test_integer_power_multiplies_the_squares_of_the_exponents_bits():
+    x = np.float32(0.9)
+    n = np.arange(0, 41, dtype=np.int32)
+    got = np.asarray(jax.jit(integer_power, static_argnums=2)(x, n, 40))
+    # By hand: the squares x, x^2, x^4, ... multiplied in, lowest bit first, in float32.
+    squares = [x]
+    for _ in range(5):
+        squares.append(np.float32(squares[-1] * squares[-1]))
+    for k in n:
+        want = np.float32(1.0)
+        for bit, square in enumerate(squares):
+            if (k >> bit) & 1:
+                want = np.float32(want * square)
+        assert got[k] == want, k
+    assert got[0] == 1.0
 
 
 def test_ordered_sum_adds_halves_pairwise_whatever_the_batch():

@@ -7,7 +7,8 @@ count. On XLA:CPU three things break that, and this module offers their remedies
 * contraction of a multiply and an add into one rounding: :data:`ISA_FLAG` caps XLA at AVX,
   which has no FMA (:func:`fixed_arithmetic_flags`, :func:`require_fixed_arithmetic`); divide
   by an operand a batch shares as ``x * (1 / y)``, as XLA rewrites such a division;
-* XLA's ``exp``, whose last bit depends on the width: :func:`exp`, by IEEE operations only;
+* XLA's ``exp``, ``log`` and ``pow``, whose last bits depend on the width: :func:`exp`,
+  :func:`log` and :func:`integer_power`, by IEEE operations only;
 * reductions in an order XLA picks per program: :func:`ordered_sum` and :func:`ordered_cumsum`,
   in an order fixed by the axis length alone.
 
@@ -105,6 +106,58 @@ def exp(x: jax.Array) -> jax.Array:
 def _power_of_two(n: jax.Array) -> jax.Array:
     """f32[...] ``2^n`` for i32[...] ``n`` in [-126, 127], from its exponent bits."""
     return jax.lax.bitcast_convert_type((n + 127) << 23, jnp.float32)
+
+
+# Cephes' logf: x = m 2^e with m in [sqrt(1/2), sqrt(2)), log(x) = log(m) + e ln 2, log(m) =
+# log(1 + f) by a polynomial of degree 9 in f = m - 1, e ln 2 in the two parts exp uses.
+_SQRT_HALF = np.float32(0.707106781186547524)
+_LOG_POLY = tuple(np.float32(c) for c in (7.0376836292e-2, -1.1514610310e-1, 1.1676998740e-1,
+                                          -1.2420140846e-1, 1.4249322787e-1, -1.6668057665e-1,
+                                          2.0000714765e-1, -2.4999993993e-1, 3.3333331174e-1))
+_SMALLEST_NORMAL = np.float32(np.finfo(np.float32).tiny)
+
+
+def log(x: jax.Array) -> jax.Array:
+    """The natural ``log`` of f32[...] by IEEE operations only, at most 1 ulp from the true
+    value (XLA's own differs in its last bits between programs, as its ``exp`` does): the same
+    bits in every program and on every width, and in the native kernels, which copy it.
+    Below the smallest normal float (0 and the subnormals, which XLA:CPU flushes) the result is
+    ``-inf``; negative numbers give NaN, ``inf`` gives ``inf``, NaN NaN."""
+    x = jnp.asarray(x, jnp.float32)
+    word = jax.lax.bitcast_convert_type(x, jnp.uint32)
+    exponent = (word >> 23).astype(jnp.int32) - 126  # x = m 2^exponent, m in [1/2, 1)
+    m = jax.lax.bitcast_convert_type((word & np.uint32(0x007FFFFF)) | np.uint32(0x3F000000),
+                                     jnp.float32)
+    below = m < _SQRT_HALF
+    e = jnp.where(below, exponent - 1, exponent).astype(jnp.float32)
+    f = jnp.where(below, (m + m) - np.float32(1.0), m - np.float32(1.0))
+    z = f * f
+    p = _LOG_POLY[0]
+    for c in _LOG_POLY[1:]:
+        p = p * f + c
+    y = p * f * z
+    y = y + _LN2_LOW * e
+    y = y - np.float32(0.5) * z
+    value = (f + y) + _LN2_HIGH * e
+    value = jnp.where(x < _SMALLEST_NORMAL, -jnp.inf, value)
+    value = jnp.where(x < 0, jnp.nan, value)
+    value = jnp.where(x == jnp.inf, jnp.inf, value)
+    return jnp.where(jnp.isnan(x), x, value)
+
+
+def integer_power(x: jax.Array, n: jax.Array, max_exponent: int) -> jax.Array:
+    """``x ** n`` for f32[...] ``x`` and i32[...] ``n`` in ``[0, max_exponent]`` (a static
+    bound), by squaring: the product of ``x^(2^b)`` over the set bits ``b`` of ``n``, lowest
+    first (``x ** n`` with an array exponent is XLA's ``pow``, whose last bits vary as its
+    ``exp`` and ``log`` do). The native kernels copy it."""
+    x = jnp.asarray(x, jnp.float32)
+    n = jnp.asarray(n, jnp.int32)
+    result = jnp.ones(jnp.broadcast_shapes(x.shape, n.shape), jnp.float32)
+    square = x
+    for bit in range(max(max_exponent, 1).bit_length()):
+        result = jnp.where((n >> bit) & 1 == 1, result * square, result)
+        square = square * square
+    return result
 
 
 def ordered_sum(x: jax.Array, axis: int = -1) -> jax.Array:

@@ -36,7 +36,7 @@ from jaxswarm.runtime.cache import VARIABLE as CACHE_VARIABLE
 
 SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"))
 """The kernels' C++ sources, compiled together into one library."""
-HEADERS = (Path(__file__).with_name("streams.h"),)
+HEADERS = (Path(__file__).with_name("arithmetic.h"), Path(__file__).with_name("streams.h"))
 """The headers the sources share (beside them; part of the library's digest)."""
 UNIFORMS_TARGET = "jaxswarm_uniforms_v1"
 """The FFI target name of :func:`uniforms`. A compiled program names its kernels by target name

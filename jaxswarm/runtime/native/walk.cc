@@ -36,13 +36,9 @@
 #include <limits>
 #include <vector>
 
-#if defined(__SSE__) || defined(__x86_64__)
-#include <xmmintrin.h>
-#define JAXSWARM_HAVE_MXCSR 1
-#endif
-
 #include "xla/ffi/api/ffi.h"
 
+#include "arithmetic.h"
 #include "streams.h"
 
 namespace ffi = xla::ffi;
@@ -53,54 +49,11 @@ constexpr int32_t kBlock = 16;            // jaxswarm.swarm.walking.log.BLOCK
 constexpr int32_t kOrthogonalSlots = 4;   // jaxswarm.world.lattice.ORTHOGONAL_SLOTS
 constexpr int32_t kNoNode = -1;           // jaxswarm.world.graph.NO_NODE
 
-// jaxswarm.runtime.arithmetic's constants, as float32.
-constexpr float kLog2e = 1.44269504088896341f;
-constexpr float kLn2High = 0.693359375f;
-constexpr float kLn2Low = -2.12194440e-4f;
-constexpr float kExpPoly[6] = {1.9875691500e-4f, 1.3981999507e-3f, 8.3334519073e-3f,
-                               4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
-constexpr float kExpMax = 88.72283935546875f;
-constexpr float kExpMin = -103.972084045410f;
 // jaxswarm.world.lattice.SQRT2: float32(sqrt(2)).
 constexpr float kSqrt2 = 1.41421356237309515f;
 
-// Saves the thread's MXCSR, sets flush-to-zero and denormals-are-zero (as XLA:CPU runs its
-// kernels), and restores it when the call ends.
-class FlushDenormals {
- public:
-#ifdef JAXSWARM_HAVE_MXCSR
-  FlushDenormals() : saved_(_mm_getcsr()) { _mm_setcsr(saved_ | 0x8040u); }
-  ~FlushDenormals() { _mm_setcsr(saved_); }
-
- private:
-  unsigned int saved_;
-#endif
-};
-
-inline float PowerOfTwo(int32_t n) {  // 2^n for n in [-126, 127], from its exponent bits
-  uint32_t bits = static_cast<uint32_t>(n + 127) << 23;
-  float out;
-  std::memcpy(&out, &bits, sizeof out);
-  return out;
-}
-
-// jaxswarm.runtime.arithmetic.exp, operation for operation.
-inline float Exp(float x) {
-  // jnp.clip: maximum with the lower bound, then minimum with the upper.
-  float clipped = x > kExpMin ? x : kExpMin;
-  clipped = clipped < kExpMax ? clipped : kExpMax;
-  float n = std::floor(clipped * kLog2e + 0.5f);
-  float r = (clipped - n * kLn2High) - n * kLn2Low;
-  float p = kExpPoly[0];
-  for (int i = 1; i < 6; ++i) p = p * r + kExpPoly[i];
-  float y = p * (r * r) + r + 1.0f;
-  int32_t half = static_cast<int32_t>(std::floor(n * 0.5f));
-  int32_t rest = static_cast<int32_t>(n) - half;
-  float value = y * PowerOfTwo(half) / PowerOfTwo(-rest);
-  if (x > kExpMax) value = std::numeric_limits<float>::infinity();
-  return std::isnan(x) ? x : value;
-}
-
+using jaxswarm::Exp;
+using jaxswarm::FlushDenormals;
 using jaxswarm::Uniform;  // jaxswarm.swarm.walking.streams.uniforms
 
 // What one call reads.

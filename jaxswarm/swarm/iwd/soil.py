@@ -22,7 +22,7 @@ import functools
 import jax
 import jax.numpy as jnp
 
-from jaxswarm.runtime.arithmetic import ordered_cumsum
+from jaxswarm.runtime.arithmetic import integer_power, log, ordered_cumsum
 from jaxswarm.swarm.walking import FORCED, goal_log_distance, heads
 from jaxswarm.swarm.walking.hooks import Move, StepHook
 from jaxswarm.world.graph import Graph
@@ -42,7 +42,7 @@ def choice_log_weights(params, soil_rows, admissible) -> jax.Array:
     choices = jnp.where(admissible, soil_rows, jnp.inf)
     smallest = functools.reduce(jnp.minimum, [choices[:, k] for k in range(choices.shape[1])])
     g = soil_rows - jnp.minimum(smallest, 0.0)[:, None]  # shifted only when negative
-    log_f = -jnp.log(params.eps_s[:, None] + g)
+    log_f = -log(params.eps_s[:, None] + g)
     return jnp.where(admissible, params.alpha[:, None] * log_f, 0.0)
 
 
@@ -79,12 +79,15 @@ def local_update(params, soil, move: Move, graph: Graph):
     taken = soil_taken(params, move_lengths(graph, move.here, slot), velocity)
     keep = 1.0 - params.rho_n
     groups = move.groups
+    lanes = move.run.shape[0]  # no group has more drops
     removed = groups.group_sum(jnp.where(
-        move.moving, params.rho_n * keep ** (groups.count - 1 - groups.rank) * taken, 0.0))
+        move.moving,
+        params.rho_n * integer_power(keep, groups.count - 1 - groups.rank, lanes) * taken, 0.0))
     # The first drop of each edge's group writes the edge's soil once: no two writes collide.
     row = jnp.where(groups.first, move.run, soil.shape[0])  # dropped
-    soil = soil.at[row, move.here, slot].set(before * keep ** groups.count - removed,
-                                             mode="drop", unique_indices=True)
+    soil = soil.at[row, move.here, slot].set(
+        before * integer_power(keep, groups.count, lanes) - removed, mode="drop",
+        unique_indices=True)
     state = jnp.where(move.moving[:, None],
                       jnp.stack([velocity, move.state[:, CARRIED] + taken], axis=-1), move.state)
     return soil, state
