@@ -46,6 +46,8 @@ otherwise."""
 WALK_TARGET = "jaxswarm_walk_v1"
 """The FFI target name of the plain walk (``walk.cc``; called by
 :mod:`jaxswarm.swarm.walking.native`), versioned as :data:`UNIFORMS_TARGET` is."""
+TARGETS = {UNIFORMS_TARGET: "JaxswarmUniforms", WALK_TARGET: "JaxswarmWalk"}
+"""Each FFI target and the handler symbol (``XLA_FFI_DEFINE_HANDLER_SYMBOL``) that runs it."""
 FLAGS = ("-O3", "-std=c++17", "-shared", "-fPIC", "-ffp-contract=off", "-w")
 """Compiler flags. No floating-point contraction: XLA:CPU's arithmetic has none (the uniforms
 have no multiply-add, but the walker's kernels will). No ``-march=native``: the library runs on
@@ -154,11 +156,9 @@ def register() -> ctypes.CDLL:
                 library = ctypes.CDLL(str(path))
             except OSError as error:
                 raise NativeUnavailable(f"loading {path} failed: {error}") from error
-            jax.ffi.register_ffi_target(UNIFORMS_TARGET,
-                                        jax.ffi.pycapsule(library.JaxswarmUniforms),
-                                        platform="cpu")
-            jax.ffi.register_ffi_target(WALK_TARGET, jax.ffi.pycapsule(library.JaxswarmWalk),
-                                        platform="cpu")
+            for target, symbol in TARGETS.items():
+                jax.ffi.register_ffi_target(target, jax.ffi.pycapsule(getattr(library, symbol)),
+                                            platform="cpu")
             _library = library
         return _library
 
