@@ -1,8 +1,8 @@
-"""The native plain walk (jaxswarm.swarm.walking.native, walk.cc) against the XLA walker's lanes:
+"""The native walk (jaxswarm.swarm.walking.native, walk.cc) against the XLA walker's lanes:
 every leaf of the Walk bit for bit, on ACO*'s and rfd_graded's tables of the shared maze and of
 mosaic50, alone and in batches (the walker's vmap rule folds the runs into one kernel call),
 with a greedy agent, a run that starts at its goal, a walk whose lanes narrow twice, overflowed
-logs, and a general graph."""
+logs, and a general graph; and IWD's drops under its two soil hooks."""
 import os
 import shutil
 
@@ -17,6 +17,7 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime import native
 from jaxswarm.swarm import aco, make, make_task, rfd
 from jaxswarm.swarm.executor import with_room
+from jaxswarm.swarm.iwd.soil import SOIL, SOIL_CHOICE, goal_log_desirability
 from jaxswarm.swarm.walking import WalkerOptions, loop, walk
 from jaxswarm.swarm.walking import native as native_walk
 from jaxswarm.swarm.walking.tables import edge_table, step_budget
@@ -64,18 +65,20 @@ def assert_same(lanes, native_out, label=""):
 
 
 def walks(implementation, monkeypatch, graph, *, agents, steps, greedy=0, walker=WalkerOptions(),
-          runs=None):
-    """The jitted walk ``(key(s), table, start, goal(s)) -> Walk`` as ``walk`` traces it with
-    ``JAXSWARM_WALKER=implementation``: alone (``runs`` None) or under ``vmap`` over ``runs``
-    keys and goals (one folded batch). Returns ``(call, lower)``, each setting the variable
-    before the program is traced."""
+          runs=None, hook=None):
+    """The jitted walk ``(key(s), table, start, goal(s), memory, hook params) -> Walk`` as
+    ``walk`` traces it with ``JAXSWARM_WALKER=implementation``: alone (``runs`` None) or under
+    ``vmap`` over ``runs`` keys, goals and memories (one folded batch). Returns ``(call,
+    lower)``, each setting the variable before the program is traced."""
     traced = walk.__wrapped__  # traced afresh by this jit, so the variable is read then
 
-    def one(key, table, start, goal):
+    def one(key, table, start, goal, memory, params):
         return traced(key, graph, table, start, goal, num_agents=agents, max_steps=steps,
-                      greedy_agents=greedy, walker=walker)
+                      greedy_agents=greedy, hook=hook, memory=memory, hook_params=params,
+                      walker=walker)
 
-    program = jax.jit(one if runs is None else jax.vmap(one, in_axes=(0, None, None, 0)))
+    axes = (0, None, None, 0, None if hook is None else 0, None)
+    program = jax.jit(one if runs is None else jax.vmap(one, in_axes=axes))
 
     def call(*args):
         monkeypatch.setenv(native_walk.VARIABLE, implementation)
@@ -89,32 +92,38 @@ def walks(implementation, monkeypatch, graph, *, agents, steps, greedy=0, walker
 
 
 def compare(monkeypatch, graph, task, table_list, *, agents=sizes.AGENTS, greedy=0,
-            walker=WalkerOptions(), runs=None, goals=None):
-    """Both implementations on every table and key; returns the lanes' walks."""
+            walker=WalkerOptions(), runs=None, goals=None, hook=None, soil=None, params=None):
+    """Both implementations on every table and key (with ``hook``: over ``soil``, f32[N, K],
+    and a run ``r`` of a batch over ``soil + r``, with IWD ``params``); returns the lanes'
+    walks."""
     steps = step_budget(graph, None)
-    shared = dict(agents=agents, steps=steps, greedy=greedy, walker=walker, runs=runs)
+    shared = dict(agents=agents, steps=steps, greedy=greedy, walker=walker, runs=runs,
+                  hook=hook)
     lanes, lower_lanes = walks("lanes", monkeypatch, graph, **shared)
     natives, lower_natives = walks("native", monkeypatch, graph, **shared)
-    example = arguments(task, table_list[0], 0, runs, goals)
-    target = f"custom_call @{native.WALK_TARGET}("
+    memory = (soil, params)
+    example = arguments(task, table_list[0], 0, runs, goals, memory)
+    target = f"custom_call @{native.WALK_TARGET if hook is None else native.HOOKED_WALK_TARGET}("
     assert lower_natives(*example).as_text().count(target) == 1  # the batch in one call
     assert target not in lower_lanes(*example).as_text()
     out = []
     for t, table in enumerate(table_list):
         for key in KEYS:
-            args = arguments(task, table, key, runs, goals)
+            args = arguments(task, table, key, runs, goals, memory)
             reference = lanes(*args)
             assert_same(reference, natives(*args), f"table {t}, key {key}")
             out.append(reference)
     return out
 
 
-def arguments(task, table, key, runs, goals):
+def arguments(task, table, key, runs, goals, memory=(None, None)):
+    soil, params = memory
     if runs is None:
-        return jax.random.key(key), table, task.start, task.goal
+        return jax.random.key(key), table, task.start, task.goal, soil, params
     keys = jax.random.split(jax.random.key(key), runs)
     goal = jnp.full((runs,), task.goal, jnp.int32) if goals is None else jnp.asarray(goals)
-    return keys, table, task.start, goal
+    soils = None if soil is None else soil + jnp.arange(runs, dtype=jnp.float32)[:, None, None]
+    return keys, table, task.start, goal, soils, params
 
 
 @pytest.fixture(scope="module")
@@ -177,10 +186,47 @@ def test_a_general_graph_equals_the_lanes(monkeypatch):
     compare(monkeypatch, graph, task, [table], runs=3)
 
 
+def drops(graph, task):
+    """IWD's goal table, a soil with noise (some of it negative, so the choice's shift by the
+    smallest soil matters) and IWD's default params."""
+    params = make("iwd", num_agents=sizes.AGENTS).default_params
+    table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
+    soil = jax.random.uniform(jax.random.key(7), graph.nbr.shape, minval=-20.0, maxval=200.0)
+    return table, soil, params
+
+
+@pytest.mark.parametrize("hook", [SOIL, SOIL_CHOICE], ids=["soil", "soil_choice"])
+def test_the_soil_hooks_equal_the_lanes(maze, monkeypatch, hook):
+    """IWD's drops with the soil rule (the soil written as they walk; several drops cross one
+    edge in one step) and with the soil choice (read only): alone and in a batch of three with
+    a run that starts at its goal, the memory and the drops' states included."""
+    graph, task, _ = maze
+    table, soil, params = drops(graph, task)
+    walked = compare(monkeypatch, graph, task, [table], hook=hook, soil=soil, params=params)
+    assert any(int(w.arrived.sum()) for w in walked)
+    if hook.writes:
+        assert not np.array_equal(walked[0].memory, soil)
+    compare(monkeypatch, graph, task, [table], hook=hook, soil=soil, params=params, runs=3,
+            goals=[task.goal, task.start, task.goal])
+
+
+def test_the_soil_rule_on_a_general_graph_with_an_overflowed_log_equals_the_lanes(monkeypatch):
+    """The soil rule on a random directed graph (each edge's own length in eq. 4), its logs
+    overflowed."""
+    graph = geometric_graph(np.random.default_rng(3), 60, radius=3.0, density=0.7,
+                            stretch=(1.0, 1.5))
+    task = make_task(graph, 0, 59)
+    table, soil, params = drops(graph, task)
+    walked = compare(monkeypatch, graph, task, [table], hook=SOIL, soil=soil, params=params,
+                     runs=3, walker=WalkerOptions(log_moves=16))
+    assert any(bool(np.all(w.log.overflowed)) for w in walked)
+
+
 def test_the_switch(monkeypatch):
     monkeypatch.setenv(native_walk.VARIABLE, "native")
     assert native_walk.implementation() == "native"
-    assert native_walk.implementation(hook=object()) == "lanes"  # no hooked loop yet
+    assert native_walk.implementation(hook=SOIL) == "native"
+    assert native_walk.implementation(hook=SOIL._replace(native=None)) == "lanes"
     monkeypatch.delenv(native_walk.VARIABLE)
     assert native_walk.implementation() == native_walk.DEFAULT == "lanes"
     monkeypatch.setenv(native_walk.VARIABLE, "fast")

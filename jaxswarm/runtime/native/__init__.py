@@ -46,7 +46,10 @@ otherwise."""
 WALK_TARGET = "jaxswarm_walk_v1"
 """The FFI target name of the plain walk (``walk.cc``; called by
 :mod:`jaxswarm.swarm.walking.native`), versioned as :data:`UNIFORMS_TARGET` is."""
-TARGETS = {UNIFORMS_TARGET: "JaxswarmUniforms", WALK_TARGET: "JaxswarmWalk"}
+HOOKED_WALK_TARGET = "jaxswarm_hooked_walk_v1"
+"""The FFI target name of the walk with a hook that has a native twin (``walk.cc``)."""
+TARGETS = {UNIFORMS_TARGET: "JaxswarmUniforms", WALK_TARGET: "JaxswarmWalk",
+           HOOKED_WALK_TARGET: "JaxswarmHookedWalk"}
 """Each FFI target and the handler symbol (``XLA_FFI_DEFINE_HANDLER_SYMBOL``) that runs it."""
 FLAGS = ("-O3", "-std=c++17", "-shared", "-fPIC", "-ffp-contract=off", "-w")
 """Compiler flags. No floating-point contraction: XLA:CPU's arithmetic has none (the uniforms

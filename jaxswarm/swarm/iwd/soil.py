@@ -94,13 +94,13 @@ def local_update(params, soil, move: Move, graph: Graph):
 
 
 SOIL = StepHook(state_width=2, initial_state=initial_state, log_weights=choice_log_weights,
-                update=local_update)
+                update=local_update, native="iwd_soil")
 """The walker hook of drops that change the soil as they walk: soil memory ``f32[N, K]`` per
 run, eqs. 1-6."""
 
 
 SOIL_CHOICE = StepHook(state_width=0, initial_state=lambda params: jnp.zeros((0,), jnp.float32),
-                       log_weights=choice_log_weights)
+                       log_weights=choice_log_weights, native="iwd_soil_choice")
 """The walker hook of drops that read the soil and leave it as it is during the walk (eqs. 1-3;
 their updates come after it, :func:`arrived_update`)."""
 

@@ -47,6 +47,10 @@ class StepHook(NamedTuple):
         hook that only reads its memory (the walk leaves the memory and the states as they
         were, groups no moves, and the agents may walk in any lanes at any time).
 
+      native: the name of the native walker's copy of this rule
+        (:data:`jaxswarm.swarm.walking.native.HOOK_RULES`), or None: walks with this hook stay
+        on the lanes.
+
     Build hooks from module-level functions, once: the walker's compiled loops are cached by
     the hook (a hook made per call would compile per call).
     """
@@ -55,6 +59,7 @@ class StepHook(NamedTuple):
     initial_state: Callable[[Any], jax.Array]
     log_weights: Callable[..., jax.Array]
     update: Callable[..., tuple[Any, jax.Array]] | None = None
+    native: str | None = None
 
     @property
     def writes(self) -> bool:

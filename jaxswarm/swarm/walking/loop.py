@@ -207,7 +207,7 @@ def _batched_walk(num_agents: int, max_steps: int, greedy_agents: int, hook: Ste
     may be 1), whose ``vmap`` folds the mapped axis into R; the room of each run's log as
     :func:`~.log.room_blocks` gives it for ``log_moves`` and the map's ``default_budget``;
     walked by the lanes (:func:`_walk_runs`) or, ``implementation="native"``, by the native
-    kernel (:func:`.native.walk_runs`, without a hook)."""
+    kernel (:func:`.native.walk_runs`)."""
     shape = dict(num_agents=num_agents, max_steps=max_steps, greedy_agents=greedy_agents,
                  hook=hook, log_moves=log_moves, default_budget=default_budget)
     walk_impl = _native_walk_runs if implementation == "native" else _walk_runs
@@ -323,9 +323,11 @@ def _walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params
 
 def _native_walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
                       **shape) -> Walk:
-    """:func:`_walk_runs` without a hook as one native kernel call (:func:`.native.walk_runs`),
-    which replays this module's schedule of lanes for the outputs that depend on it."""
-    schedule = (lanes_for(start.shape[0] * shape["num_agents"]), REFILL_SHARE, COMPACT_SHARE,
+    """:func:`_walk_runs` as one native kernel call (:func:`.native.walk_runs`), which replays
+    this module's schedule of lanes for the outputs that depend on it."""
+    count = start.shape[0] * shape["num_agents"]
+    writes = shape["hook"] is not None and shape["hook"].writes
+    schedule = (count if writes else lanes_for(count), REFILL_SHARE, COMPACT_SHARE,
                 SMALLEST_COMPACTION)
     return Walk(**native.walk_runs(seed, graph, log_weights, start, goal, memory, hook_params,
                                    schedule=schedule, **shape))

@@ -1,12 +1,14 @@
-"""The plain walk (no hook) as one native kernel call on CPU (issue 67; ``docs/native.md``).
+"""The walk as one native kernel call on CPU (issue 67; ``docs/native.md``).
 
 :func:`walk_runs` takes what the lanes' loop (``loop._walk_runs``) takes and returns the fields
-of the same :class:`~.loop.Walk`, every leaf bit for bit: the C++ handler ``walk.cc``
-(:mod:`jaxswarm.runtime.native`) walks each agent of each run to its end in turn with the
-lanes' arithmetic operation for operation, then replays the lanes' schedule from the agents'
-step counts for the two outputs that depend on it (``lane_steps``, and the blocks an
-overflowed journal loses). :data:`VARIABLE` picks the implementation when a walk is traced
-(:func:`implementation`).
+of the same :class:`~.loop.Walk`, every leaf bit for bit: the C++ handlers of ``walk.cc``
+(:mod:`jaxswarm.runtime.native`) walk each agent of each run to its end in turn (no hook, or a
+hook that only reads its memory) or a run's agents step by step together (a hook that writes
+its memory, as the lanes walk them), with the lanes' arithmetic operation for operation, then
+replay the lanes' schedule from the agents' step counts for the two outputs that depend on it
+(``lane_steps``, and the blocks an overflowed journal loses). A hook walks natively when its
+rule has a native copy (:data:`HOOK_RULES`). :data:`VARIABLE` picks the implementation when a
+walk is traced (:func:`implementation`).
 """
 from __future__ import annotations
 
@@ -21,7 +23,7 @@ from jaxswarm.runtime import native
 from jaxswarm.swarm.walking.log import BLOCK, MoveLog, room_blocks, walked_lengths
 from jaxswarm.swarm.walking.options import IMPLEMENTATIONS
 from jaxswarm.world.graph import Graph
-from jaxswarm.world.lattice import slot_offsets
+from jaxswarm.world.lattice import slot_lengths, slot_offsets
 
 VARIABLE = "JAXSWARM_WALKER"
 """The environment variable that picks the walker's implementation when a walk is traced:
@@ -30,14 +32,27 @@ a hook on CPU). Unset: :data:`DEFAULT`."""
 
 DEFAULT = "lanes"
 """The implementation when :data:`VARIABLE` is unset: the lanes, until the native loop walks
-every kind of walk (the hooked and the backtracking walks do not yet)."""
+every kind of walk (the backtracking walk does not yet)."""
+
+
+HOOK_RULES = {
+    "iwd_soil_choice": (1, ("alpha", "eps_s")),
+    "iwd_soil": (2, ("alpha", "eps_s", "a_v", "b_v", "c_v", "a_s", "b_s", "c_s", "hud_scale",
+                     "eps_v", "rho_n", "initial_velocity")),
+}
+"""The hooks ``walk.cc`` copies, by :attr:`~.hooks.StepHook.native` name: the kernel's rule
+number and the hook params' fields it reads, in its order. ``iwd_soil_choice``:
+:data:`jaxswarm.swarm.iwd.soil.SOIL_CHOICE` (eqs. 1-3 over the soil, which it does not change);
+``iwd_soil``: :data:`jaxswarm.swarm.iwd.soil.SOIL` (eqs. 1-6 as the drops walk). Their memory is
+the soil, one ``f32[N, K]`` per run."""
 
 
 def implementation(hook=None, requested: str | None = None) -> str:
     """The implementation a walk traced now takes: ``requested`` (a swarm's
     :class:`~jaxswarm.swarm.walking.options.WalkerOptions`), else :data:`VARIABLE`'s, else
-    :data:`DEFAULT`; ``native`` only for walks without a hook (``hook`` None) when the kernel
-    can be built here, else ``lanes`` (with a warning when the kernel cannot be built).
+    :data:`DEFAULT`; ``native`` only for walks without a hook or with one that has a native copy
+    (:data:`HOOK_RULES`), when the kernels can be built here, else ``lanes`` (with a warning
+    when the kernels cannot be built).
 
     Raises:
       ValueError: :data:`VARIABLE` names no implementation.
@@ -46,8 +61,8 @@ def implementation(hook=None, requested: str | None = None) -> str:
     if chosen not in IMPLEMENTATIONS:
         raise ValueError(f"{VARIABLE} must be one of {', '.join(IMPLEMENTATIONS)}, got "
                          f"{chosen!r}")
-    if chosen == "native" and hook is not None:
-        return "lanes"  # the hooked walk has no native loop yet
+    if chosen == "native" and hook is not None and hook.native not in HOOK_RULES:
+        return "lanes"  # a hook of Python functions only: the lanes run it
     if chosen == "native" and not native.available():
         warnings.warn(f"{VARIABLE}=native but the native walker cannot be built here (no C++ "
                       f"compiler?): walking on the lanes", RuntimeWarning, stacklevel=3)
@@ -58,23 +73,21 @@ def implementation(hook=None, requested: str | None = None) -> str:
 def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
               num_agents: int, max_steps: int, greedy_agents: int, hook, log_moves: int | None,
               default_budget: int, schedule: tuple[int, int, int, int]) -> dict:
-    """``loop._walk_runs`` without a hook, as one native kernel call: the fields of the same
+    """``loop._walk_runs`` as one native kernel call: the fields of the same
     :class:`~.loop.Walk` (the loop builds it), every leaf bit for bit, ``lane_steps`` (the
     lane-steps the lanes' loop would have executed, replayed) and an overflowed log's blocks
     included.
 
     Args:
       seed: u32[R, 2]; graph: the map; log_weights: f32[R or 1, N, K]; start, goal: i32[R];
-      memory, hook_params: None (no hook); the rest static, as ``loop._walk_runs``'s, and
-      ``schedule``: the lanes' loop's ``(lanes_for(R * A), REFILL_SHARE, COMPACT_SHARE,
-      SMALLEST_COMPACTION)``, which the kernel replays.
+      memory: with a hook, its memory (f32[R, N, K]); hook_params: its numbers (leaves f32[R]
+      or f32[1]); the rest static, as ``loop._walk_runs``'s, and ``schedule``: the lanes'
+      loop's ``(lanes, REFILL_SHARE, COMPACT_SHARE, SMALLEST_COMPACTION)``, which the kernel
+      replays.
 
     Raises:
-      ValueError: a hook was given.
+      ValueError: the hook has no native copy (:data:`HOOK_RULES`).
     """
-    if hook is not None:
-        raise ValueError("the native walker walks without a hook only")
-    del memory, hook_params
     native.register()
     lanes, refill_share, compact_share, smallest_compaction = schedule
     runs = start.shape[0]
@@ -84,7 +97,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
                   else jnp.asarray(graph.nbr, jnp.int32))
     words = (graph.num_nodes + 31) // 32
     per_agent = (runs, num_agents)
-    shapes = (
+    shapes = [
         jax.ShapeDtypeStruct((runs, blocks, BLOCK), jnp.int32),  # nodes
         jax.ShapeDtypeStruct((runs, blocks, BLOCK), slot_dtype),  # slots
         jax.ShapeDtypeStruct(per_agent, jnp.int32),  # offset
@@ -96,21 +109,45 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         jax.ShapeDtypeStruct(per_agent, jnp.int32),  # position
         jax.ShapeDtypeStruct(per_agent + (words,), jnp.uint32),  # visited
         jax.ShapeDtypeStruct((runs,), jnp.int32),  # lane_steps
-    )
+    ]
+    inputs = [jnp.asarray(seed, jnp.uint32), jnp.asarray(log_weights, jnp.float32),
+              jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours]
+    attributes = dict(
+        num_agents=np.int32(num_agents), max_steps=np.int32(max_steps),
+        greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks), lanes=np.int32(lanes),
+        refill_share=np.int32(refill_share), compact_share=np.int32(compact_share),
+        smallest_compaction=np.int32(smallest_compaction))
+    target = native.WALK_TARGET
+    if hook is not None:
+        if hook.native not in HOOK_RULES:
+            raise ValueError(f"the native walker has no copy of this hook (native="
+                             f"{hook.native!r}; it has {', '.join(HOOK_RULES)})")
+        rule, fields = HOOK_RULES[hook.native]
+        target, attributes["rule"] = native.HOOKED_WALK_TARGET, np.int32(rule)
+        inputs += [jnp.asarray(memory, jnp.float32), _numbers(hook_params, fields),
+                   jnp.asarray(slot_lengths(graph) if graph.is_grid else graph.cost,
+                               jnp.float32)]
+        shapes += [jax.ShapeDtypeStruct(memory.shape, jnp.float32),  # memory after the walk
+                   jax.ShapeDtypeStruct(per_agent + (hook.state_width,), jnp.float32)]  # state
     # "sequential": walks on different maps (a vmap the walker's batching rule does not fold)
     # are one call each; the runs of one map come folded into R by that rule.
     (nodes, slots, offset, moves, overflowed, length, arrived, stuck, position, visited,
-     lane_steps) = jax.ffi.ffi_call(native.WALK_TARGET, shapes, vmap_method="sequential")(
-        jnp.asarray(seed, jnp.uint32), jnp.asarray(log_weights, jnp.float32),
-        jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours,
-        num_agents=np.int32(num_agents), max_steps=np.int32(max_steps),
-        greedy_agents=np.int32(greedy_agents), blocks=np.int32(blocks),
-        lanes=np.int32(lanes), refill_share=np.int32(refill_share),
-        compact_share=np.int32(compact_share), smallest_compaction=np.int32(smallest_compaction))
+     lane_steps, *hooked) = jax.ffi.ffi_call(target, tuple(shapes),
+                                             vmap_method="sequential")(*inputs, **attributes)
     log = MoveLog(nodes=nodes, slots=slots, offset=offset, moves=moves, start=start,
                   overflowed=overflowed, max_steps=max_steps)
     if not graph.is_grid:  # general graphs: the edge costs summed from the log, as the lanes do
         length = walked_lengths(graph, log)
-    return dict(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
-                visited=visited, moves=moves, lane_steps=lane_steps)
+    out = dict(log=log, length=length, arrived=arrived, stuck=stuck, position=position,
+               visited=visited, moves=moves, lane_steps=lane_steps)
+    if hook is not None:
+        memory_after, state = hooked
+        out.update(state=state, memory=memory_after if hook.writes else memory)
+    return out
 
+
+def _numbers(hook_params, fields: tuple[str, ...]) -> jax.Array:
+    """f32[R or 1, P] the hook params' ``fields`` (leaves f32[R] or f32[1]) side by side."""
+    columns = [jnp.asarray(getattr(hook_params, name), jnp.float32) for name in fields]
+    rows = max(column.shape[0] for column in columns)
+    return jnp.stack([jnp.broadcast_to(column, (rows,)) for column in columns], axis=-1)
