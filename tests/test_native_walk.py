@@ -228,7 +228,7 @@ def test_the_switch(monkeypatch):
     assert native_walk.implementation(hook=SOIL) == "native"
     assert native_walk.implementation(hook=SOIL._replace(native=None)) == "lanes"
     monkeypatch.delenv(native_walk.VARIABLE)
-    assert native_walk.implementation() == native_walk.DEFAULT == "lanes"
+    assert native_walk.implementation() == native_walk.platform_default() == "native"  # CPU
     monkeypatch.setenv(native_walk.VARIABLE, "fast")
     with pytest.raises(ValueError, match="JAXSWARM_WALKER"):
         native_walk.implementation()

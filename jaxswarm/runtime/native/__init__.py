@@ -137,13 +137,15 @@ def build(folder: str | os.PathLike | None = None) -> Path:
 
 
 _library: ctypes.CDLL | None = None
+_failure: NativeUnavailable | None = None
 
 
 def register() -> ctypes.CDLL:
     """Build (if needed), load and register the kernels, once per process; thread-safe.
 
     Registration must come before a program that calls a kernel is compiled or read from the
-    persistent cache; :func:`uniforms` calls it when it is traced.
+    persistent cache; :func:`uniforms` calls it when it is traced. A failure is remembered:
+    the process does not try again.
 
     Returns:
       The loaded library (kept loaded for the life of the process: XLA holds pointers into it).
@@ -151,19 +153,30 @@ def register() -> ctypes.CDLL:
     Raises:
       NativeUnavailable: the library cannot be built or loaded.
     """
-    global _library  # pylint: disable=global-statement
+    global _library, _failure  # pylint: disable=global-statement
     with _lock:
+        if _failure is not None:  # tried once in this process: not again at every trace
+            raise _failure
         if _library is None:
-            path = build()
             try:
-                library = ctypes.CDLL(str(path))
-            except OSError as error:
-                raise NativeUnavailable(f"loading {path} failed: {error}") from error
-            for target, symbol in TARGETS.items():
-                jax.ffi.register_ffi_target(target, jax.ffi.pycapsule(getattr(library, symbol)),
-                                            platform="cpu")
-            _library = library
+                _library = _load()
+            except NativeUnavailable as error:
+                _failure = error
+                raise
         return _library
+
+
+def _load() -> ctypes.CDLL:
+    """Build (if needed) and load the library, and register its :data:`TARGETS`."""
+    path = build()
+    try:
+        library = ctypes.CDLL(str(path))
+    except OSError as error:
+        raise NativeUnavailable(f"loading {path} failed: {error}") from error
+    for target, symbol in TARGETS.items():
+        jax.ffi.register_ffi_target(target, jax.ffi.pycapsule(getattr(library, symbol)),
+                                    platform="cpu")
+    return library
 
 
 def available() -> bool:

@@ -27,12 +27,14 @@ from jaxswarm.world.lattice import slot_lengths, slot_offsets
 
 VARIABLE = "JAXSWARM_WALKER"
 """The environment variable that picks the walker's implementation when a walk is traced:
-``lanes`` (the XLA lanes, the reference) or ``native`` (this module's kernel, for walks without
-a hook on CPU). Unset: :data:`DEFAULT`."""
+``lanes`` (the XLA lanes, the reference) or ``native`` (this module's kernels, on CPU). Unset:
+:func:`platform_default`."""
 
-DEFAULT = "lanes"
-"""The implementation when :data:`VARIABLE` is unset: the lanes, until the native loop walks
-every kind of walk (the backtracking walk does not yet)."""
+
+def platform_default() -> str:
+    """The implementation when neither a swarm nor :data:`VARIABLE` names one: ``native`` when
+    JAX's default backend is the CPU, ``lanes`` on accelerators (the kernels are CPU code)."""
+    return "native" if jax.default_backend() == "cpu" else "lanes"
 
 
 HOOK_RULES = {
@@ -50,22 +52,23 @@ the soil, one ``f32[N, K]`` per run."""
 def implementation(hook=None, requested: str | None = None) -> str:
     """The implementation a walk traced now takes: ``requested`` (a swarm's
     :class:`~jaxswarm.swarm.walking.options.WalkerOptions`), else :data:`VARIABLE`'s, else
-    :data:`DEFAULT`; ``native`` only for walks without a hook or with one that has a native copy
-    (:data:`HOOK_RULES`), when the kernels can be built here, else ``lanes`` (with a warning
-    when the kernels cannot be built).
+    :func:`platform_default`'s; ``native`` only for walks without a hook or with one that has a
+    native copy (:data:`HOOK_RULES`), and only where the kernels can be built, else ``lanes``
+    (with a warning when the kernels cannot be built).
 
     Raises:
       ValueError: :data:`VARIABLE` names no implementation.
     """
-    chosen = requested or os.environ.get(VARIABLE, "").strip().lower() or DEFAULT
+    chosen = requested or os.environ.get(VARIABLE, "").strip().lower() or platform_default()
     if chosen not in IMPLEMENTATIONS:
         raise ValueError(f"{VARIABLE} must be one of {', '.join(IMPLEMENTATIONS)}, got "
                          f"{chosen!r}")
     if chosen == "native" and hook is not None and hook.native not in HOOK_RULES:
         return "lanes"  # a hook of Python functions only: the lanes run it
     if chosen == "native" and not native.available():
-        warnings.warn(f"{VARIABLE}=native but the native walker cannot be built here (no C++ "
-                      f"compiler?): walking on the lanes", RuntimeWarning, stacklevel=3)
+        warnings.warn("the native walker cannot be built here (no C++ compiler?): walking on "
+                      f"the lanes (set {VARIABLE}=lanes to say so)", RuntimeWarning,
+                      stacklevel=3)
         return "lanes"
     return chosen
 
@@ -95,21 +98,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
     slot_dtype = jnp.int8 if graph.max_degree <= 127 else jnp.int16
     neighbours = (jnp.asarray(slot_offsets(graph)) if graph.is_grid
                   else jnp.asarray(graph.nbr, jnp.int32))
-    words = (graph.num_nodes + 31) // 32
-    per_agent = (runs, num_agents)
-    shapes = [
-        jax.ShapeDtypeStruct((runs, blocks, BLOCK), jnp.int32),  # nodes
-        jax.ShapeDtypeStruct((runs, blocks, BLOCK), slot_dtype),  # slots
-        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # offset
-        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # moves
-        jax.ShapeDtypeStruct((runs,), jnp.bool_),  # overflowed
-        jax.ShapeDtypeStruct(per_agent, jnp.float32),  # length
-        jax.ShapeDtypeStruct(per_agent, jnp.bool_),  # arrived
-        jax.ShapeDtypeStruct(per_agent, jnp.bool_),  # stuck
-        jax.ShapeDtypeStruct(per_agent, jnp.int32),  # position
-        jax.ShapeDtypeStruct(per_agent + (words,), jnp.uint32),  # visited
-        jax.ShapeDtypeStruct((runs,), jnp.int32),  # lane_steps
-    ]
+    shapes = _shapes(graph, runs, num_agents, blocks, slot_dtype)
     inputs = [jnp.asarray(seed, jnp.uint32), jnp.asarray(log_weights, jnp.float32),
               jnp.asarray(start, jnp.int32), jnp.asarray(goal, jnp.int32), neighbours]
     attributes = dict(
@@ -128,7 +117,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
                    jnp.asarray(slot_lengths(graph) if graph.is_grid else graph.cost,
                                jnp.float32)]
         shapes += [jax.ShapeDtypeStruct(memory.shape, jnp.float32),  # memory after the walk
-                   jax.ShapeDtypeStruct(per_agent + (hook.state_width,), jnp.float32)]  # state
+                   jax.ShapeDtypeStruct((runs, num_agents, hook.state_width), jnp.float32)]
     # "sequential": walks on different maps (a vmap the walker's batching rule does not fold)
     # are one call each; the runs of one map come folded into R by that rule.
     (nodes, slots, offset, moves, overflowed, length, arrived, stuck, position, visited,
@@ -144,6 +133,22 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         memory_after, state = hooked
         out.update(state=state, memory=memory_after if hook.writes else memory)
     return out
+
+
+def _shapes(graph: Graph, runs: int, num_agents: int, blocks: int, slot_dtype) -> list:
+    """The plain walk kernel's outputs: the log's nodes, slots, offsets, moves and overflow,
+    and each agent's length, arrival, stop, position and visited set, and the lane-steps."""
+    per_agent = (runs, num_agents)
+    words = (graph.num_nodes + 31) // 32
+    return [jax.ShapeDtypeStruct((runs, blocks, BLOCK), jnp.int32),
+            jax.ShapeDtypeStruct((runs, blocks, BLOCK), slot_dtype),
+            jax.ShapeDtypeStruct(per_agent, jnp.int32), jax.ShapeDtypeStruct(per_agent, jnp.int32),
+            jax.ShapeDtypeStruct((runs,), jnp.bool_),
+            jax.ShapeDtypeStruct(per_agent, jnp.float32),
+            jax.ShapeDtypeStruct(per_agent, jnp.bool_), jax.ShapeDtypeStruct(per_agent, jnp.bool_),
+            jax.ShapeDtypeStruct(per_agent, jnp.int32),
+            jax.ShapeDtypeStruct(per_agent + (words,), jnp.uint32),
+            jax.ShapeDtypeStruct((runs,), jnp.int32)]
 
 
 def _numbers(hook_params, fields: tuple[str, ...]) -> jax.Array:
