@@ -27,6 +27,7 @@ from jaxswarm.swarm import make, make_task
 from jaxswarm.swarm.testing import (check_batch_invariant, check_compiles_once,
                                      check_reproducible, check_unreachable_goal,
                                      check_valid_results)
+from jaxswarm.swarm.walking import WalkerOptions
 from jaxswarm.world.graph import Graph
 
 SMALL = sizes.CONFIG
@@ -77,16 +78,7 @@ class Conformance:
                             runs=sizes.RUNS)
 
     def test_replays_its_golden_records(self):
-        # Every leaf's digest, the best cost and the iterations it ran, bit for bit.
-        records = [r for r in RECORDS if r["swarm"] == self.name]
-        for record in records:
-            again = replay(record)
-            described = f"{self.name} on {record['world']}, seed {record['seed']}"
-            assert (again["ran"], again["best_cost"]) == (record["ran"], record["best_cost"]), (
-                described)
-            changed = sorted(leaf for leaf, digest in record["digests"].items()
-                             if again["digests"].get(leaf) != digest)
-            assert not changed, f"{described}: these leaves changed: {changed}"
+        assert_replays(self.name)
 
     @pytest.mark.slow  # 1,000 runs alone, of 2 iterations and 8 agents to fit CI: 20-300 s
     def test_a_thousand_keys_alone_equal_them_in_one_batch_of_a_thousand(self, maze, field):
@@ -107,11 +99,40 @@ def walled():
 
 
 class WalkerConformance(Conformance):
-    """The checks of a swarm on a graph: those of every swarm, and a goal it cannot reach."""
+    """The checks of a swarm on a graph: those of every swarm, a goal it cannot reach, and, in
+    the slow tier, the golden records and the batch widths on the XLA walker's lanes (the
+    reference; the default tier walks natively on CPU, and ``test_native_walk.py`` compares the
+    two walk by walk)."""
 
     def test_an_unreachable_goal_is_a_clean_not_found_result(self, walled):
         graph, task = walled
         check_unreachable_goal(make(self.name, **SMALL), graph, task, iterations=ITERATIONS)
+
+    @pytest.mark.slow  # the lanes' programs, each a few seconds to compile
+    def test_on_the_lanes_it_replays_its_golden_records_and_one_key_gives_one_result(self, maze,
+                                                                                    field):
+        assert_replays(self.name, walker=LANES)
+        world, task, _ = self._world(maze, field)
+        check_batch_invariant(make(self.name, **SMALL, walker=LANES), world, task,
+                              iterations=ITERATIONS, widths=(sizes.RUNS, *SLOW_WIDTHS),
+                              keys=KEYS)
+
+
+LANES = WalkerOptions(implementation="lanes")
+"""The walker of the slow tier's reference checks."""
+
+
+def assert_replays(name: str, **options) -> None:
+    """Every golden record of swarm ``name``, run again (its config with ``options``): every
+    leaf's digest, the best cost and the iterations it ran, bit for bit."""
+    for record in (r for r in RECORDS if r["swarm"] == name):
+        again = replay(dict(record, config=dict(record["config"], **options)))
+        described = f"{name} on {record['world']}, seed {record['seed']}"
+        assert (again["ran"], again["best_cost"]) == (record["ran"], record["best_cost"]), (
+            described)
+        changed = sorted(leaf for leaf, digest in record["digests"].items()
+                         if again["digests"].get(leaf) != digest)
+        assert not changed, f"{described}: these leaves changed: {changed}"
 
 
 for _name in [*FIRST, *(n for n in swarms.registered() if n not in FIRST)]:

@@ -2,7 +2,8 @@
 every leaf of the Walk bit for bit, on ACO*'s and rfd_graded's tables of the shared maze and of
 mosaic50, alone and in batches (the walker's vmap rule folds the runs into one kernel call),
 with a greedy agent, a run that starts at its goal, a walk whose lanes narrow twice, overflowed
-logs, and a general graph; and IWD's drops under its two soil hooks."""
+logs, and a general graph; and IWD's drops under its two soil hooks. The default tier compares
+them once at the shared size; the rest is in the slow tier."""
 import os
 import shutil
 
@@ -140,14 +141,19 @@ def mosaic():
     return graph, task, tables(graph, task)
 
 
-@pytest.mark.parametrize("world", ["maze", "mosaic"])
+WORLDS = ["maze", pytest.param("mosaic", marks=pytest.mark.slow)]
+"""The shared maze in the default tier (the lanes' conformance once, at the shared size);
+mosaic50 in the slow tier."""
+
+
+@pytest.mark.parametrize("world", WORLDS)
 def test_one_run_equals_the_lanes(world, request, monkeypatch):
     graph, task, table_list = request.getfixturevalue(world)
     walked = compare(monkeypatch, graph, task, table_list)
     assert any(int(w.arrived.sum()) for w in walked) and any(int(w.stuck.sum()) for w in walked)
 
 
-@pytest.mark.parametrize("world", ["maze", "mosaic"])
+@pytest.mark.parametrize("world", WORLDS)
 def test_a_batch_of_three_with_a_greedy_agent_equals_the_lanes(world, request, monkeypatch):
     """Three runs under vmap, folded into one kernel call; one greedy agent per run; the third
     run starts at its goal (its agents do not walk)."""
@@ -158,6 +164,7 @@ def test_a_batch_of_three_with_a_greedy_agent_equals_the_lanes(world, request, m
         assert bool(np.all(w.arrived[2])) and not np.any(w.moves[2])
 
 
+@pytest.mark.slow  # 3 x 1,024 agents on the lanes
 def test_narrowing_lanes_and_a_shared_count_equal_the_lanes(maze, monkeypatch):
     """3 x 1,024 agents: 384 lanes, narrowed to 96 and then 24 as agents stop (lane_steps
     depends on that schedule, which the kernel replays)."""
@@ -166,7 +173,7 @@ def test_narrowing_lanes_and_a_shared_count_equal_the_lanes(maze, monkeypatch):
     compare(monkeypatch, graph, task, table_list[:2], agents=1024, runs=3)
 
 
-@pytest.mark.parametrize("runs", [None, 3])
+@pytest.mark.parametrize("runs", [None, pytest.param(3, marks=pytest.mark.slow)])
 def test_an_overflowed_log_equals_the_lanes(maze, monkeypatch, runs):
     """Room for 16 moves an agent: the logs overflow, and the blocks the lanes' journal lost
     (the last in the lanes' schedule) are the kernel's too."""
@@ -210,6 +217,7 @@ def test_the_soil_hooks_equal_the_lanes(maze, monkeypatch, hook):
             goals=[task.goal, task.start, task.goal])
 
 
+@pytest.mark.slow
 def test_the_soil_rule_on_a_general_graph_with_an_overflowed_log_equals_the_lanes(monkeypatch):
     """The soil rule on a random directed graph (each edge's own length in eq. 4), its logs
     overflowed."""
