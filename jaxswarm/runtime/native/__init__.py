@@ -34,9 +34,11 @@ import jax.numpy as jnp
 from jaxswarm.runtime.atomic import atomic_path
 from jaxswarm.runtime.cache import VARIABLE as CACHE_VARIABLE
 
-SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"))
+SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"),
+           Path(__file__).with_name("backtrack.cc"))
 """The kernels' C++ sources, compiled together into one library."""
-HEADERS = (Path(__file__).with_name("arithmetic.h"), Path(__file__).with_name("streams.h"))
+HEADERS = tuple(Path(__file__).with_name(name)
+                for name in ("arithmetic.h", "choice.h", "streams.h"))
 """The headers the sources share (beside them; part of the library's digest)."""
 UNIFORMS_TARGET = "jaxswarm_uniforms_v1"
 """The FFI target name of :func:`uniforms`. A compiled program names its kernels by target name
@@ -48,8 +50,11 @@ WALK_TARGET = "jaxswarm_walk_v1"
 :mod:`jaxswarm.swarm.walking.native`), versioned as :data:`UNIFORMS_TARGET` is."""
 HOOKED_WALK_TARGET = "jaxswarm_hooked_walk_v1"
 """The FFI target name of the walk with a hook that has a native twin (``walk.cc``)."""
+DEPTH_FIRST_TARGET = "jaxswarm_depth_first_v1"
+"""The FFI target name of the depth-first walk (``backtrack.cc``; called by
+:mod:`jaxswarm.swarm.walking.native_backtrack`), versioned as :data:`UNIFORMS_TARGET` is."""
 TARGETS = {UNIFORMS_TARGET: "JaxswarmUniforms", WALK_TARGET: "JaxswarmWalk",
-           HOOKED_WALK_TARGET: "JaxswarmHookedWalk"}
+           HOOKED_WALK_TARGET: "JaxswarmHookedWalk", DEPTH_FIRST_TARGET: "JaxswarmDepthFirst"}
 """Each FFI target and the handler symbol (``XLA_FFI_DEFINE_HANDLER_SYMBOL``) that runs it."""
 FLAGS = ("-O3", "-std=c++17", "-shared", "-fPIC", "-ffp-contract=off", "-w")
 """Compiler flags. No floating-point contraction: XLA:CPU's arithmetic has none (the uniforms

@@ -51,6 +51,7 @@
 #include "xla/ffi/api/ffi.h"
 
 #include "arithmetic.h"
+#include "choice.h"
 #include "streams.h"
 
 namespace ffi = xla::ffi;
@@ -66,8 +67,10 @@ constexpr float kSqrt2 = 1.41421356237309515f;
 
 using jaxswarm::Exp;
 using jaxswarm::FlushDenormals;
+using jaxswarm::DrawFromWeights;
 using jaxswarm::IntegerPower;
-using jaxswarm::Log;
+using jaxswarm::InverseCdf;
+using jaxswarm::SoilTerm;
 using jaxswarm::Uniform;  // jaxswarm.swarm.walking.streams.uniforms
 
 // What one call reads.
@@ -142,7 +145,7 @@ int32_t Choose(const Map& map, const float* row, const float* soil_row, const So
     }
     const float shift = smallest < 0.0f ? smallest : 0.0f;
     for (int32_t k = 0; k < K; ++k) {
-      const float added = admissible[k] ? p.alpha * -Log(p.eps_s + (soil_row[k] - shift)) : 0.0f;
+      const float added = admissible[k] ? SoilTerm(p.alpha, p.eps_s, soil_row[k], shift) : 0.0f;
       masked[k] = admissible[k] ? row[k] + added : -inf;
     }
   } else {
@@ -151,19 +154,9 @@ int32_t Choose(const Map& map, const float* row, const float* soil_row, const So
   float top = -inf;
   for (int32_t k = 0; k < K; ++k) top = masked[k] > top ? masked[k] : top;
   if (!std::isfinite(top)) return -1;
-  for (int32_t k = 0; k < K; ++k) {
-    weight[k] = greedy ? (masked[k] == top ? 1.0f : 0.0f) : Exp(masked[k] - top);
-  }
-  float total = weight[0];
-  for (int32_t k = 1; k < K; ++k) total = total + weight[k];
-  const float u = uniform * total;
-  float running = 0.0f;
-  int32_t choice = 0;
-  for (int32_t k = 0; k < K; ++k) {
-    running = running + weight[k];
-    choice += (running <= u) & (running < total);
-  }
-  return choice;
+  if (!greedy) return InverseCdf(masked, K, top, uniform, weight);
+  for (int32_t k = 0; k < K; ++k) weight[k] = masked[k] == top ? 1.0f : 0.0f;  // ties drawn
+  return DrawFromWeights(weight, K, uniform);
 }
 
 // The lanes' loop's schedule (jaxswarm.swarm.walking.loop).

@@ -15,7 +15,8 @@ import jax
 import jax.numpy as jnp
 
 from jaxswarm.swarm.walking import heads
-from jaxswarm.swarm.walking.backtrack import depth_first_walk
+from jaxswarm.swarm.walking.backtrack import DepthFirstRule, depth_first_walk
+from jaxswarm.swarm.walking.native import implementation as chosen_implementation
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.paths import path_length
 
@@ -30,11 +31,10 @@ def direction_cosine(graph: Graph, goal) -> jax.Array:
                      1.0)
 
 
-@functools.partial(jax.jit, static_argnames="greedy")
 def first_ant_path(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *,
-                   greedy: bool = False):
+                   greedy: bool = False, implementation: str | None = None):
     """The first ant's depth-first walk from ``start`` to ``goal`` (node indices, may be traced;
-    :func:`~jaxswarm.swarm.walking.backtrack.depth_first_walk` over a fixed table).
+    :func:`~jaxswarm.swarm.walking.backtrack.depth_first_walk` over a fixed table), jitted.
 
     Args:
       key: PRNG key of its draws (unused when ``greedy``).
@@ -42,13 +42,25 @@ def first_ant_path(key: jax.Array, graph: Graph, log_weights: jax.Array, start, 
       log_weights: f32[N, K] the transition log-weights (``-inf``: not admissible).
       start, goal: i32[] node indices.
       greedy: take the most likely admissible move (the first of equals) instead of drawing one.
+      implementation: ``"lanes"`` (XLA), ``"native"`` or None: resolved now
+        (:func:`~jaxswarm.swarm.walking.native.implementation`, which reads the environment),
+        not when the program was first traced. Both give the same path, bit for bit.
 
     Returns:
       ``(path i32[N], cost f32[], found bool[])``: the path without its backed-out dead ends,
       -1 padded (all -1 and cost inf when the goal cannot be reached).
     """
-    walked = depth_first_walk(key, graph, lambda here, unvisited: log_weights[here], start,
-                              goal, max_nodes=graph.num_nodes, greedy=greedy)
+    return _first_ant_path(key, graph, log_weights, start, goal, greedy=greedy,
+                           implementation=chosen_implementation(requested=implementation))
+
+
+@functools.partial(jax.jit, static_argnames=("greedy", "implementation"))
+def _first_ant_path(key: jax.Array, graph: Graph, log_weights: jax.Array, start, goal, *,
+                    greedy: bool, implementation: str):
+    """:func:`first_ant_path` with its implementation resolved (static)."""
+    walked = depth_first_walk(key, graph, DepthFirstRule(log_weights), start, goal,
+                              max_nodes=graph.num_nodes, greedy=greedy,
+                              implementation=implementation)
     return (walked.path, jnp.where(walked.found, path_length(graph, walked.path), jnp.inf),
             walked.found)
 

@@ -85,7 +85,8 @@ def first_ant(config: ImprovedConfig):
         table = transition_rule(graph, task, pheromone, params, direction=True,
                                 beta=params.beta_first)
         path, cost, found = first_ant_path(key, graph, table, task.start, task.goal,
-                                           greedy=config.first_ant == "greedy")
+                                           greedy=config.first_ant == "greedy",
+                                           implementation=config.walker.implementation)
         fits = found & (jnp.sum(path >= 0) <= length)  # a longer first path cannot be stored
         path = jnp.pad(path, (0, max(length - path.shape[0], 0)), constant_values=-1)[:length]
         return jnp.where(fits, path, -1), jnp.where(fits, cost, jnp.inf).astype(jnp.float32)

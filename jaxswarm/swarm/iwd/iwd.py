@@ -28,11 +28,10 @@ import numpy as np
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm.core import (ParamError, Swarm, Task, WalkingConfig, best_solution,
                                  check_positive, default_params, keep_best, shown)
-from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update,
-                                     choice_log_weights, global_update, goal_log_desirability,
-                                     walked_soil)
+from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update, global_update,
+                                     goal_log_desirability, walked_soil)
 from jaxswarm.swarm.walking import Walk, WalkerOptions, edge_table, fold_agents, step_budget, walk
-from jaxswarm.swarm.walking.backtrack import backtracking_walk
+from jaxswarm.swarm.walking.backtrack import DepthFirstRule, backtracking_walk
 from jaxswarm.world.graph import Graph
 
 
@@ -196,8 +195,9 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
                     max_steps=budget, hook=SOIL, memory=soil, hook_params=params,
                     walker=walker)
     if backtrack:
-        drops = backtracking_walk(key, graph, soil_choice(graph, table, soil, params),
-                                  task.start, task.goal, num_agents=num_agents, max_steps=budget)
+        drops = backtracking_walk(key, graph, soil_choice(table, soil, params), task.start,
+                                  task.goal, num_agents=num_agents, max_steps=budget,
+                                  implementation=walker.implementation)
     else:
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params,
@@ -224,17 +224,11 @@ def _arrived_drop(after, drop, row, run, graph: Graph):
             carried.at[drop].set(ordered_sum(taken, axis=1)[0], mode="drop"))
 
 
-def soil_choice(graph: Graph, table, soil, params: IWDParams):
+def soil_choice(table, soil, params: IWDParams) -> DepthFirstRule:
     """The drops' transition rule (eqs. 1-3) over fixed ``soil`` (f32[N, K]) and ``table``
-    (f32[N, K], the goal term) as a :data:`~jaxswarm.swarm.walking.backtrack.ChoiceRule`."""
-    one_lane = jax.tree_util.tree_map(lambda p: jnp.asarray(p)[None], params)
-
-    def choice(here, unvisited):
-        row = table[here]
-        admissible = unvisited & (row > -jnp.inf)
-        return row + choice_log_weights(one_lane, soil[here][None], admissible[None])[0]
-
-    return choice
+    (f32[N, K], the goal term) as a :class:`~jaxswarm.swarm.walking.backtrack.DepthFirstRule`:
+    over the admissible slots, the row plus :func:`~.soil.choice_log_weights`."""
+    return DepthFirstRule(table=table, soil=soil, hook=SOIL_CHOICE, hook_params=params)
 
 
 def soil_after_best(graph: Graph, drops: Walk, path_of: Callable, costs,

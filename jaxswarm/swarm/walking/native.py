@@ -111,9 +111,9 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         if hook.native not in HOOK_RULES:
             raise ValueError(f"the native walker has no copy of this hook (native="
                              f"{hook.native!r}; it has {', '.join(HOOK_RULES)})")
-        rule, fields = HOOK_RULES[hook.native]
+        rule, _ = HOOK_RULES[hook.native]
         target, attributes["rule"] = native.HOOKED_WALK_TARGET, np.int32(rule)
-        inputs += [jnp.asarray(memory, jnp.float32), _numbers(hook_params, fields),
+        inputs += [jnp.asarray(memory, jnp.float32), hook_numbers(hook_params, hook),
                    jnp.asarray(slot_lengths(graph) if graph.is_grid else graph.cost,
                                jnp.float32)]
         shapes += [jax.ShapeDtypeStruct(memory.shape, jnp.float32),  # memory after the walk
@@ -151,8 +151,10 @@ def _shapes(graph: Graph, runs: int, num_agents: int, blocks: int, slot_dtype) -
             jax.ShapeDtypeStruct((runs,), jnp.int32)]
 
 
-def _numbers(hook_params, fields: tuple[str, ...]) -> jax.Array:
-    """f32[R or 1, P] the hook params' ``fields`` (leaves f32[R] or f32[1]) side by side."""
-    columns = [jnp.asarray(getattr(hook_params, name), jnp.float32) for name in fields]
+def hook_numbers(hook_params, hook) -> jax.Array:
+    """f32[R or 1, P] the numbers of ``hook``'s native copy (the fields :data:`HOOK_RULES`
+    names, in its order) of ``hook_params`` (leaves f32[R], f32[1] or f32[]), side by side."""
+    columns = [jnp.atleast_1d(jnp.asarray(getattr(hook_params, name), jnp.float32))
+               for name in HOOK_RULES[hook.native][1]]
     rows = max(column.shape[0] for column in columns)
     return jnp.stack([jnp.broadcast_to(column, (rows,)) for column in columns], axis=-1)
