@@ -31,6 +31,7 @@ exits with status 1 when the replay does not reproduce the row bit for bit.
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import sys
 import time
@@ -48,6 +49,9 @@ from jaxswarm.multiagent import registry as planners
 from jaxswarm.multiagent.limits import OptionError
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, registry, run
+from jaxswarm.swarm.walking.native import VARIABLE as WALKER_VARIABLE
+from jaxswarm.swarm.walking.native import implementation
+from jaxswarm.swarm.walking.options import IMPLEMENTATIONS
 from jaxswarm.sweep.spec import DEFAULT_MAX_RUNS
 from jaxswarm.tune.spec import HELD_OUT_SETTINGS
 from jaxswarm.world.graph import Graph
@@ -228,6 +232,9 @@ def _add_replay_parser(subparsers) -> None:
                              "runs.csv, from 0")
     replay.add_argument("--out", type=Path,
                         help="folder of the figure (default out/replay/STORE_NAME)")
+    replay.add_argument("--walker", choices=IMPLEMENTATIONS,
+                        help="the walker's implementation (as JAXSWARM_WALKER; default: native "
+                             "on CPU): both give the same bits")
 
 
 def run_replay(args: argparse.Namespace) -> int:
@@ -239,9 +246,12 @@ def run_replay(args: argparse.Namespace) -> int:
     from jaxswarm.plot.sweep import plot_replay
     from jaxswarm.sweep.replay import replay_row
 
+    if args.walker:
+        os.environ[WALKER_VARIABLE] = args.walker
     replayed = replay_row(args.store, args.row)
     row = replayed.row
-    print(f"{args.store} row {args.row}: {replayed.title}")
+    print(f"{args.store} row {args.row}: {replayed.title} (walker: "
+          f"{implementation()})")
     for name in replayed.figures:
         mark = "" if f"{name}:" not in " ".join(replayed.differences) else "   <- differs"
         print(f"  {name:<12} stored {row[name]!s:<20} replayed {replayed.figures[name]!s}{mark}")

@@ -465,3 +465,17 @@ def test_a_committed_table_row_replays_bit_for_bit():
                if (row["map"], row["algorithm"], row["seed"]) == ("maze20", "rfd_star", "3"))
     replayed = replay_row(ROOT / "results" / "rfd_static", row)
     assert replayed.reproduced, replayed.differences
+
+
+@pytest.mark.slow  # the same row's program on the lanes, in a process of its own (the walker's
+# implementation is read when a program is traced)
+def test_a_committed_table_row_replays_bit_for_bit_on_the_lanes(tmp_path):
+    rows = read_csv(ROOT / "results" / "rfd_static" / "runs.csv")
+    row = next(index for index, row in enumerate(rows)
+               if (row["map"], row["algorithm"], row["seed"]) == ("maze20", "rfd_star", "3"))
+    done = subprocess.run(
+        [sys.executable, "-m", "jaxswarm.cli", "replay", str(ROOT / "results" / "rfd_static"),
+         str(row), "--walker", "lanes", "--out", str(tmp_path)],
+        capture_output=True, text=True, check=False, cwd=ROOT)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "(walker: lanes)" in done.stdout and "reproduced bit for bit" in done.stdout
