@@ -134,17 +134,16 @@ def test_a_vmap_over_keys_is_one_call_per_walk_and_equals_the_walks_alone():
                     f"key {key}")
 
 
-def spied(monkeypatch) -> list:
-    """Counts the native walks traced from now on (one entry per kernel call traced)."""
-    calls = []
-    traced = native_backtrack.depth_first_walks
-
-    def spy(*args, **kwargs):
-        calls.append(kwargs["max_nodes"])
-        return traced(*args, **kwargs)
-
-    monkeypatch.setattr(native_backtrack, "depth_first_walks", spy)
-    return calls
+def calls_the_kernel(name, **config) -> bool:
+    """Whether ``name``'s first iteration (``init`` and ``step`` of its shared-size run on the
+    maze, with ``config``), as traced now, calls the native depth-first walk."""
+    swarm = make(name, **sizes.CONFIG, **config)
+    graph, task = sizes.maze()
+    args = (graph, task, swarm.default_params)
+    state = jax.eval_shape(swarm.init, jax.random.key(0), *args)
+    traced = [jax.make_jaxpr(swarm.init)(jax.random.key(0), *args),
+              jax.make_jaxpr(swarm.step)(state, *args)]
+    return any(native.DEPTH_FIRST_TARGET in str(jaxpr) for jaxpr in traced)
 
 
 def runs_of(name, **config):
@@ -157,28 +156,25 @@ def runs_of(name, **config):
                 iterations=sizes.ITERATIONS) for key in KEYS[:2]]
 
 
-def test_iwd_with_backtracking_drops_runs_the_same_native(monkeypatch):
-    calls = spied(monkeypatch)
-    lanes = runs_of("iwd", backtrack=True,
-                    walker=WalkerOptions(implementation="lanes"))
-    assert not calls
-    natives = runs_of("iwd", backtrack=True,
-                      walker=WalkerOptions(implementation="native"))
-    assert calls  # the drops walked natively
+def test_iwd_with_backtracking_drops_runs_the_same_native():
+    chosen = {name: WalkerOptions(implementation=name) for name in ("lanes", "native")}
+    traced = [calls_the_kernel("iwd", backtrack=True, walker=chosen[name]) for name in chosen]
+    assert traced == [False, True]
+    lanes = runs_of("iwd", backtrack=True, walker=chosen["lanes"])
+    natives = runs_of("iwd", backtrack=True, walker=chosen["native"])
     for key, (reference, other) in enumerate(zip(lanes, natives)):
         assert_same(reference, other, f"key {key}")
     assert np.isfinite(np.asarray(lanes[0][0].best_cost))
 
 
-def test_improved_max_min_acos_first_ant_runs_the_same_native(monkeypatch):
+def test_improved_max_min_acos_first_ant_runs_the_same_native():
     """The first ant (bug2.first_ant_path) walks as the colony's walker options say."""
-    calls = spied(monkeypatch)
-    results = {}
-    for implementation in ("lanes", "native"):
-        results[implementation] = runs_of("improved_max_min_aco",
-                                          walker=WalkerOptions(implementation=implementation))
-        assert bool(calls) == (implementation == "native")
-    for key, (reference, other) in enumerate(zip(results["lanes"], results["native"])):
+    chosen = {name: WalkerOptions(implementation=name) for name in ("lanes", "native")}
+    traced = [calls_the_kernel("improved_max_min_aco", walker=chosen[name]) for name in chosen]
+    assert traced == [False, True]
+    lanes = runs_of("improved_max_min_aco", walker=chosen["lanes"])
+    natives = runs_of("improved_max_min_aco", walker=chosen["native"])
+    for key, (reference, other) in enumerate(zip(lanes, natives)):
         assert_same(reference, other, f"key {key}")
 
 
