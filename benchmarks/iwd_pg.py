@@ -3,24 +3,29 @@ iteration, and the share of each stage; and a check that its results are the rec
 
 For each key of ``--keys`` one run of ``--iterations`` iterations (default 100, no patience:
 a run stops early only when every drop of an iteration took one path) on ``--map`` (default
-mosaic50, the map of ``jaxswarm demo``, with its start and goal). The run is compiled once
-(without the compile cache: its seconds are printed), then each key is timed ``--repeats`` times
-and the median per key is printed, divided by the iterations it ran.
+mosaic50, the map of ``jaxswarm demo``, with its start and goal), by each of the walker's
+implementations of ``--implementations`` (default ``lanes,native``: the XLA lanes, the
+reference, and the native kernels, :mod:`jaxswarm.swarm.walking.native`), named in the swarm's
+config (``walker=WalkerOptions(implementation=...)``), one after the other in the same process,
+one row each (``walker``). The run is compiled once per implementation (without the compile
+cache: its seconds are printed), then each key is timed ``--repeats`` times and the median per
+key is printed, divided by the iterations it ran.
 
 ``--stages`` also times variants with one stage switched off (:class:`IWDPGConfig`), each
 compiled on its own: ``no smooth``, ``no operators`` (the memory operators compiled but never
 due: ``operator_patience`` above the iterations), ``no intersections``, ``no local search``;
-a stage's share is how much of the default run's time per iteration the variant saves. The
-variants' runs take other paths (a stage off changes what the drops find), so the shares are
-estimates; the variant ``walk only`` (smooth and operators off) is the drops' walk with the
-bookkeeping of the iteration.
+a stage's share is how much of the default run's time per iteration (of the same
+implementation) the variant saves. The variants' runs take other paths (a stage off changes
+what the drops find), so the shares are estimates; the variant ``walk only`` (smooth and
+operators off) is the drops' walk with the bookkeeping of the iteration.
 
 Same results: the SHA-256 of every leaf of each run's state and trace (PRNG keys as their data;
 not the trace's ``lane_steps``, the walker's schedule) are compared with :data:`RECORDED`, the
 digests of jaxswarm 0.7.0's runs (the same runs as before IWD_PG was sped up, in 0.7.0's
 arithmetic, :mod:`jaxswarm.runtime.arithmetic`; ``same results: yes`` when every leaf matches;
-printed for the default map, iterations and config; ``--record`` prints the digests of this run
-as the record's source text).
+printed for the default map, iterations and config, per implementation; ``--record`` prints
+the digests of this run as the record's source text, per implementation). ``same as lanes``:
+whether every other implementation's runs have the lanes' digests, every key (any map).
 
 XLA:CPU runs each run on ``--threads`` intra-op threads (default 1; see
 :mod:`jaxswarm.runtime.cpu`).
@@ -30,6 +35,7 @@ Run from the repository root::
     python benchmarks/iwd_pg.py
     python benchmarks/iwd_pg.py --stages --repeats 3
     python benchmarks/iwd_pg.py --map maze50 --keys 0
+    python benchmarks/iwd_pg.py --implementations native   # the native walker alone
 """
 from __future__ import annotations
 
@@ -44,9 +50,11 @@ import jax
 import numpy as np
 
 from jaxswarm.maps.named import named_map
+from jaxswarm.runtime import native
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.testing import key_data
+from jaxswarm.swarm.walking.options import IMPLEMENTATIONS, WalkerOptions
 
 DEFAULT_MAP, DEFAULT_ITERATIONS = "mosaic50", 100
 
@@ -193,6 +201,39 @@ def measure(swarm, graph, task, keys, iterations: int, repeats: int):
     return compile_seconds - out[keys[0]][0] * out[keys[0]][1] / 1e3, out
 
 
+def chosen_implementations(text: str, parser: argparse.ArgumentParser) -> list[str]:
+    """The walker's implementations ``--implementations`` names, checked (and the native
+    kernels built or loaded, so that no compile time below includes that)."""
+    names = text.split(",")
+    for name in names:
+        if name not in IMPLEMENTATIONS:
+            parser.error(f"--implementations: {name!r} is none of {', '.join(IMPLEMENTATIONS)}")
+    if "native" in names and not native.available():
+        parser.error("--implementations: the native kernels cannot be built here")
+    return names
+
+
+def check_results(args, keys: list[int], defaults: dict) -> None:
+    """Print whether each implementation's default runs (``defaults``: implementation -> key
+    -> (ms, iterations, cost, digests)) have the recorded digests, and the lanes' (and, with
+    ``--record``, the record's source text)."""
+    for implementation, out in defaults.items():
+        if args.record:
+            print(f"# {implementation}\n" + record_source(
+                {args.map: {key: leaves for key, (*_, leaves) in out.items()}}))
+        record = RECORDED.get(args.map, {}) if args.iterations == DEFAULT_ITERATIONS else {}
+        recorded = [key for key in keys if key in record]
+        if recorded:
+            changed = {key: sorted(leaf for leaf, digest in record[key].items()
+                                   if out[key][3].get(leaf) != digest) for key in recorded}
+            same = not any(changed.values())
+            print(f"{implementation}: same results as recorded (keys {recorded}): "
+                  f"{'yes' if same else 'NO'}" + ("" if same else f" changed leaves: {changed}"))
+        if implementation != "lanes" and "lanes" in defaults:
+            same = all(out[key][3] == defaults["lanes"][key][3] for key in keys)
+            print(f"{implementation}: same as lanes (keys {keys}): {'yes' if same else 'NO'}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default=DEFAULT_MAP, help="a map jaxswarm demo takes")
@@ -205,6 +246,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="also time the variants with a stage switched off")
     parser.add_argument("--record", action="store_true",
                         help="print this run's digests as RECORDED's source text")
+    parser.add_argument("--implementations", default=",".join(IMPLEMENTATIONS),
+                        help=f"comma-separated walker implementations, from "
+                             f"{', '.join(IMPLEMENTATIONS)}")
     args = parser.parse_args(argv)
     if args.repeats < 1:
         parser.error(f"--repeats must be at least 1, got {args.repeats}")
@@ -216,6 +260,7 @@ def main(argv: list[str] | None = None) -> int:
         chosen = named_map(args.map)
     except ValueError as error:
         parser.error(str(error))
+    implementations = chosen_implementations(args.implementations, parser)
     graph = chosen.graph
     task = make_task(graph, chosen.start, chosen.goal)
     print(f"machine: {platform.platform()} | {os.cpu_count()} CPUs | jax {jax.__version__} "
@@ -223,31 +268,31 @@ def main(argv: list[str] | None = None) -> int:
           f"{os.getloadavg()[0]:.1f}")
     print(f"iwd_pg on {args.map} ({graph.shape[1]}x{graph.shape[0]}), {args.iterations} "
           f"iterations, no patience, keys {keys}, median of {args.repeats}")
+    print(f"{'variant':18} {'walker':6} {'compile s':>9} {'ms/iter':>8} {'share':>6}  per key: "
+          f"ms/iter (iterations, best cost)")
     rows = [("default", {})] + (list(VARIANTS.items()) if args.stages else [])
-    print(f"{'variant':18} {'compile s':>9} {'ms/iter':>8} {'share':>6}  per key: ms/iter "
-          f"(iterations, best cost)")
-    baseline = None
+    defaults = {}
     for label, options in rows:
-        compile_seconds, out = measure(make("iwd_pg", **options), graph, task, keys,
-                                       args.iterations, args.repeats)
-        per_iteration = statistics.median(ms for ms, *_ in out.values())
-        baseline = per_iteration if baseline is None else baseline
-        share = "" if label == "default" else f"{(baseline - per_iteration) / baseline:>6.0%}"
-        print(f"{label:18} {compile_seconds:>9.1f} {per_iteration:>8.2f} {share:>6}  " + ", ".join(
-            f"{ms:.2f} ({ran}, {cost:.2f})" for ms, ran, cost, _ in out.values()), flush=True)
-        if label != "default":
-            continue
-        if args.record:
-            print(record_source({args.map: {key: leaves for key, (*_, leaves) in out.items()}}))
-        record = RECORDED.get(args.map, {}) if args.iterations == DEFAULT_ITERATIONS else {}
-        recorded = [key for key in keys if key in record]
-        if recorded:
-            changed = {key: sorted(leaf for leaf, digest in record[key].items()
-                                   if out[key][3].get(leaf) != digest) for key in recorded}
-            same = not any(changed.values())
-            print(f"same results as recorded (keys {recorded}): {'yes' if same else 'NO'}"
-                  + ("" if same else f" changed leaves: {changed}"))
+        for implementation in implementations:
+            walker = WalkerOptions(implementation=implementation)
+            compile_seconds, out = measure(make("iwd_pg", walker=walker, **options), graph, task,
+                                           keys, args.iterations, args.repeats)
+            defaults.setdefault(implementation, out)
+            print_row(label, implementation, compile_seconds, out, defaults[implementation])
+    check_results(args, keys, defaults)
     return 0
+
+
+def print_row(label: str, implementation: str, compile_seconds: float, out: dict,
+              default: dict) -> None:
+    """One row of the table: a variant's runs by one implementation (``out``: key -> (ms,
+    iterations, cost, digests)), its share against that implementation's ``default`` runs."""
+    per_iteration = statistics.median(ms for ms, *_ in out.values())
+    baseline = statistics.median(ms for ms, *_ in default.values())
+    share = "" if out is default else f"{(baseline - per_iteration) / baseline:>6.0%}"
+    print(f"{label:18} {implementation:6} {compile_seconds:>9.1f} {per_iteration:>8.2f} "
+          f"{share:>6}  " + ", ".join(f"{ms:.2f} ({ran}, {cost:.2f})"
+                                      for ms, ran, cost, _ in out.values()), flush=True)
 
 
 if __name__ == "__main__":

@@ -7,13 +7,20 @@ geometric from 2 to 200, ``alpha`` linear from 1 to 20) x ``--seeds`` seeds on `
 :func:`jaxswarm.sweep.run_sweep` into a fresh temporary store, then the same runs are done one at
 a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The CPU is split into
 ``--devices`` JAX devices (default: one per core, each with one XLA thread; see
-:mod:`jaxswarm.runtime.cpu`), so the sweep runs one shard of each chunk per core. Printed per agent count:
+:mod:`jaxswarm.runtime.cpu`), so the sweep runs one shard of each chunk per core. Both are done
+by each of the walker's implementations of ``--implementations`` (default ``lanes,native``: the
+XLA lanes, the reference, and the native kernels, :mod:`jaxswarm.swarm.walking.native`), named
+in the swarm's config (``walker=WalkerOptions(implementation=...)``, which the sweep runner
+builds its swarm with), one after the other in the same process. Printed per agent count and
+implementation (``walker``), one row each:
 
 * ``sweep``: one timed call of ``run_sweep`` (not repeated: it takes a while). Its compile time
-  is the runner's own ``compiled ... in X s`` log line; the wall time and runs/s exclude it (they
-  still include the map's optimum, the chunks' inputs and the Parquet writes). Before it, a
-  sweep of a quarter of the seeds is run, so that the peak resident memory (``ru_maxrss``) after
-  each shows whether memory grows with the number of runs.
+  (``compile s``) is the runner's own ``compiled ... in X s`` log line (the persistent
+  compilation cache is switched off, so every program is compiled); the wall time and runs/s
+  exclude it (they still include the map's optimum, the chunks' inputs and the Parquet writes).
+  Before it, a sweep of a quarter of the seeds is run, so that the peak resident memory
+  (``ru_maxrss``) after each shows whether memory grows with the number of runs (the process's
+  peak so far: a row's includes the rows before it).
 * ``loop``: ``run`` called per (params, seed) with ``jax.random.key(seed)`` and blocked on, after
   one warm-up call (params are traced, so the loop compiles once; that compile is excluded), on
   the first device. With ``--loop-runs N`` below the total only N runs, spread over the grid and
@@ -24,13 +31,16 @@ a time by :func:`jaxswarm.swarm.run` in a Python loop, in the same process. The 
   result``): the sweep's row of every run measured in both equals the loop's run, its cost (bit
   for bit, float32), its moves and its fingerprint (the whole final state and trace,
   :func:`jaxswarm.swarm.fingerprint.run_fingerprint`, taken after the timed loop). A run that
-  differs is listed below the table with its seed and params.
+  differs is listed below the table with its seed and params. ``as lanes``: the runs whose
+  sweep rows (cost, moves and fingerprint) equal the lanes' sweep's (``-`` on the lanes' row,
+  or when ``lanes`` is not measured).
 
 Run from the repository root::
 
     python benchmarks/sweep.py
     python benchmarks/sweep.py --agents 16 --loop-runs 64
     python benchmarks/sweep.py --values 2 --seeds 4 --iterations 5 --agents 16 --loop-runs 4
+    python benchmarks/sweep.py --implementations native   # the native walker alone
 """
 from __future__ import annotations
 
@@ -47,10 +57,12 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.maps.paper import paper_map
+from jaxswarm.runtime import native
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep import run_sweep, spec_from_dict
+from jaxswarm.swarm.walking.options import IMPLEMENTATIONS, WalkerOptions
 from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
 
 GiB = 2 ** 30
@@ -65,13 +77,16 @@ def machine() -> str:
             f"{len(jax.devices())} device(s))")
 
 
-def sweep_document(args, agents: int, seeds: int) -> dict:
+def sweep_document(args, agents: int, seeds: int, implementation: str) -> dict:
+    """The sweep's document (as :func:`~jaxswarm.sweep.spec_from_dict` reads it): runs of
+    ``agents`` agents, ``seeds`` seeds, walked by the walker's ``implementation``."""
     sweep = {"name": "bench", "algorithm": "rfd_graded", "maps": [args.map], "seeds": seeds,
              "iterations": args.iterations, "chunk_size": args.chunk_size}
     if args.vmap_size is not None:
         sweep["vmap_size"] = args.vmap_size
     return {"sweep": sweep,
-            "config": {"num_agents": agents},
+            "config": {"num_agents": agents,
+                       "walker": WalkerOptions(implementation=implementation)},
             "params": {"p_base": {"start": 2, "stop": 200, "num": args.values, "log": True},
                        "alpha": {"start": 1, "stop": 20, "num": args.values}}}
 
@@ -146,12 +161,14 @@ def time_loop(spec, map_name: str, runs: list[int]) -> dict:
                 wall=wall, compile=compile_seconds)
 
 
-def measure(args, agents: int) -> dict:
-    """The quarter sweep, the sweep and the loop for runs of ``agents`` agents."""
-    quarter = spec_from_dict(sweep_document(args, agents, max(1, args.seeds // 4)))
+def measure(args, agents: int, implementation: str) -> dict:
+    """The quarter sweep, the sweep and the loop for runs of ``agents`` agents walked by
+    ``implementation``."""
+    quarter = spec_from_dict(sweep_document(args, agents, max(1, args.seeds // 4),
+                                            implementation))
     time_sweep(quarter)
     quarter_rss = peak_rss()
-    spec = spec_from_dict(sweep_document(args, agents, args.seeds))
+    spec = spec_from_dict(sweep_document(args, agents, args.seeds, implementation))
     total = spec.num_runs
     sweep = time_sweep(spec)
     runs = loop_runs(total, len(spec.grid()), len(spec.seeds), args.loop_runs)
@@ -167,7 +184,48 @@ def measure(args, agents: int) -> dict:
                 compile=sweep["compile"], measured=len(runs), mismatches=mismatches,
                 quarter_rss=quarter_rss, rss=sweep["rss"],
                 iterations=float(sweep["frame"]["iterations"].mean()),
-                moves=int(sweep["frame"]["moves"].sum()))
+                moves=int(sweep["frame"]["moves"].sum()),
+                rows=by_run[["cost", "moves", "fingerprint"]])
+
+
+def same_rows(rows, lanes) -> int:
+    """How many runs have the same cost (bit for bit), moves and fingerprint in two sweeps'
+    rows (indexed by run)."""
+    return int(((rows["cost"].to_numpy(np.float32).view(np.uint32)
+                 == lanes["cost"].to_numpy(np.float32).view(np.uint32))
+                & (rows["moves"] == lanes["moves"]).to_numpy()
+                & (rows["fingerprint"] == lanes["fingerprint"]).to_numpy()).sum())
+
+
+def print_row(agents: int, implementation: str, r: dict, lanes) -> None:
+    """One row of the table (see the module docstring); ``lanes``: the lanes' sweep rows of
+    the same agents, or None (no ``as lanes`` count)."""
+    speedup = r["loop_wall"] / r["sweep_wall"]
+    goal = GOAL_SPEEDUP.get(agents)
+    met = "" if goal is None else ("met" if speedup >= goal else "NOT met")
+    as_lanes = "-" if lanes is None else f"{same_rows(r['rows'], lanes)}/{r['total']}"
+    print(f"{agents:>6} {implementation:6} {r['total']:>6} {r['sweep_wall']:>8.2f} "
+          f"{r['loop_wall']:>8.2f}{'*' if r['measured'] < r['total'] else ' '} {speedup:>8.2f}x "
+          f"{met:>5} {r['compile']:>9.1f} {r['quarter_rss'] / GiB:>11.2f} "
+          f"{r['rss'] / GiB:>8.2f} {r['measured'] - len(r['mismatches']):>5}/"
+          f"{r['measured']:<5} {as_lanes:>11} {r['iterations']:>10.1f} "
+          f"{r['moves'] / r['sweep_wall'] / 1e6:>12.2f} / "
+          f"{r['moves'] / r['loop_wall'] / 1e6:<7.2f}", flush=True)
+    for row in r["mismatches"]:
+        print(f"  differs from the loop: run {row.name}, seed {int(row.seed)}, "
+              f"p_base {float(row.p_base)!r}, alpha {float(row.alpha)!r}", flush=True)
+
+
+def chosen_implementations(text: str, parser: argparse.ArgumentParser) -> list[str]:
+    """The walker's implementations ``--implementations`` names, checked (and the native
+    kernels built or loaded, so that no compile time below includes that)."""
+    names = text.split(",")
+    for name in names:
+        if name not in IMPLEMENTATIONS:
+            parser.error(f"--implementations: {name!r} is none of {', '.join(IMPLEMENTATIONS)}")
+    if "native" in names and not native.available():
+        parser.error("--implementations: the native kernels cannot be built here")
+    return names
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -186,31 +244,29 @@ def main(argv: list[str] | None = None) -> int:
                         help="JAX CPU devices, one XLA thread each (default: one per core)")
     parser.add_argument("--loop-runs", type=int, default=None,
                         help="time only this many loop runs and extrapolate (default: all)")
+    parser.add_argument("--implementations", default=",".join(IMPLEMENTATIONS),
+                        help=f"comma-separated walker implementations, from "
+                             f"{', '.join(IMPLEMENTATIONS)}")
     args = parser.parse_args(argv)
-    configure(devices=args.devices, threads=args.devices)  # before JAX's first computation
+    # Before JAX's first computation; compile seconds are measured, so no cached programs.
+    jax.config.update("jax_enable_compilation_cache", False)
+    configure(devices=args.devices, threads=args.devices)
+    implementations = chosen_implementations(args.implementations, parser)
 
     print(f"machine: {machine()}")
     print(f"rfd_graded on {args.map}: p_base x alpha = {args.values} x {args.values} values x "
           f"{args.seeds} seeds, {args.iterations} iterations, chunks of {args.chunk_size}, "
           f"groups of {args.vmap_size or 'the runner default'}")
-    print(f"{'agents':>6} {'runs':>6} {'sweep s':>8} {'loop s':>8} {'speed-up':>9} {'goal':>5} "
-          f"{'compile s':>9} {'RSS 1/4 GiB':>11} {'RSS GiB':>8} {'same result':>11} "
-          f"{'iterations':>10} {'M moves/s sweep / loop':>22}", flush=True)
+    print(f"{'agents':>6} {'walker':6} {'runs':>6} {'sweep s':>8} {'loop s':>8} "
+          f"{'speed-up':>9} {'goal':>5} {'compile s':>9} {'RSS 1/4 GiB':>11} {'RSS GiB':>8} "
+          f"{'same result':>11} {'as lanes':>11} {'iterations':>10} "
+          f"{'M moves/s sweep / loop':>22}", flush=True)
     for agents in (int(part) for part in args.agents.split(",")):
-        r = measure(args, agents)
-        speedup = r["loop_wall"] / r["sweep_wall"]
-        goal = GOAL_SPEEDUP.get(agents)
-        met = "" if goal is None else ("met" if speedup >= goal else "NOT met")
-        print(f"{agents:>6} {r['total']:>6} {r['sweep_wall']:>8.2f} {r['loop_wall']:>8.2f}"
-              f"{'*' if r['measured'] < r['total'] else ' '} {speedup:>8.2f}x "
-              f"{met:>5} {r['compile']:>9.1f} {r['quarter_rss'] / GiB:>11.2f} "
-              f"{r['rss'] / GiB:>8.2f} {r['measured'] - len(r['mismatches']):>5}/"
-              f"{r['measured']:<5} {r['iterations']:>10.1f} "
-              f"{r['moves'] / r['sweep_wall'] / 1e6:>12.2f} / {r['moves'] / r['loop_wall'] / 1e6:<7.2f}",
-              flush=True)
-        for row in r["mismatches"]:
-            print(f"  differs from the loop: run {row.name}, seed {int(row.seed)}, "
-                  f"p_base {float(row.p_base)!r}, alpha {float(row.alpha)!r}", flush=True)
+        lanes = None
+        for implementation in implementations:
+            r = measure(args, agents, implementation)
+            print_row(agents, implementation, r, None if implementation == "lanes" else lanes)
+            lanes = r["rows"] if implementation == "lanes" else lanes
     print("* loop extrapolated from --loop-runs runs" if args.loop_runs else "")
     print(f"goals: speed-up {', '.join(f'{v}x at {k} agents' for k, v in GOAL_SPEEDUP.items())}; "
           f"peak memory below {GOAL_MEMORY / GiB:.0f} GiB and flat in the number of runs")
