@@ -18,7 +18,8 @@
 //   memory f32[R, N, K], params f32[R or 1, P] (the rule's numbers), lengths f32[K] (by slot,
 //   grids) or f32[N, K] (each edge's length), attribute rule (1: the soil choice, which reads
 //   the soil; 2: the soil rule, which writes it)
-//   -> memory f32[R, N, K] after the walk, state f32[R, A, E] (E = 0, or 2: velocity, carried)
+//   -> memory f32[R, N, K] after the walk (f32[0] under the soil choice, which does not write
+//      it), state f32[R, A, E] (E = 0, or 2: velocity, carried)
 // Under the soil choice the agents walk in turn, as without a hook; under the soil rule the
 // drops of a run walk step by step together, as the lanes walk them (WalkTogether).
 //
@@ -96,7 +97,8 @@ constexpr int32_t kSoilParams = 12;
 // the soil rule), each run's numbers and each edge's length (f32[K] by slot on grids, f32[N, K]).
 struct Hook {
   Rule rule;
-  float* memory;             // f32[R, N, K], or null (plain)
+  const float* memory;       // f32[R, N, K] as the walk starts (the soil choice reads it)
+  float* written;            // f32[R, N, K] the soil rule's memory, a copy it writes, or null
   const float* params;       // f32[R or 1, P]
   int64_t params_runs;
   int32_t params_width;
@@ -418,7 +420,7 @@ int64_t WalkTogether(const Call& c, const Hook& hook, int64_t r, const Out<Slot>
                      Scratch& scratch, std::vector<int32_t>& group_of_edge) {
   const int32_t A = c.agents, K = c.map.degree;
   const SoilParams p = ParamsOf(hook, r);
-  float* soil = hook.memory + r * static_cast<int64_t>(c.map.num_nodes) * K;
+  float* soil = hook.written + r * static_cast<int64_t>(c.map.num_nodes) * K;
   const float keep = 1.0f - p.rho_n;
   std::vector<Agent> agents(A);
   std::vector<std::vector<std::pair<int32_t, int32_t>>> moved(A);  // (node, slot) per move
@@ -608,7 +610,7 @@ ffi::Error WalkImpl(ffi::Buffer<ffi::U32> seed, ffi::Buffer<ffi::F32> log_weight
                     ffi::ResultBuffer<ffi::PRED> arrived, ffi::ResultBuffer<ffi::PRED> stuck,
                     ffi::ResultBuffer<ffi::S32> position, ffi::ResultBuffer<ffi::U32> visited,
                     ffi::ResultBuffer<ffi::S32> lane_steps) {
-  const Hook plain{kPlain, nullptr, nullptr, 0, 0, nullptr};
+  const Hook plain{kPlain, nullptr, nullptr, nullptr, 0, 0, nullptr};
   return Walk(seed, log_weights, start, goal, neighbours, plain, num_agents, max_steps,
               greedy_agents, blocks, {lanes, refill_share, compact_share, smallest_compaction},
               nodes, slots, offset, moves, overflowed, length, arrived, stuck, position, visited,
@@ -639,9 +641,12 @@ ffi::Error HookedWalkImpl(
   const int64_t cells = table_dims[1] * table_dims[2];
   const int32_t width = rule == kSoil ? kSoilParams : kSoilChoiceParams;
   auto params_dims = params.dimensions();
+  // The soil choice reads the memory in place and writes none (an empty memory_after).
+  const size_t written = rule == kSoil ? static_cast<size_t>(runs * cells) : 0;
   if (memory.element_count() != static_cast<size_t>(runs * cells) ||
-      memory_after->element_count() != static_cast<size_t>(runs * cells)) {
-    return ffi::Error::InvalidArgument("hooked walk: memory must be f32[R, N, K]");
+      memory_after->element_count() != written) {
+    return ffi::Error::InvalidArgument("hooked walk: memory must be f32[R, N, K], and the "
+                                       "memory after f32[R, N, K] (the soil rule) or f32[0]");
   }
   if (params_dims.size() != 2 || params_dims[1] != width ||
       (params_dims[0] != 1 && params_dims[0] != runs)) {
@@ -653,8 +658,9 @@ ffi::Error HookedWalkImpl(
     return ffi::Error::InvalidArgument("hooked walk: lengths must be f32[K] or f32[N, K]");
   }
   const int32_t state_width = rule == kSoil ? 2 : 0;
-  std::copy(memory.typed_data(), memory.typed_data() + runs * cells, memory_after->typed_data());
-  const Hook hook{static_cast<Rule>(rule), memory_after->typed_data(), params.typed_data(),
+  std::copy(memory.typed_data(), memory.typed_data() + written, memory_after->typed_data());
+  const Hook hook{static_cast<Rule>(rule), memory.typed_data(),
+                  rule == kSoil ? memory_after->typed_data() : nullptr, params.typed_data(),
                   params_dims[0], width, lengths.typed_data()};
   return Walk(seed, log_weights, start, goal, neighbours, hook, num_agents, max_steps,
               greedy_agents, blocks, {lanes, refill_share, compact_share, smallest_compaction},

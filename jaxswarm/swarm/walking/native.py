@@ -116,7 +116,8 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         inputs += [jnp.asarray(memory, jnp.float32), hook_numbers(hook_params, hook),
                    jnp.asarray(slot_lengths(graph) if graph.is_grid else graph.cost,
                                jnp.float32)]
-        shapes += [jax.ShapeDtypeStruct(memory.shape, jnp.float32),  # memory after the walk
+        written = memory.shape if hook.writes else (0,)  # a read-only hook writes none
+        shapes += [jax.ShapeDtypeStruct(written, jnp.float32),  # memory after the walk
                    jax.ShapeDtypeStruct((runs, num_agents, hook.state_width), jnp.float32)]
     # "sequential": walks on different maps (a vmap the walker's batching rule does not fold)
     # are one call each; the runs of one map come folded into R by that rule.
