@@ -4,6 +4,7 @@
 #define JAXSWARM_RUNTIME_NATIVE_CHOICE_H_
 
 #include <cstdint>
+#include <limits>
 
 #include "arithmetic.h"
 
@@ -33,10 +34,15 @@ inline int32_t DrawFromWeights(const float* weight, int32_t K, float uniform) {
 }
 
 // sample_masked's draw of one row whose largest log-weight `top` is finite: the weights
-// exp(masked - top) into `weight` (K floats), then DrawFromWeights.
+// exp(masked - top) into `weight` (K floats), then DrawFromWeights. Two weights need no Exp:
+// a masked-out slot's (exp(-inf) is 0: below the smallest normal float, flushed as XLA
+// flushes it) and the top's (exp(0) is 1 exactly).
 inline int32_t InverseCdf(const float* masked, int32_t K, float top, float uniform,
                           float* weight) {
-  for (int32_t k = 0; k < K; ++k) weight[k] = Exp(masked[k] - top);
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int32_t k = 0; k < K; ++k) {
+    weight[k] = masked[k] == -inf ? 0.0f : masked[k] == top ? 1.0f : Exp(masked[k] - top);
+  }
   return DrawFromWeights(weight, K, uniform);
 }
 
