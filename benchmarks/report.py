@@ -25,7 +25,9 @@ ROOT = Path(__file__).resolve().parents[1]
 BENCHMARKS = [
     ("Walks: moves per second against a scalar C loop", "walk.py", [],
      ["--repeats", "2", "--layouts", "64x4", "--maps", "maze20"],
-     "Moves per second of one jitted call of the walker on maze100 and on the 256 x 256 Moving AI "
+     "Moves per second of one jitted call of the walker, with each implementation (the XLA "
+     "lanes and the native kernels; `as lanes`: agents whose outputs equal the lanes', "
+     "`compile s`: the walk program's compile seconds), on maze100 and on the 256 x 256 Moving AI "
      "map Berlin_1_256 (a device's seeds' walks share one queue over its lanes), from the swarm's "
      "first memory and from its memory after 30 iterations, on one JAX CPU device and with the "
      "seeds shared out over one device per core (`jax.shard_map`, as sweeps run), beside "
@@ -43,11 +45,18 @@ BENCHMARKS = [
      "Median wall time of one `rfd_graded` run (100 iterations at most, patience 30, 256 drops, "
      "one XLA thread) per paper map over 20 seeds, beside the RFD paper's C# time of RFD*, and "
      "how many seeds reached the optimum."),
+    ("IWD_PG per iteration", "iwd_pg.py", ["--repeats", "3"],
+     ["--map", "mosaic20", "--keys", "0", "--iterations", "5", "--repeats", "1"],
+     "Milliseconds per iteration of `iwd_pg` (its default config) on mosaic50, keys 0-2, 100 "
+     "iterations without patience, with each walker implementation (the XLA lanes and the "
+     "native kernels), the compile seconds of each, and whether the runs equal the recorded "
+     "digests and each other."),
     ("Sweeps against the same runs one at a time", "sweep.py", [],
      ["--values", "2", "--seeds", "8", "--iterations", "10", "--loop-runs", "4"],
      "1,280 `rfd_graded` runs on mosaic50 (8 x 8 values of p_base x alpha, 20 seeds, 100 "
      "iterations) by the sweep runner and by `run` in a Python loop, in one process, for runs "
-     "of 16 and of 64 drops; the CPU is split into one JAX device per core."),
+     "of 16 and of 64 drops, with each walker implementation; the CPU is split into one JAX "
+     "device per core."),
     ("Settling and the distance field", "relax.py", [], ["--maps", "maze20", "--repeats", "3"],
      "The batched relaxation behind `rfd_graded`'s settling and the exact distance field, on "
      "maze100."),
