@@ -108,11 +108,7 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         smallest_compaction=np.int32(smallest_compaction))
     target = native.WALK_TARGET
     if hook is not None:
-        if hook.native not in HOOK_RULES:
-            raise ValueError(f"the native walker has no copy of this hook (native="
-                             f"{hook.native!r}; it has {', '.join(HOOK_RULES)})")
-        rule, _ = HOOK_RULES[hook.native]
-        target, attributes["rule"] = native.HOOKED_WALK_TARGET, np.int32(rule)
+        target, attributes["rule"] = native.HOOKED_WALK_TARGET, _rule(hook)
         inputs += [jnp.asarray(memory, jnp.float32), hook_numbers(hook_params, hook),
                    jnp.asarray(slot_lengths(graph) if graph.is_grid else graph.cost,
                                jnp.float32)]
@@ -134,6 +130,18 @@ def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params,
         memory_after, state = hooked
         out.update(state=state, memory=memory_after if hook.writes else memory)
     return out
+
+
+def _rule(hook) -> np.int32:
+    """The kernel's number of ``hook``'s rule (:data:`HOOK_RULES`).
+
+    Raises:
+      ValueError: the hook has no native copy.
+    """
+    if hook.native not in HOOK_RULES:
+        raise ValueError(f"the native walker has no copy of this hook (native={hook.native!r}; "
+                         f"it has {', '.join(HOOK_RULES)})")
+    return np.int32(HOOK_RULES[hook.native][0])
 
 
 def _shapes(graph: Graph, runs: int, num_agents: int, blocks: int, slot_dtype) -> list:
