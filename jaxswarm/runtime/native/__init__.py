@@ -35,7 +35,7 @@ from jaxswarm.runtime.atomic import atomic_path
 from jaxswarm.runtime.cache import VARIABLE as CACHE_VARIABLE
 
 SOURCES = (Path(__file__).with_name("uniforms.cc"), Path(__file__).with_name("walk.cc"),
-           Path(__file__).with_name("backtrack.cc"))
+           Path(__file__).with_name("backtrack.cc"), Path(__file__).with_name("smooth.cc"))
 """The kernels' C++ sources, compiled together into one library."""
 HEADERS = tuple(Path(__file__).with_name(name)
                 for name in ("arithmetic.h", "choice.h", "streams.h"))
@@ -53,8 +53,12 @@ HOOKED_WALK_TARGET = "jaxswarm_hooked_walk_v1"
 DEPTH_FIRST_TARGET = "jaxswarm_depth_first_v1"
 """The FFI target name of the depth-first walk (``backtrack.cc``; called by
 :mod:`jaxswarm.swarm.walking.native_backtrack`), versioned as :data:`UNIFORMS_TARGET` is."""
+SMOOTH_TARGET = "jaxswarm_smooth_v1"
+"""The FFI target name of IWD_PG's smooth operator (``smooth.cc``; called by
+:mod:`jaxswarm.swarm.iwd.native_smooth`), versioned as :data:`UNIFORMS_TARGET` is."""
 TARGETS = {UNIFORMS_TARGET: "JaxswarmUniforms", WALK_TARGET: "JaxswarmWalk",
-           HOOKED_WALK_TARGET: "JaxswarmHookedWalk", DEPTH_FIRST_TARGET: "JaxswarmDepthFirst"}
+           HOOKED_WALK_TARGET: "JaxswarmHookedWalk", DEPTH_FIRST_TARGET: "JaxswarmDepthFirst",
+           SMOOTH_TARGET: "JaxswarmSmooth"}
 """Each FFI target and the handler symbol (``XLA_FFI_DEFINE_HANDLER_SYMBOL``) that runs it."""
 FLAGS = ("-O3", "-std=c++17", "-shared", "-fPIC", "-ffp-contract=off", "-w")
 """Compiler flags. No floating-point contraction: XLA:CPU's arithmetic has none (the uniforms

@@ -18,7 +18,9 @@ as much), on the first ``W`` positions of the paths (the narrowest width
 of :func:`~jaxswarm.swarm.walking.moves.on_moves` that holds them all in the batch: past a
 path's end every position is padding, where a pass finds nothing to replace). On grids and
 path maps a move's edge is found from the cells' coordinates and the slots' fixed directions
-(:func:`lattice_costs`) instead of a search of the node's slots.
+(:func:`lattice_costs`) instead of a search of the node's slots. On CPU the passes run natively by
+default (:mod:`.native_smooth`: one kernel call smooths every selected path, bit for bit these
+passes' paths); :func:`jaxswarm.swarm.walking.native.implementation` chooses, as for the walker.
 """
 from __future__ import annotations
 
@@ -29,7 +31,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxswarm.swarm.walking import on_moves
+from jaxswarm.swarm.iwd.native_smooth import smooth_rows
+from jaxswarm.swarm.walking import native, on_moves
 from jaxswarm.world.graph import NO_NODE, Graph
 from jaxswarm.world.lattice import DIRECTIONS, ORTHOGONAL_SLOTS, slot_lengths
 
@@ -207,22 +210,32 @@ def smooth_path(graph: Graph, path: jax.Array) -> jax.Array:
     return _passes(graph.num_nodes, costs_of(graph), path)
 
 
-def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array) -> jax.Array:
+def smooth_paths(graph: Graph, paths: jax.Array, which: jax.Array,
+                 implementation: str | None = None) -> jax.Array:
     """i32[A, L]: each path of ``paths`` (i32[A, L], -1 padded, walks on the current map) where
     ``which`` (bool[A]) after the global smooth operator (:func:`smooth_path`), the others as
     they were; worked on the narrowest width that holds every path of ``which`` in the batch
-    (:func:`~jaxswarm.swarm.walking.moves.on_moves`)."""
+    (:func:`~jaxswarm.swarm.walking.moves.on_moves`).
+
+    ``implementation`` (static): ``"lanes"`` (the XLA passes) or ``"native"`` (one kernel call,
+    :func:`~.native_smooth.smooth_rows`; the same paths bit for bit); None: the walker's choice
+    (:func:`jaxswarm.swarm.walking.native.implementation`, native on CPU), made when traced.
+    """
+    natively = native.implementation(requested=implementation) == "native"
     nodes = jnp.where(which, jnp.sum(paths >= 0, axis=1, dtype=jnp.int32), 0)
-    smoothed = on_moves(functools.partial(_smooth_within, paths.shape[1]), nodes, (paths,),
-                        which, graph)
+    smoothed = on_moves(functools.partial(_smooth_within, paths.shape[1], natively), nodes,
+                        (paths,), which, graph)
     return jnp.where(which[:, None], smoothed, paths)
 
 
-def _smooth_within(length: int, columns, which, graph: Graph) -> jax.Array:
+def _smooth_within(length: int, natively: bool, columns, which, graph: Graph) -> jax.Array:
     """i32[A, length]: the paths ``columns`` (one i32[A, W]) where ``which`` (bool[A]) smoothed,
-    -1 padded to ``length``."""
+    natively or by the XLA passes, -1 padded to ``length``."""
     (paths,) = columns
-    smoothed = _smooth_distinct(graph.num_nodes, costs_of(graph), paths, which)
+    if natively:
+        smoothed = smooth_rows(graph, paths, which, IMPROVEMENT)
+    else:
+        smoothed = _smooth_distinct(graph.num_nodes, costs_of(graph), paths, which)
     return jnp.pad(smoothed, ((0, 0), (0, length - paths.shape[1])), constant_values=NO_NODE)
 
 
