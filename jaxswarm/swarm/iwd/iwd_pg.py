@@ -322,10 +322,12 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
     shorter. Their local searches (around the first operator's joints, and the second's
     connections) run as one batch; a search whose result no pair uses (around the joints of a
     pair that does not cross, or connecting a pair that does) runs from its first node to
-    itself, where no drop walks."""
+    itself, where no drop walks. With both operators a pair needs the first's two searches or
+    the second's one, never all three: the batch holds two per pair (:func:`_packed`)."""
     config = setup.config
     num_pairs = config.memory_size - 1
     improve_first = config.first_intersection and config.local_search
+    both = improve_first and config.second_intersection
     searches = (2 * num_pairs if improve_first else 0) + (
         num_pairs if config.second_intersection else 0)
     plan = _crossing_plan(setup, graph, memory)
@@ -343,10 +345,16 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
             heres.append(here)
             theres.append(jnp.where(plan.pairs.present & ~plan.crossing, plan.pairs.others[
                 jnp.arange(num_pairs), plan.closest[1]], here))
-        return (jax.random.split(key, searches), jnp.concatenate(heres),
-                jnp.concatenate(theres)), None
+        asked = (jax.random.split(key, searches), jnp.concatenate(heres),
+                 jnp.concatenate(theres))
+        if both:
+            packed, _ = _packed(plan.crossing)
+            asked = tuple(x[packed] for x in asked)
+        return asked, None
 
     def apply(memory, _, found):
+        if both:
+            found = jax.tree_util.tree_map(lambda x: x[_packed(plan.crossing)[1]], found)
         offspring = plan.offspring
         if improve_first:
             offspring = _improved_at_joints(
@@ -358,7 +366,26 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
                                               found.calls[-num_pairs:])
         return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
 
-    return _Stage(searches=searches, ask=ask, apply=apply)
+    return _Stage(searches=2 * num_pairs if both else searches, ask=ask, apply=apply)
+
+
+def _packed(crossing: jax.Array):
+    """The intersection stage's 3P searches (the first operator's two per pair, rows 2q and
+    2q + 1, then the second's, row 2P + q) in a batch of 2P, for ``crossing`` (bool[P]): slot
+    2q runs search 2q where pair q crosses, else search 2P + q; slot 2q + 1 runs search 2q + 1.
+    Every search whose result a pair uses has a slot (the others run from a node to itself).
+
+    Returns:
+      ``(packed, unpacked)``: i32[2P] the search each slot runs, and i32[3P] the slot each
+      search's result is read from (a search without a slot reads one whose result the pair
+      does not use).
+    """
+    num_pairs = crossing.shape[0]
+    pairs = jnp.arange(num_pairs)
+    packed = jnp.stack([jnp.where(crossing, 2 * pairs, 2 * num_pairs + pairs),
+                        2 * pairs + 1], axis=1).reshape(-1)
+    unpacked = jnp.concatenate([jnp.arange(2 * num_pairs), 2 * pairs])
+    return packed, unpacked
 
 
 def _crossing_plan(setup: _Setup, graph: Graph, memory: Memory) -> _Crossing:
