@@ -30,9 +30,11 @@ from jaxswarm.swarm.core import (ParamError, Swarm, Task, WalkingConfig, best_so
                                  check_positive, default_params, keep_best, shown)
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update, global_update,
                                      goal_log_desirability, walked_soil)
-from jaxswarm.swarm.walking import Walk, WalkerOptions, edge_table, fold_agents, step_budget, walk
+from jaxswarm.swarm.walking import (FORCED, Walk, WalkerOptions, edge_table, fold_agents,
+                                   step_budget, walk)
 from jaxswarm.swarm.walking.backtrack import DepthFirstRule, backtracking_walk
 from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import slot_offsets
 
 
 LOCAL_UPDATES = ("arrived", "while_walking")
@@ -188,7 +190,7 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
       when only arrived drops change the soil (``local_updates="arrived"``), NaN for the drops
       that did not arrive (their soil is not kept, so their walks are not followed further).
     """
-    table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
+    table = goal_table(graph, task.goal, params)
     budget = step_budget(graph, max_steps)
     if local_updates == "while_walking":
         return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
@@ -206,6 +208,45 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
     memory, velocity, carried = fold_agents(_arrived_drop, drops.log, (soil, lost, lost),
                                             (soil, params), graph, used=drops.arrived)
     return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
+
+
+def goal_table(graph: Graph, goal, params: IWDParams) -> jax.Array:
+    """f32[N, K] the drops' goal term, ``beta log h(j)`` of each valid slot's neighbour ``j``
+    (:func:`~.soil.goal_log_desirability` through
+    :func:`~jaxswarm.swarm.walking.edge_table`: ``-inf`` where the edge is not valid now), the
+    same numbers. On grids and path maps each slot's column is a shifted slice of the nodes'
+    values (:func:`_slot_columns`), not a gather, and ``log d_j`` is computed once a node: built
+    as a gather of the nodes' values, XLA:CPU computed ``log d_j`` once a slot, or the table in
+    slot-major layout and transposed it in every iteration of a run's loop."""
+    if not graph.is_grid:
+        return edge_table(graph, params.beta * goal_log_desirability(graph, goal))
+    into_goal = _slot_columns(graph, jnp.arange(graph.num_nodes) == goal)
+    log_h = _slot_columns(graph, -_log_distance(graph, goal))
+    return jnp.where(graph.valid_edges(), params.beta * jnp.where(into_goal, FORCED, log_h),
+                     -jnp.inf)
+
+
+def _log_distance(graph: Graph, goal) -> jax.Array:
+    """f32[N] :func:`~jaxswarm.swarm.walking.goal_log_distance` (``log d_j``, 0 where ``d_j`` is
+    0), the same bits: ``jnp.linalg.norm`` of a node's two coordinate differences adds their two
+    squares (in either order the same float), and so does this, without the norm's reduction
+    (a slow kernel over an axis of two)."""
+    apart = graph.xy - graph.xy[goal]
+    to_goal = jnp.sqrt(apart[:, 0] * apart[:, 0] + apart[:, 1] * apart[:, 1])
+    return jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
+
+
+def _slot_columns(graph: Graph, values: jax.Array) -> jax.Array:
+    """[N, K]: ``values[nbr[i, k]]`` of ``values`` ([N], any dtype) on a grid or path map, each
+    slot's column a shifted slice of the padded values (some value of the array where slot k has
+    no neighbour: mask it by the valid edges), as
+    :func:`~jaxswarm.swarm.walking.neighbour_slots` builds them slot-major."""
+    offsets = [int(offset) for offset in slot_offsets(graph)]
+    margin = max(abs(offset) for offset in offsets)
+    padded = jnp.pad(values, (margin, margin), mode="edge")
+    n = graph.num_nodes
+    return jnp.stack([padded[margin + offset:margin + offset + n] for offset in offsets],
+                     axis=1)
 
 
 def _arrived_drop(after, drop, row, run, graph: Graph):
