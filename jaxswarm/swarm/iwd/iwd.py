@@ -284,6 +284,36 @@ def soil_after_best(graph: Graph, drops: Walk, path_of: Callable, costs,
                      drops.memory)
 
 
+def _soil_after_walked_best(graph: Graph, drops: Walk, costs, params: IWDParams) -> jax.Array:
+    """:func:`soil_after_best` of the drops' walked paths (``costs`` f32[A], inf for a drop that
+    did not arrive), the same bits. On grids and path maps the best drop's moves are read from
+    the walk's log at the width that holds them (:func:`~jaxswarm.swarm.walking.fold_agents`
+    over that one drop), their slots the log's, not a path written out at the step budget and
+    its slots searched again (a lattice neighbour has one slot)."""
+    if not graph.is_grid:
+        return soil_after_best(graph, drops, drops.agent_path, costs, params)
+    winner = jnp.argmin(costs)
+    best = (jnp.arange(costs.shape[0]) == winner) & jnp.isfinite(costs[winner])
+    return fold_agents(_global_move_update, drops.log, drops.memory,
+                       (drops.state[winner, CARRIED], params), graph, used=best)
+
+
+def _global_move_update(soil, drop, row, run, graph: Graph):
+    """:func:`~.soil.global_update` of the walk of drop ``drop`` (i32[], ``row`` its ``(path
+    i32[W + 1], slots [W])``, ``W`` any width that holds its moves), which carried ``run``'s
+    soil (``(carried f32[], params)``): ``soil`` (f32[N, K]) after it; ``soil`` as it was for a
+    ``drop`` past the last (a row of no moves)."""
+    path, slots = row
+    carried, params = run
+    on_path = slots >= 0
+    rows = jnp.where(on_path, path[:-1], graph.num_nodes)
+    columns = jnp.maximum(slots, 0).astype(jnp.int32)
+    share = carried / jnp.maximum(jnp.sum(path >= 0) - 1, 1)
+    updated = (1.0 + params.rho_iwd) * soil[jnp.minimum(rows, graph.num_nodes - 1), columns] \
+        - params.rho_iwd * share
+    return soil.at[rows, columns].set(updated, mode="drop")
+
+
 def soil_per_node(state) -> jax.Array:
     """f32[N] the mean soil on each node's edge slots (the figures' view of the memory)."""
     return ordered_sum(state.soil) / state.soil.shape[-1]
@@ -309,7 +339,7 @@ def build_iwd(config: IWDConfig) -> Swarm:
                           walker=config.walker)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
-        soil = soil_after_best(graph, drops, drops.agent_path, costs, params)
+        soil = _soil_after_walked_best(graph, drops, costs, params)
         return IWDState(key=key, soil=soil, best_path=best_path, best_cost=best_cost), info
 
     return Swarm(name="iwd", config=config, init=jax.jit(init), step=jax.jit(step),
