@@ -30,10 +30,19 @@ from jaxswarm.swarm.core import (ParamError, Swarm, Task, WalkingConfig, best_so
                                  check_positive, default_params, keep_best, shown)
 from jaxswarm.swarm.iwd.soil import (CARRIED, SOIL, SOIL_CHOICE, arrived_update, global_update,
                                      goal_log_desirability, walked_soil)
-from jaxswarm.swarm.walking import Walk, WalkerOptions, edge_table, fold_agents, step_budget, walk
+from jaxswarm.swarm.walking import (FORCED, Walk, WalkerOptions, edge_table, fold_agents,
+                                   on_walk, step_budget, walk)
 from jaxswarm.swarm.walking.backtrack import DepthFirstRule, backtracking_walk
 from jaxswarm.world.graph import Graph
+from jaxswarm.world.lattice import slot_offsets
 
+
+FEW_DROPS = 16
+"""Up to this many drops a walk (IWD_PG's local searches' 10), the arrived drops' local updates
+take one pass over every drop's walk (:func:`_arrived_soil`: eq. 4 for all the drops at once,
+then eq. 5 drop by drop, the drops that did not arrive changing nothing); with more, a fold over
+the arrived drops alone (:func:`_arrived_drop`), which costs more a drop but only for the
+drops that arrived (few of IWD's 50 on a maze). The same bits either way."""
 
 LOCAL_UPDATES = ("arrived", "while_walking")
 """When the drops' local soil updates (eqs. 4-6) apply: see :class:`IWDConfig`."""
@@ -188,7 +197,7 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
       when only arrived drops change the soil (``local_updates="arrived"``), NaN for the drops
       that did not arrive (their soil is not kept, so their walks are not followed further).
     """
-    table = edge_table(graph, params.beta * goal_log_desirability(graph, task.goal))
+    table = goal_table(graph, task.goal, params)
     budget = step_budget(graph, max_steps)
     if local_updates == "while_walking":
         return walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
@@ -202,10 +211,87 @@ def drop_walk(key, graph: Graph, task: Task, soil, params: IWDParams, *, num_age
         drops = walk(key, graph, table, task.start, task.goal, num_agents=num_agents,
                      max_steps=budget, hook=SOIL_CHOICE, memory=soil, hook_params=params,
                      walker=walker)
-    lost = jnp.full(drops.arrived.shape, jnp.nan, jnp.float32)
-    memory, velocity, carried = fold_agents(_arrived_drop, drops.log, (soil, lost, lost),
-                                            (soil, params), graph, used=drops.arrived)
-    return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
+    return _arrived_updates(graph, drops, soil, params)
+
+
+def _arrived_updates(graph: Graph, drops: Walk, soil, params: IWDParams) -> Walk:
+    """``drops`` with the local updates (the velocity update and eqs. 4-5) of those that
+    arrived: ``memory`` the soil after them (``soil`` f32[N, K] as the drops met it, each drop's
+    moves applied in agent order, then move order), ``state`` f32[A, 2] each drop's velocity
+    and carried soil at its end (NaN for a drop that did not arrive). Up to
+    :data:`FEW_DROPS` drops one pass over the walks written out at the width that holds the
+    arrived drops' moves (:func:`~jaxswarm.swarm.walking.on_walk`, :func:`_arrived_soil`), else
+    a fold over the arrived drops (:func:`~jaxswarm.swarm.walking.fold_agents`,
+    :func:`_arrived_drop`)."""
+    if drops.arrived.shape[-1] > FEW_DROPS:
+        lost = jnp.full(drops.arrived.shape, jnp.nan, jnp.float32)
+        memory, velocity, carried = fold_agents(_arrived_drop, drops.log, (soil, lost, lost),
+                                                (soil, params), graph, used=drops.arrived)
+        return drops._replace(memory=memory, state=jnp.stack([velocity, carried], axis=-1))
+    memory, velocity, carried = on_walk(_arrived_soil, drops.log, (soil, params, drops.arrived),
+                                        graph, used=drops.arrived)
+    state = jnp.where(drops.arrived[:, None], jnp.stack([velocity, carried], axis=-1), jnp.nan)
+    return drops._replace(memory=memory, state=state)
+
+
+def _arrived_soil(rows, run, graph: Graph):
+    """The local updates along the walks ``rows`` (``(path i32[A, W + 1], slots [A, W])``) of
+    one run (``run``: ``(soil f32[N, K] as the drops met it, params, arrived bool[A])``):
+    ``(soil f32[N, K], velocity f32[A], carried f32[A])``, the soil after each arrived drop's
+    eq. 5 in agent order (:func:`~.soil.arrived_update`; a drop crosses an edge at most once,
+    drops after it read its update), each drop's velocity at its end and the soil it carries.
+    The soil each move took (eq. 4, :func:`~.soil.walked_soil`) depends on the soil the drops
+    met only, so it is computed for all the drops at once; only eq. 5 goes drop by drop (the
+    drops that did not arrive change nothing)."""
+    path, slots = rows
+    soil, params, arrived = run
+    taken, velocity = walked_soil(graph, soil, path[:, :-1], slots, params)
+
+    def one(agent, after):
+        moved = jnp.where(arrived[agent], slots[agent], -1)
+        return arrived_update(graph, after, path[agent, :-1], moved, taken[agent], params)
+
+    after = jax.lax.fori_loop(0, arrived.shape[0], one, soil)
+    return after, velocity, ordered_sum(taken, axis=1)
+
+
+def goal_table(graph: Graph, goal, params: IWDParams) -> jax.Array:
+    """f32[N, K] the drops' goal term, ``beta log h(j)`` of each valid slot's neighbour ``j``
+    (:func:`~.soil.goal_log_desirability` through
+    :func:`~jaxswarm.swarm.walking.edge_table`: ``-inf`` where the edge is not valid now), the
+    same numbers. On grids and path maps each slot's column is a shifted slice of the nodes'
+    values (:func:`_slot_columns`), not a gather, and ``log d_j`` is computed once a node: built
+    as a gather of the nodes' values, XLA:CPU computed ``log d_j`` once a slot, or the table in
+    slot-major layout and transposed it in every iteration of a run's loop."""
+    if not graph.is_grid:
+        return edge_table(graph, params.beta * goal_log_desirability(graph, goal))
+    into_goal = _slot_columns(graph, jnp.arange(graph.num_nodes) == goal)
+    log_h = _slot_columns(graph, -_log_distance(graph, goal))
+    return jnp.where(graph.valid_edges(), params.beta * jnp.where(into_goal, FORCED, log_h),
+                     -jnp.inf)
+
+
+def _log_distance(graph: Graph, goal) -> jax.Array:
+    """f32[N] :func:`~jaxswarm.swarm.walking.goal_log_distance` (``log d_j``, 0 where ``d_j`` is
+    0), the same bits: ``jnp.linalg.norm`` of a node's two coordinate differences adds their two
+    squares (in either order the same float), and so does this, without the norm's reduction
+    (a slow kernel over an axis of two)."""
+    apart = graph.xy - graph.xy[goal]
+    to_goal = jnp.sqrt(apart[:, 0] * apart[:, 0] + apart[:, 1] * apart[:, 1])
+    return jnp.log(jnp.where(to_goal > 0, to_goal, 1.0))
+
+
+def _slot_columns(graph: Graph, values: jax.Array) -> jax.Array:
+    """[N, K]: ``values[nbr[i, k]]`` of ``values`` ([N], any dtype) on a grid or path map, each
+    slot's column a shifted slice of the padded values (some value of the array where slot k has
+    no neighbour: mask it by the valid edges), as
+    :func:`~jaxswarm.swarm.walking.neighbour_slots` builds them slot-major."""
+    offsets = [int(offset) for offset in slot_offsets(graph)]
+    margin = max(abs(offset) for offset in offsets)
+    padded = jnp.pad(values, (margin, margin), mode="edge")
+    n = graph.num_nodes
+    return jnp.stack([padded[margin + offset:margin + offset + n] for offset in offsets],
+                     axis=1)
 
 
 def _arrived_drop(after, drop, row, run, graph: Graph):
@@ -243,6 +329,36 @@ def soil_after_best(graph: Graph, drops: Walk, path_of: Callable, costs,
                      drops.memory)
 
 
+def _soil_after_walked_best(graph: Graph, drops: Walk, costs, params: IWDParams) -> jax.Array:
+    """:func:`soil_after_best` of the drops' walked paths (``costs`` f32[A], inf for a drop that
+    did not arrive), the same bits. On grids and path maps the best drop's moves are read from
+    the walk's log at the width that holds them (:func:`~jaxswarm.swarm.walking.fold_agents`
+    over that one drop), their slots the log's, not a path written out at the step budget and
+    its slots searched again (a lattice neighbour has one slot)."""
+    if not graph.is_grid:
+        return soil_after_best(graph, drops, drops.agent_path, costs, params)
+    winner = jnp.argmin(costs)
+    best = (jnp.arange(costs.shape[0]) == winner) & jnp.isfinite(costs[winner])
+    return fold_agents(_global_move_update, drops.log, drops.memory,
+                       (drops.state[winner, CARRIED], params), graph, used=best)
+
+
+def _global_move_update(soil, drop, row, run, graph: Graph):
+    """:func:`~.soil.global_update` of the walk of drop ``drop`` (i32[], ``row`` its ``(path
+    i32[W + 1], slots [W])``, ``W`` any width that holds its moves), which carried ``run``'s
+    soil (``(carried f32[], params)``): ``soil`` (f32[N, K]) after it; ``soil`` as it was for a
+    ``drop`` past the last (a row of no moves)."""
+    path, slots = row
+    carried, params = run
+    on_path = slots >= 0
+    rows = jnp.where(on_path, path[:-1], graph.num_nodes)
+    columns = jnp.maximum(slots, 0).astype(jnp.int32)
+    share = carried / jnp.maximum(jnp.sum(path >= 0) - 1, 1)
+    updated = (1.0 + params.rho_iwd) * soil[jnp.minimum(rows, graph.num_nodes - 1), columns] \
+        - params.rho_iwd * share
+    return soil.at[rows, columns].set(updated, mode="drop")
+
+
 def soil_per_node(state) -> jax.Array:
     """f32[N] the mean soil on each node's edge slots (the figures' view of the memory)."""
     return ordered_sum(state.soil) / state.soil.shape[-1]
@@ -268,7 +384,7 @@ def build_iwd(config: IWDConfig) -> Swarm:
                           walker=config.walker)
         best_path, best_cost, info = keep_best(drops, state.best_path, state.best_cost)
         costs = jnp.where(drops.arrived, drops.length, jnp.inf)
-        soil = soil_after_best(graph, drops, drops.agent_path, costs, params)
+        soil = _soil_after_walked_best(graph, drops, costs, params)
         return IWDState(key=key, soil=soil, best_path=best_path, best_cost=best_cost), info
 
     return Swarm(name="iwd", config=config, init=jax.jit(init), step=jax.jit(step),

@@ -267,11 +267,10 @@ class _Stage(NamedTuple):
 def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDParams):
     """The memory operators that are switched on, the intersection operators first, then the
     section local search: ``(memory, evaluations i32[], overflowed bool[])`` (a local search's
-    walk had no room in its log), the memory sorted again without duplicates. When both ask for
-    local searches, a loop of two turns runs them through one batch of searches (one compiled
-    program of the small runs; a turn's batch is padded with runs from node 0 to itself, which
-    walk no drop and are dropped). A run's result does not depend on the others of its batch:
-    its drops read its own soil, which changes after their walk (``local_updates="arrived"``)."""
+    walk had no room in its log), the memory sorted again without duplicates. Each stage's
+    local searches run as one batch of the searches it asks for (a batch of small runs of its
+    own size: a run's result does not depend on the others of its batch, whose drops read their
+    own soil, which changes after their walk, ``local_updates="arrived"``)."""
     config = setup.config
     intersection_key, section_key = jax.random.split(key)
     stages = []
@@ -279,18 +278,14 @@ def _operators(setup: _Setup, key, graph: Graph, memory: Memory, params: IWDPara
         stages.append(_intersection_stage(setup, intersection_key, graph, memory))
     if config.local_search:
         stages.append(_section_stage(setup, section_key, graph))
-    search = functools.partial(_search, setup, graph, params)
-    if sum(stage.searches > 0 for stage in stages) < 2:
-        evaluations, overflowed = jnp.int32(0), jnp.array(False)
-        for stage in stages:
-            searches, plan = stage.ask(memory) if stage.searches else (None, None)
-            found = search(*searches) if searches else None
-            memory, count = stage.apply(memory, plan, found)
-            evaluations += count
-            if found is not None:
-                overflowed |= jnp.any(found.overflowed)
-    else:
-        memory, evaluations, overflowed = _stage_loop(stages, search, memory)
+    evaluations, overflowed = jnp.int32(0), jnp.array(False)
+    for stage in stages:
+        searches, plan = stage.ask(memory) if stage.searches else (None, None)
+        found = _search(setup, graph, params, *searches) if searches else None
+        memory, count = stage.apply(memory, plan, found)
+        evaluations += count
+        if found is not None:
+            overflowed |= jnp.any(found.overflowed)
     return (remember(empty_memory(*memory.paths.shape), memory.paths, memory.costs),
             evaluations, overflowed)
 
@@ -299,42 +294,6 @@ def _search(setup: _Setup, graph: Graph, params: IWDParams, keys, heres, theres)
     """The local searches (one batch) from ``heres`` to ``theres`` (i32[B]) with ``keys``."""
     return _Found(*connect_all(keys, graph, heres, theres, params, swarm=setup.local,
                                iterations=setup.config.local_iterations))
-
-
-def _stage_loop(stages, search, memory: Memory):
-    """The ``stages`` applied in turn, each turn's local searches through one batch of the most
-    searches a stage asks for: ``(memory, evaluations i32[], overflowed bool[])``. A turn
-    carries every stage's plan from its ask to its apply (zeros for the other stages')."""
-    size = max(stage.searches for stage in stages)
-    plans = [jax.tree_util.tree_map(lambda s: jnp.zeros(s.shape, s.dtype), jax.eval_shape(
-        lambda memory, stage=stage: stage.ask(memory)[1], memory)) for stage in stages]
-
-    def asking(index, stage):
-        def ask(memory):
-            (keys, heres, theres), plan = stage.ask(memory)
-            fill = size - stage.searches
-            return ((keys[jnp.minimum(jnp.arange(size), stage.searches - 1)],
-                     jnp.pad(heres, (0, fill)), jnp.pad(theres, (0, fill))),
-                    plans[:index] + [plan] + plans[index + 1:])
-        return ask
-
-    def applying(index, stage):
-        def apply(memory, turn_plans, found):
-            return stage.apply(memory, turn_plans[index], jax.tree_util.tree_map(
-                lambda x: x[:stage.searches], found))
-        return apply
-
-    def turn(index, carry):
-        memory, evaluations, overflowed = carry
-        searches, turn_plans = jax.lax.switch(
-            index, [asking(i, stage) for i, stage in enumerate(stages)], memory)
-        found = search(*searches)
-        memory, count = jax.lax.switch(
-            index, [applying(i, stage) for i, stage in enumerate(stages)], memory, turn_plans,
-            found)
-        return memory, evaluations + count, overflowed | jnp.any(found.overflowed)
-
-    return jax.lax.fori_loop(0, len(stages), turn, (memory, jnp.int32(0), jnp.array(False)))
 
 
 class _Crossing(NamedTuple):
@@ -363,10 +322,12 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
     shorter. Their local searches (around the first operator's joints, and the second's
     connections) run as one batch; a search whose result no pair uses (around the joints of a
     pair that does not cross, or connecting a pair that does) runs from its first node to
-    itself, where no drop walks."""
+    itself, where no drop walks. With both operators a pair needs the first's two searches or
+    the second's one, never all three: the batch holds two per pair (:func:`_packed`)."""
     config = setup.config
     num_pairs = config.memory_size - 1
     improve_first = config.first_intersection and config.local_search
+    both = improve_first and config.second_intersection
     searches = (2 * num_pairs if improve_first else 0) + (
         num_pairs if config.second_intersection else 0)
     plan = _crossing_plan(setup, graph, memory)
@@ -384,10 +345,16 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
             heres.append(here)
             theres.append(jnp.where(plan.pairs.present & ~plan.crossing, plan.pairs.others[
                 jnp.arange(num_pairs), plan.closest[1]], here))
-        return (jax.random.split(key, searches), jnp.concatenate(heres),
-                jnp.concatenate(theres)), None
+        asked = (jax.random.split(key, searches), jnp.concatenate(heres),
+                 jnp.concatenate(theres))
+        if both:
+            packed, _ = _packed(plan.crossing)
+            asked = tuple(x[packed] for x in asked)
+        return asked, None
 
     def apply(memory, _, found):
+        if both:
+            found = jax.tree_util.tree_map(lambda x: x[_packed(plan.crossing)[1]], found)
         offspring = plan.offspring
         if improve_first:
             offspring = _improved_at_joints(
@@ -399,7 +366,26 @@ def _intersection_stage(setup: _Setup, key, graph: Graph, memory: Memory) -> _St
                                               found.calls[-num_pairs:])
         return _replace_parents(memory, offspring.paths, offspring.costs), offspring.evaluations
 
-    return _Stage(searches=searches, ask=ask, apply=apply)
+    return _Stage(searches=2 * num_pairs if both else searches, ask=ask, apply=apply)
+
+
+def _packed(crossing: jax.Array):
+    """The intersection stage's 3P searches (the first operator's two per pair, rows 2q and
+    2q + 1, then the second's, row 2P + q) in a batch of 2P, for ``crossing`` (bool[P]): slot
+    2q runs search 2q where pair q crosses, else search 2P + q; slot 2q + 1 runs search 2q + 1.
+    Every search whose result a pair uses has a slot (the others run from a node to itself).
+
+    Returns:
+      ``(packed, unpacked)``: i32[2P] the search each slot runs, and i32[3P] the slot each
+      search's result is read from (a search without a slot reads one whose result the pair
+      does not use).
+    """
+    num_pairs = crossing.shape[0]
+    pairs = jnp.arange(num_pairs)
+    packed = jnp.stack([jnp.where(crossing, 2 * pairs, 2 * num_pairs + pairs),
+                        2 * pairs + 1], axis=1).reshape(-1)
+    unpacked = jnp.concatenate([jnp.arange(2 * num_pairs), 2 * pairs])
+    return packed, unpacked
 
 
 def _crossing_plan(setup: _Setup, graph: Graph, memory: Memory) -> _Crossing:
