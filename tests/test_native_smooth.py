@@ -19,7 +19,6 @@ from jaxswarm.runtime import native
 from jaxswarm.swarm import make, run
 from jaxswarm.swarm.iwd.native_smooth import smooth_rows
 from jaxswarm.swarm.iwd.smooth import IMPROVEMENT, smooth_paths
-from jaxswarm.swarm.registry import REGISTRY
 from jaxswarm.swarm.walking import WalkerOptions
 from jaxswarm.swarm.walking import native as native_walk
 
@@ -110,15 +109,13 @@ def calls_the_kernel(swarm) -> bool:
     return native.SMOOTH_TARGET in str(jax.make_jaxpr(swarm.step)(state, *args))
 
 
-def test_iwd_pg_runs_the_same_with_either_smoothing(monkeypatch):
+def test_iwd_pg_runs_the_same_with_either_smoothing():
     """IWD_PG's shared-size run on the maze, keys 0 and 1, walker and smoothing both on the
-    lanes or both native (the smoothing follows the walker's switch: the environment's, as
-    iwd_pg.py leaves its implementation None), every leaf of state and trace equal."""
+    lanes or both native (the smoothing follows the swarm's walker options), every leaf of
+    state and trace equal."""
     results = {}
     for name in ("lanes", "native"):
-        monkeypatch.setenv(native_walk.VARIABLE, name)
-        config = make("iwd_pg", **sizes.CONFIG, walker=WalkerOptions(implementation=name)).config
-        swarm = REGISTRY["iwd_pg"].build(config)  # traced now, under this environment
+        swarm = make("iwd_pg", **sizes.CONFIG, walker=WalkerOptions(implementation=name))
         assert calls_the_kernel(swarm) == (name == "native")
         graph, task = sizes.maze()
         results[name] = [run(swarm, jax.random.key(key), graph, task, swarm.default_params,

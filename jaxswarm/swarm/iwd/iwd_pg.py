@@ -200,7 +200,8 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
                       num_agents=config.num_agents, max_steps=config.max_steps,
                       local_updates=config.local_updates, backtrack=config.backtrack,
                       walker=config.walker)
-    paths, lengths = _measured_paths(graph, drops, smooth=config.smooth)
+    paths, lengths = _measured_paths(graph, drops, smooth=config.smooth,
+                                     implementation=config.walker.implementation)
     _, _, info = keep_best(drops, state.best_path, state.best_cost, paths=paths,
                            lengths=lengths)
     costs = jnp.where(drops.arrived, lengths, jnp.inf)
@@ -220,12 +221,14 @@ def _step(setup: _Setup, state: IWDPGState, graph: Graph, task: Task, params: IW
                           overflowed=info.overflowed | overflowed))
 
 
-def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool):
+def _measured_paths(graph: Graph, drops: Walk, *, smooth: bool, implementation: str | None):
     """The drops' paths, with ``smooth`` each one that arrived through the global smooth
-    operator, and their lengths: ``(paths i32[A, L], lengths f32[A])`` (a drop that did not
-    arrive keeps its walked length). IWD_PG's few drops' paths are written out whole: smoothing
-    and the memory take every arrived one."""
-    paths = smooth_paths(graph, drops.path, drops.arrived) if smooth else drops.path
+    operator (native or on XLA as ``implementation``, the walker's, says), and their lengths:
+    ``(paths i32[A, L], lengths f32[A])`` (a drop that did not arrive keeps its walked length).
+    IWD_PG's few drops' paths are written out whole: smoothing and the memory take every
+    arrived one."""
+    paths = (smooth_paths(graph, drops.path, drops.arrived, implementation) if smooth
+             else drops.path)
     lengths = jnp.where(drops.arrived, jax.vmap(lambda p: path_length(graph, p))(paths),
                         drops.length)
     return paths, lengths
