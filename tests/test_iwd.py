@@ -14,7 +14,7 @@ from jaxswarm.maps.paper import paper_map
 from jaxswarm.runtime.arithmetic import ordered_sum
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd import STANDARD_IWD, global_update, soil_taken, velocity_after
-from jaxswarm.swarm.iwd.iwd import drop_walk
+from jaxswarm.swarm.iwd.iwd import FEW_DROPS, drop_walk, goal_table
 from jaxswarm.swarm.iwd.soil import (SOIL, arrived_update, choice_log_weights,
                                      goal_log_desirability, walked_soil)
 from jaxswarm.swarm.walking import FORCED, edge_table, walk
@@ -201,6 +201,33 @@ def test_arrived_drops_update_the_soil_after_the_walk_in_agent_order():
     for member in range(2):
         np.testing.assert_array_equal(memory[0, member], expected)
         np.testing.assert_array_equal(memory[1, member], np.asarray(soil))
+
+
+def test_few_drops_update_the_soil_in_one_pass_as_a_loop_over_them_does():
+    # Up to FEW_DROPS drops (IWD_PG's local searches) take one pass over their walks (eq. 4
+    # for all at once, eq. 5 drop by drop): the soil and states of the loop in agent order.
+    blocked = np.zeros((3, 9), bool)
+    blocked[:, 6] = True
+    graph = cut_out(blocked)
+    task = make_task(graph, (0, 1), (5, 1))
+    soil = jax.random.uniform(jax.random.key(3), graph.nbr.shape, minval=900.0, maxval=1100.0)
+    drops = few_drops(jax.random.key(2), graph, task, soil, P)
+    assert drops.arrived.shape[0] <= FEW_DROPS and np.asarray(drops.arrived).sum() >= 2
+    assert_sequential_soil(graph, soil, drops)
+
+
+@jax.jit
+def few_drops(key, graph, task, soil, params):
+    """:func:`drop_walk` of 8 drops (below :data:`FEW_DROPS`)."""
+    return drop_walk(key, graph, task, soil, params, num_agents=8, max_steps=None)
+
+
+def test_the_goal_table_on_grids_is_the_edge_table_of_the_goal_desirability():
+    graph, task = sizes.maze()
+    fast = jax.jit(goal_table)(graph, task.goal, P)
+    composed = jax.jit(lambda graph, goal, params: edge_table(
+        graph, params.beta * goal_log_desirability(graph, goal)))(graph, task.goal, P)
+    assert np.asarray(fast).tobytes() == np.asarray(composed).tobytes()
 
 
 def test_arrived_drops_leave_the_soil_of_stuck_drops_alone():
