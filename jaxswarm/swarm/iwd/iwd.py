@@ -39,10 +39,10 @@ from jaxswarm.world.lattice import slot_offsets
 
 FEW_DROPS = 16
 """Up to this many drops a walk (IWD_PG's local searches' 10), the arrived drops' local updates
-take one pass over every drop's walk (:func:`_arrived_soil`: eq. 4 for all the drops at once,
-then eq. 5 drop by drop, the drops that did not arrive changing nothing); with more, a fold over
-the arrived drops alone (:func:`_arrived_drop`), which costs more a drop but only for the
-drops that arrived (few of IWD's 50 on a maze). The same bits either way."""
+take one pass over every drop's walk (eq. 4 for all the drops at once, then eq. 5 drop by drop,
+the drops that did not arrive changing nothing); with more, a fold over the arrived drops alone,
+which costs more a drop but only for the drops that arrived (few of IWD's 50 on a maze). The
+same bits either way."""
 
 LOCAL_UPDATES = ("arrived", "while_walking")
 """When the drops' local soil updates (eqs. 4-6) apply: see :class:`IWDConfig`."""
@@ -260,7 +260,7 @@ def goal_table(graph: Graph, goal, params: IWDParams) -> jax.Array:
     (:func:`~.soil.goal_log_desirability` through
     :func:`~jaxswarm.swarm.walking.edge_table`: ``-inf`` where the edge is not valid now), the
     same numbers. On grids and path maps each slot's column is a shifted slice of the nodes'
-    values (:func:`_slot_columns`), not a gather, and ``log d_j`` is computed once a node: built
+    values, not a gather, and ``log d_j`` is computed once a node: built
     as a gather of the nodes' values, XLA:CPU computed ``log d_j`` once a slot, or the table in
     slot-major layout and transposed it in every iteration of a run's loop."""
     if not graph.is_grid:
