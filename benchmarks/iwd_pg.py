@@ -50,10 +50,10 @@ import jax
 import numpy as np
 
 from jaxswarm.maps.named import named_map
-from jaxswarm.runtime import native
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.testing import key_data
+from jaxswarm.swarm.walking.native import check_implementations
 from jaxswarm.swarm.walking.options import IMPLEMENTATIONS, WalkerOptions
 
 DEFAULT_MAP, DEFAULT_ITERATIONS = "mosaic50", 100
@@ -202,15 +202,13 @@ def measure(swarm, graph, task, keys, iterations: int, repeats: int):
 
 
 def chosen_implementations(text: str, parser: argparse.ArgumentParser) -> list[str]:
-    """The walker's implementations ``--implementations`` names, checked (and the native
-    kernels built or loaded, so that no compile time below includes that)."""
-    names = text.split(",")
-    for name in names:
-        if name not in IMPLEMENTATIONS:
-            parser.error(f"--implementations: {name!r} is none of {', '.join(IMPLEMENTATIONS)}")
-    if "native" in names and not native.available():
-        parser.error("--implementations: the native kernels cannot be built here")
-    return names
+    """The walker's implementations ``--implementations`` names, checked
+    (:func:`~jaxswarm.swarm.walking.native.check_implementations`: the native kernels built or
+    loaded, so that no compile time below includes that)."""
+    try:
+        return check_implementations(text.split(","))
+    except ValueError as error:
+        parser.error(f"--implementations: {error}")
 
 
 def check_results(args, keys: list[int], defaults: dict) -> None:

@@ -57,11 +57,11 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxswarm.maps.paper import paper_map
-from jaxswarm.runtime import native
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.fingerprint import hex_fingerprint, run_fingerprint
 from jaxswarm.sweep import run_sweep, spec_from_dict
+from jaxswarm.swarm.walking.native import check_implementations
 from jaxswarm.swarm.walking.options import IMPLEMENTATIONS, WalkerOptions
 from jaxswarm.sweep.spec import DEFAULT_CHUNK_SIZE
 
@@ -217,15 +217,13 @@ def print_row(agents: int, implementation: str, r: dict, lanes) -> None:
 
 
 def chosen_implementations(text: str, parser: argparse.ArgumentParser) -> list[str]:
-    """The walker's implementations ``--implementations`` names, checked (and the native
-    kernels built or loaded, so that no compile time below includes that)."""
-    names = text.split(",")
-    for name in names:
-        if name not in IMPLEMENTATIONS:
-            parser.error(f"--implementations: {name!r} is none of {', '.join(IMPLEMENTATIONS)}")
-    if "native" in names and not native.available():
-        parser.error("--implementations: the native kernels cannot be built here")
-    return names
+    """The walker's implementations ``--implementations`` names, checked
+    (:func:`~jaxswarm.swarm.walking.native.check_implementations`: the native kernels built or
+    loaded, so that no compile time below includes that)."""
+    try:
+        return check_implementations(text.split(","))
+    except ValueError as error:
+        parser.error(f"--implementations: {error}")
 
 
 def main(argv: list[str] | None = None) -> int:

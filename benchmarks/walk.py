@@ -89,7 +89,6 @@ import numpy as np
 from jax.sharding import Mesh, PartitionSpec as P
 
 from jaxswarm.maps.named import PAPER, map_kind
-from jaxswarm.runtime import native
 from jaxswarm.runtime.cpu import configure
 from jaxswarm.studies.problems import movingai_folder, named_problem, scenario_problem
 from jaxswarm.swarm import aco, make, rfd, run
@@ -97,6 +96,7 @@ from jaxswarm.swarm.core import Task
 from jaxswarm.swarm.iwd.iwd import drop_walk
 from jaxswarm.swarm.walking import Walk, step_budget, walk
 from jaxswarm.swarm.walking.log import BLOCK, room_blocks
+from jaxswarm.swarm.walking.native import check_implementations
 from jaxswarm.swarm.walking.options import IMPLEMENTATIONS, WalkerOptions
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import slot_offsets
@@ -437,15 +437,13 @@ def timed_in_turn(calls: dict, repeats: int) -> dict:
 
 
 def chosen_implementations(text: str, parser: argparse.ArgumentParser) -> list[str]:
-    """The walker's implementations ``--implementations`` names, checked (and the native
-    kernels built or loaded, so that no compile time below includes that)."""
-    names = text.split(",")
-    for name in names:
-        if name not in IMPLEMENTATIONS:
-            parser.error(f"--implementations: {name!r} is none of {', '.join(IMPLEMENTATIONS)}")
-    if "native" in names and not native.available():
-        parser.error("--implementations: the native kernels cannot be built here")
-    return names
+    """The walker's implementations ``--implementations`` names, checked
+    (:func:`~jaxswarm.swarm.walking.native.check_implementations`: the native kernels built or
+    loaded, so that no compile time below includes that)."""
+    try:
+        return check_implementations(text.split(","))
+    except ValueError as error:
+        parser.error(f"--implementations: {error}")
 
 
 def walk_table(problems: dict, layouts: list, args, implementations: list[str]) -> None:

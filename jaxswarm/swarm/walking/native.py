@@ -73,6 +73,24 @@ def implementation(hook=None, requested: str | None = None) -> str:
     return chosen
 
 
+def check_implementations(names) -> list[str]:
+    """``names`` (walker implementations, e.g. a benchmark's ``--implementations`` split at
+    commas) as a list, each checked: one of
+    :data:`~jaxswarm.swarm.walking.options.IMPLEMENTATIONS`, and ``native`` only where its
+    kernels can be built (this builds and registers them).
+
+    Raises:
+      ValueError: naming the first that is neither, or saying the kernels cannot be built.
+    """
+    names = list(names)
+    for name in names:
+        if name not in IMPLEMENTATIONS:
+            raise ValueError(f"{name!r} is none of {', '.join(IMPLEMENTATIONS)}")
+    if "native" in names and not native.available():
+        raise ValueError("the native kernels cannot be built here")
+    return names
+
+
 def walk_runs(seed, graph: Graph, log_weights, start, goal, memory, hook_params, *,
               num_agents: int, max_steps: int, greedy_agents: int, hook, log_moves: int | None,
               default_budget: int, schedule: tuple[int, int, int, int]) -> dict:
