@@ -19,6 +19,7 @@ from jaxswarm.swarm import make, make_task, run
 from jaxswarm.swarm.iwd.iwd import DEFAULT_IWD, soil_choice
 from jaxswarm.swarm.iwd.soil import SOIL_CHOICE, choice_log_weights, goal_log_desirability
 from jaxswarm.swarm.registry import REGISTRY
+from jaxswarm.swarm.testing import differing_leaves
 from jaxswarm.swarm.walking import WalkerOptions, edge_table
 from jaxswarm.swarm.walking import native as native_walk
 from jaxswarm.swarm.walking import native_backtrack
@@ -54,22 +55,6 @@ def walks(key, graph, soil, params, start, goal, *, implementation, cut):
                 cut=population(fixed, max_steps=cut))
 
 
-def leaves(tree) -> dict:
-    """Each leaf by its path, as an array (a key array as its key data)."""
-    return {jax.tree_util.keystr(path): np.asarray(
-        jax.random.key_data(leaf) if jax.dtypes.issubdtype(leaf.dtype, jax.dtypes.prng_key)
-        else leaf) for path, leaf in jax.tree_util.tree_leaves_with_path(tree)}
-
-
-def assert_same(reference, other, label=""):
-    """Every leaf of two pytrees equal: shape, dtype and bytes."""
-    a, b = leaves(reference), leaves(other)
-    assert a.keys() == b.keys()
-    differ = [k for k in a if a[k].shape != b[k].shape or a[k].dtype != b[k].dtype
-              or a[k].tobytes() != b[k].tobytes()]
-    assert not differ, f"{label}: leaves differ: {differ}"
-
-
 def soil_of(graph, seed=0):
     """f32[N, K] uneven soil, some of it negative (the choice's shift applies)."""
     return np.random.default_rng(seed).uniform(-50.0, 800.0, graph.nbr.shape).astype(np.float32)
@@ -82,7 +67,8 @@ def compare(graph, task, cut):
         args = (jax.random.key(key), graph, soil_of(graph, key), DEFAULT_IWD, task.start,
                 task.goal)
         reference = walks(*args, implementation="lanes", cut=cut)
-        assert_same(reference, walks(*args, implementation="native", cut=cut), f"key {key}")
+        native_walks = walks(*args, implementation="native", cut=cut)
+        assert not differing_leaves(reference, native_walks), f"key {key}"
         out.append(reference)
     return out
 
@@ -130,8 +116,8 @@ def test_a_vmap_over_keys_is_one_call_per_walk_and_equals_the_walks_alone():
     for i, key in enumerate(KEYS):
         alone = walks(jax.random.key(key), graph, soil, DEFAULT_IWD, task.start, task.goal,
                       implementation="native", cut=MAZE_CUT)
-        assert_same(alone, jax.tree_util.tree_map(lambda leaf, i=i: leaf[i], together),
-                    f"key {key}")
+        member = jax.tree_util.tree_map(lambda leaf, i=i: leaf[i], together)
+        assert not differing_leaves(alone, member), f"key {key}"
 
 
 def calls_the_kernel(name, **config) -> bool:
@@ -163,7 +149,7 @@ def test_iwd_with_backtracking_drops_runs_the_same_native():
     lanes = runs_of("iwd", backtrack=True, walker=chosen["lanes"])
     natives = runs_of("iwd", backtrack=True, walker=chosen["native"])
     for key, (reference, other) in enumerate(zip(lanes, natives)):
-        assert_same(reference, other, f"key {key}")
+        assert not differing_leaves(reference, other), f"key {key}"
     assert np.isfinite(np.asarray(lanes[0][0].best_cost))
 
 
@@ -175,7 +161,7 @@ def test_improved_max_min_acos_first_ant_runs_the_same_native():
     lanes = runs_of("improved_max_min_aco", walker=chosen["lanes"])
     natives = runs_of("improved_max_min_aco", walker=chosen["native"])
     for key, (reference, other) in enumerate(zip(lanes, natives)):
-        assert_same(reference, other, f"key {key}")
+        assert not differing_leaves(reference, other), f"key {key}"
 
 
 def test_the_soil_rule_is_iwds_choice():

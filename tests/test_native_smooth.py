@@ -19,6 +19,7 @@ from jaxswarm.runtime import native
 from jaxswarm.swarm import make, run
 from jaxswarm.swarm.iwd.native_smooth import smooth_rows
 from jaxswarm.swarm.iwd.smooth import IMPROVEMENT, smooth_paths
+from jaxswarm.swarm.testing import differing_leaves
 from jaxswarm.swarm.walking import WalkerOptions
 from jaxswarm.swarm.walking import native as native_walk
 
@@ -121,13 +122,7 @@ def test_iwd_pg_runs_the_same_with_either_smoothing():
         results[name] = [run(swarm, jax.random.key(key), graph, task, swarm.default_params,
                              iterations=sizes.ITERATIONS) for key in (0, 1)]
     for key, (reference, other) in enumerate(zip(results["lanes"], results["native"])):
-        a, b = (jax.tree_util.tree_leaves_with_path(jax.tree_util.tree_map(
-            lambda leaf: jax.random.key_data(leaf) if jax.dtypes.issubdtype(
-                leaf.dtype, jax.dtypes.prng_key) else leaf, out)) for out in (reference, other))
-        differ = [jax.tree_util.keystr(path) for (path, x), (_, y) in zip(a, b)
-                  if np.asarray(x).dtype != np.asarray(y).dtype
-                  or np.asarray(x).tobytes() != np.asarray(y).tobytes()]
-        assert not differ, f"key {key}: leaves differ: {differ}"
+        assert not differing_leaves(reference, other), f"key {key}"
         assert np.isfinite(np.asarray(reference[0].best_cost))
 
 

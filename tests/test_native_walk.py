@@ -19,6 +19,7 @@ from jaxswarm.runtime import native
 from jaxswarm.swarm import aco, make, make_task, rfd
 from jaxswarm.swarm.executor import with_room
 from jaxswarm.swarm.iwd.soil import SOIL, SOIL_CHOICE, goal_log_desirability
+from jaxswarm.swarm.testing import differing_leaves
 from jaxswarm.swarm.walking import WalkerOptions, loop, walk
 from jaxswarm.swarm.walking import native as native_walk
 from jaxswarm.swarm.walking.tables import edge_table, step_budget
@@ -49,20 +50,6 @@ def tables(graph, task) -> list:
             memories = (state.altitude, state.altitude + noise * 0.5)
         out += [rule(memory) for memory in memories]
     return out
-
-
-def leaves(tree) -> dict:
-    return {jax.tree_util.keystr(path): np.asarray(leaf)
-            for path, leaf in jax.tree_util.tree_leaves_with_path(tree)}
-
-
-def assert_same(lanes, native_out, label=""):
-    """Every leaf of two Walks equal: shape, dtype and bytes."""
-    a, b = leaves(lanes), leaves(native_out)
-    assert a.keys() == b.keys()
-    differ = [k for k in a if a[k].shape != b[k].shape or a[k].dtype != b[k].dtype
-              or a[k].tobytes() != b[k].tobytes()]
-    assert not differ, f"{label}: leaves differ: {differ}"
 
 
 def walks(implementation, monkeypatch, graph, *, agents, steps, greedy=0, walker=WalkerOptions(),
@@ -112,7 +99,7 @@ def compare(monkeypatch, graph, task, table_list, *, agents=sizes.AGENTS, greedy
         for key in KEYS:
             args = arguments(task, table, key, runs, goals, memory)
             reference = lanes(*args)
-            assert_same(reference, natives(*args), f"table {t}, key {key}")
+            assert not differing_leaves(reference, natives(*args)), f"table {t}, key {key}"
             out.append(reference)
     return out
 

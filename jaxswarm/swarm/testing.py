@@ -96,6 +96,20 @@ def leaves_equal(a, b) -> bool:
                for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
 
 
+def differing_leaves(a, b) -> list[str]:
+    """The paths (:func:`jax.tree_util.keystr`) of the leaves in which two pytrees differ, sorted:
+    a leaf one of them lacks, or another shape, dtype or bytes (PRNG keys compared as their
+    data; stricter than :func:`leaves_equal`: NaN payloads and the sign of zero count)."""
+    def by_path(tree):
+        return {jax.tree_util.keystr(path): np.asarray(leaf)
+                for path, leaf in jax.tree_util.tree_leaves_with_path(key_data(tree))}
+
+    x, y = by_path(a), by_path(b)
+    return sorted(name for name in x.keys() | y.keys()
+                  if name not in x or name not in y or x[name].shape != y[name].shape
+                  or x[name].dtype != y[name].dtype or x[name].tobytes() != y[name].tobytes())
+
+
 def key_data(tree):
     """``tree`` with its PRNG keys turned into their raw data (comparable arrays)."""
     return jax.tree_util.tree_map(
