@@ -669,66 +669,55 @@ ffi::Error HookedWalkImpl(
               state_width);
 }
 
+// The bindings both handlers share, in their order: the walk's inputs, its sizes and the lanes'
+// schedule, its outputs (a Binding's methods take it as an rvalue).
+template <typename Binding>
+auto WalkInputs(Binding binding) {
+  return std::move(binding).template Arg<ffi::Buffer<ffi::U32>>()  // seed
+      .template Arg<ffi::Buffer<ffi::F32>>()                    // log_weights
+      .template Arg<ffi::Buffer<ffi::S32>>()                    // start
+      .template Arg<ffi::Buffer<ffi::S32>>()                    // goal
+      .template Arg<ffi::Buffer<ffi::S32>>();                   // neighbours
+}
+
+template <typename Binding>
+auto WalkAttributes(Binding binding) {
+  return std::move(binding).template Attr<int32_t>("num_agents")
+      .template Attr<int32_t>("max_steps")
+      .template Attr<int32_t>("greedy_agents")
+      .template Attr<int32_t>("blocks")
+      .template Attr<int32_t>("lanes")
+      .template Attr<int32_t>("refill_share")
+      .template Attr<int32_t>("compact_share")
+      .template Attr<int32_t>("smallest_compaction");
+}
+
+template <typename Binding>
+auto WalkOutputs(Binding binding) {
+  return std::move(binding).template Ret<ffi::Buffer<ffi::S32>>()  // nodes
+      .template Ret<ffi::AnyBuffer>()                           // slots
+      .template Ret<ffi::Buffer<ffi::S32>>()                    // offset
+      .template Ret<ffi::Buffer<ffi::S32>>()                    // moves
+      .template Ret<ffi::Buffer<ffi::PRED>>()                   // overflowed
+      .template Ret<ffi::Buffer<ffi::F32>>()                    // length
+      .template Ret<ffi::Buffer<ffi::PRED>>()                   // arrived
+      .template Ret<ffi::Buffer<ffi::PRED>>()                   // stuck
+      .template Ret<ffi::Buffer<ffi::S32>>()                    // position
+      .template Ret<ffi::Buffer<ffi::U32>>()                    // visited
+      .template Ret<ffi::Buffer<ffi::S32>>();                   // lane_steps
+}
+
 }  // namespace
 
 XLA_FFI_DEFINE_HANDLER_SYMBOL(JaxswarmWalk, WalkImpl,
-                              ffi::Ffi::Bind()
-                                  .Arg<ffi::Buffer<ffi::U32>>()  // seed
-                                  .Arg<ffi::Buffer<ffi::F32>>()  // log_weights
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // start
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // goal
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // neighbours
-                                  .Attr<int32_t>("num_agents")
-                                  .Attr<int32_t>("max_steps")
-                                  .Attr<int32_t>("greedy_agents")
-                                  .Attr<int32_t>("blocks")
-                                  .Attr<int32_t>("lanes")
-                                  .Attr<int32_t>("refill_share")
-                                  .Attr<int32_t>("compact_share")
-                                  .Attr<int32_t>("smallest_compaction")
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // nodes
-                                  .Ret<ffi::AnyBuffer>()          // slots
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // offset
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // moves
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // overflowed
-                                  .Ret<ffi::Buffer<ffi::F32>>()   // length
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // arrived
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // stuck
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // position
-                                  .Ret<ffi::Buffer<ffi::U32>>()   // visited
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // lane_steps
-);
+                              WalkOutputs(WalkAttributes(WalkInputs(ffi::Ffi::Bind()))));
 
-XLA_FFI_DEFINE_HANDLER_SYMBOL(JaxswarmHookedWalk, HookedWalkImpl,
-                              ffi::Ffi::Bind()
-                                  .Arg<ffi::Buffer<ffi::U32>>()  // seed
-                                  .Arg<ffi::Buffer<ffi::F32>>()  // log_weights
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // start
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // goal
-                                  .Arg<ffi::Buffer<ffi::S32>>()  // neighbours
-                                  .Arg<ffi::Buffer<ffi::F32>>()  // memory
-                                  .Arg<ffi::Buffer<ffi::F32>>()  // params
-                                  .Arg<ffi::Buffer<ffi::F32>>()  // lengths
-                                  .Attr<int32_t>("rule")
-                                  .Attr<int32_t>("num_agents")
-                                  .Attr<int32_t>("max_steps")
-                                  .Attr<int32_t>("greedy_agents")
-                                  .Attr<int32_t>("blocks")
-                                  .Attr<int32_t>("lanes")
-                                  .Attr<int32_t>("refill_share")
-                                  .Attr<int32_t>("compact_share")
-                                  .Attr<int32_t>("smallest_compaction")
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // nodes
-                                  .Ret<ffi::AnyBuffer>()          // slots
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // offset
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // moves
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // overflowed
-                                  .Ret<ffi::Buffer<ffi::F32>>()   // length
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // arrived
-                                  .Ret<ffi::Buffer<ffi::PRED>>()  // stuck
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // position
-                                  .Ret<ffi::Buffer<ffi::U32>>()   // visited
-                                  .Ret<ffi::Buffer<ffi::S32>>()   // lane_steps
-                                  .Ret<ffi::Buffer<ffi::F32>>()   // memory after the walk
-                                  .Ret<ffi::Buffer<ffi::F32>>()   // state
-);
+XLA_FFI_DEFINE_HANDLER_SYMBOL(
+    JaxswarmHookedWalk, HookedWalkImpl,
+    WalkOutputs(WalkAttributes(WalkInputs(ffi::Ffi::Bind())
+                                   .Arg<ffi::Buffer<ffi::F32>>()  // memory
+                                   .Arg<ffi::Buffer<ffi::F32>>()  // params
+                                   .Arg<ffi::Buffer<ffi::F32>>()  // lengths
+                                   .Attr<int32_t>("rule")))
+        .Ret<ffi::Buffer<ffi::F32>>()   // memory after the walk
+        .Ret<ffi::Buffer<ffi::F32>>());  // state
