@@ -6,8 +6,9 @@ Berlin_1_256, 256 x 256, from ``$JAXSWARM_MOVINGAI/mapf`` or ``../shared/benchda
 start and goal from the mid-length row of its even scenario file, as the studies take them).
 For each swarm (``--swarms``), each memory (``initial``: the swarm's first altitudes or
 pheromone; ``converged``: its memory after ``--converge`` iterations of a run, when most agents
-follow a river) and each total agent count (``--layouts`` DROPSxSEEDS: 1,024 = 256 x 4 and
-16,384 = 256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents
+follow a river, from runs of the largest layout's drops) and each total agent count
+(``--layouts`` DROPSxSEEDS: 16 = 16 x 1, one small swarm's walk, 1,024 = 256 x 4 and 16,384 =
+256 x 64 by default) the walks of every seed run under ``vmap`` (so all their agents
 share one queue over the walker's lanes), jitted, after one warm-up call (compile excluded):
 once on one JAX CPU device, and once with the seeds shared out over ``--devices`` devices (one
 per core by default, each with one XLA thread; ``jax.shard_map``, as the sweep runner shares a
@@ -456,7 +457,8 @@ def walk_table(problems: dict, layouts: list, args, implementations: list[str]) 
         scalar = build_scalar(directory)
         for map_name, (graph, task) in problems.items():
             for swarm_name in args.swarms.split(","):
-                states = memories(swarm_name, graph, task, layouts[0][0], args.converge)
+                drops_most = max(drops for drops, _ in layouts)
+                states = memories(swarm_name, graph, task, drops_most, args.converge)
                 for memory_name, memory in states.items():
                     for drops, seeds in layouts:
                         rows = measure(scalar, swarm_name, graph, task, memory, drops, seeds,
@@ -501,7 +503,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="comma-separated paper maps or Moving AI MAPF map names")
     parser.add_argument("--swarms", default="rfd_graded,aco_star",
                         help=f"comma-separated, from {', '.join(TRANSITION_RULES)}")
-    parser.add_argument("--layouts", default="256x4,256x64", help="comma-separated DROPSxSEEDS")
+    parser.add_argument("--layouts", default="16x1,256x4,256x64", help="comma-separated DROPSxSEEDS")
     parser.add_argument("--converge", type=int, default=30,
                         help="iterations run for the converged memory")
     parser.add_argument("--repeats", type=int, default=5)

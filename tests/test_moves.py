@@ -7,7 +7,8 @@ import pytest
 from jitted import rows_log
 
 from jaxswarm.runtime.arithmetic import ordered_cumsum, ordered_sum
-from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves
+from jaxswarm.swarm.walking.moves import (fold_agents, fold_blocks_backwards, move_widths,
+                                          on_moves)
 
 
 def width_and_sum(moves, run, shared):
@@ -231,3 +232,72 @@ def test_a_batch_of_folds_equals_each_run_alone_at_any_nesting():
     # A batched shared input: each run folds on its own, to the same result.
     for got, want in zip(shared, batch):
         np.testing.assert_array_equal(got, want)
+
+
+def hash_block(carry, block, run, shared):
+    """A hash of the blocks' columns in the order they come (``run`` and ``shared`` weigh the
+    nodes and the slots), left as it was by a block past every path's end, and the steps taken
+    (which a block past the end does count)."""
+    steps, digest = carry
+    nodes, slots = block
+    real = jnp.any(nodes >= 0)
+    column = jnp.arange(1, nodes.shape[1] + 1)
+    value = jnp.sum(jnp.where(nodes >= 0, nodes * column, 0)) * run + jnp.sum(
+        jnp.where(slots >= 0, slots + 1, 0)) * shared
+    return steps + 1, jnp.where(real, digest * 31 + value, digest)
+
+
+def expected_hash(path, slots, block, run=1, shared=1):
+    """:func:`hash_block`'s steps and digest by a loop over one run's blocks, last first."""
+    moves_made = (path >= 0).sum(axis=1) - 1
+    blocks = (moves_made.max() + block) // block
+    padded = -np.ones((path.shape[0], path.shape[1] + block), np.int64)
+    padded[:, :path.shape[1]] = path
+    slot_rows = -np.ones_like(padded)
+    slot_rows[:, :slots.shape[1]] = slots
+    digest, column = 0, np.arange(1, block + 1)
+    for k in reversed(range(blocks)):
+        nodes = padded[:, k * block:(k + 1) * block]
+        taken = slot_rows[:, k * block:(k + 1) * block]
+        value = (np.where(nodes >= 0, nodes * column, 0).sum() * run
+                 + np.where(taken >= 0, taken + 1, 0).sum() * shared)
+        digest = (digest * 31 + value) % 2 ** 32
+    return blocks, np.array([digest], np.uint64).astype(np.uint32).view(np.int32)[0]
+
+
+def fold_back(log, run, shared):
+    """:func:`hash_block` folded backwards over one run's blocks of 8 columns."""
+    return fold_blocks_backwards(hash_block, log, (jnp.int32(0), jnp.int32(0)), run, shared,
+                                 block=8)
+
+
+def test_fold_blocks_backwards_takes_the_walked_blocks_last_first():
+    moves = [3, 37, 0, 12]
+    log, path, slots = random_log(moves, max_steps=64)
+    steps, digest = jax.jit(fold_back)(log, jnp.int32(2), jnp.int32(5))
+    want_steps, want_digest = expected_hash(path, slots, 8, run=2, shared=5)
+    assert int(steps) == want_steps == 5  # columns 0 .. 37 of the longest path
+    assert int(digest) == want_digest
+
+
+def test_a_batch_of_backward_folds_steps_to_its_longest_path_with_each_run_as_alone():
+    moves = [[3, 5, 0, 1], [2, 60, 2, 1], [0, 0, 0, 0]]
+    logs = [random_log(m, max_steps=64, seed=i) for i, m in enumerate(moves)]
+    log = jax.tree_util.tree_map(lambda *x: np.stack(x), *[entry[0] for entry in logs])
+    runs = np.array([1, 2, 3], np.int32)
+
+    @jax.jit
+    def fold_batches(log, runs):
+        flat = jax.vmap(fold_back, in_axes=(0, 0, None))(log, runs, jnp.int32(4))
+        nested = jax.vmap(jax.vmap(fold_back, in_axes=(0, None, None)), in_axes=(0, 0, None))(
+            jax.tree_util.tree_map(lambda x: x[:, None], log), runs, jnp.int32(4))
+        return flat, nested, jax.vmap(fold_back)(log, runs, jnp.full(3, 4, jnp.int32))
+
+    (steps, digest), nested, shared = jax.device_get(fold_batches(log, runs))
+    np.testing.assert_array_equal(steps, [8, 8, 8])  # the batch steps to 60 moves' blocks
+    for r, (_, path, slots) in enumerate(logs):
+        assert int(digest[r]) == expected_hash(path, slots, 8, run=r + 1, shared=4)[1]
+    np.testing.assert_array_equal(nested[1][:, 0], digest)
+    # A batched shared input: each run folds on its own, over its own blocks.
+    np.testing.assert_array_equal(shared[1], digest)
+    np.testing.assert_array_equal(shared[0], [1, 8, 1])

@@ -26,9 +26,8 @@ from jaxswarm.runtime.batching import one_at_a_time
 from jaxswarm.swarm.core import Swarm, WalkingConfig, Task, check_positive, default_params
 from jaxswarm.swarm.rfd.alleys import blind_alleys
 from jaxswarm.swarm.rfd.river import RFDState, check_greedy_drops, gradients, river_swarm
-from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, goal_log_distance,
-                                    neighbour_slots, visited_nodes)
-from jaxswarm.swarm.walking.log import columns as path_columns
+from jaxswarm.swarm.walking import (FORCED, Walk, edge_table, fold_blocks_backwards,
+                                    goal_log_distance, neighbour_slots, visited_nodes)
 from jaxswarm.world.graph import Graph
 from jaxswarm.world.lattice import move_lengths
 from jaxswarm.world.relax import lowest_neighbour, relax
@@ -153,45 +152,44 @@ def erode_banks(graph: Graph, altitude, visited, params: GradedParams):
                      jnp.minimum(altitude, lowest_neighbour(graph, bed, run)), altitude)
 
 
-@one_at_a_time
 def carve(graph: Graph, altitude, drops: Walk, params: GradedParams):
     """f32[N] altitudes after every drop lowered each node of its path to ``erosion`` times the
     shortest way its walk offers from there to water: the goal, or a later node of the path
     carved before this iteration (below ``initial_height``) plus its depth.
 
-    Works backwards over the walked part of the paths, ``CARVE_COLUMNS`` columns at a time,
-    carrying per drop the length walked after the block and the best way to water found there.
-    Under ``vmap`` the runs carve one at a time, each over its own walked blocks.
+    Works backwards over the walked part of the paths, ``CARVE_COLUMNS`` columns at a time
+    (:func:`~jaxswarm.swarm.walking.fold_blocks_backwards`: under ``vmap`` every run of the
+    batch in each step), carrying per drop the length walked after the block and the best way
+    to water found there.
     """
-    n = altitude.shape[0]
-    num_agents, width = drops.moves.shape[0], drops.log.max_steps + 1
-    blocks = -(-width // CARVE_COLUMNS)
-    walked_blocks = (jnp.max(drops.moves) + CARVE_COLUMNS) // CARVE_COLUMNS  # holding nodes
+    num_agents = drops.moves.shape[0]
+    after = jnp.zeros((num_agents,), jnp.float32)
+    best = jnp.full((num_agents,), jnp.inf, jnp.float32)
+    return fold_blocks_backwards(_carve_block, drops.log, (after, best, altitude),
+                                 (altitude, params), graph, block=CARVE_COLUMNS)[2]
 
-    def one_block(carry):
-        block, after, best, carved = carry
-        # The block's columns of the paths, -1 past each one's end (the last node has no move,
-        # so its slot reads -1).
-        nodes, slot = path_columns(drops.log, block * CARVE_COLUMNS + jnp.arange(CARVE_COLUMNS))
-        on_path = nodes >= 0
-        node = jnp.where(on_path, nodes, 0)
-        edge = move_lengths(graph, node, slot)
-        # to_end[a, k]: length drop a walks from this node to where it stopped.
-        to_end = after[:, None] + ordered_cumsum(edge, axis=1, reverse=True)
-        depth = altitude[node]
-        water = jnp.where(on_path & (depth < params.initial_height),
-                          depth / params.erosion - to_end, jnp.inf)
-        reach = jnp.minimum(jax.lax.cummin(water, axis=1, reverse=True), best[:, None])
-        carves = on_path & jnp.isfinite(reach)
-        carved = carved.at[jnp.where(carves, node, n)].min(params.erosion * (reach + to_end),
-                                                           mode="drop")
-        return block - 1, to_end[:, 0], reach[:, 0], carved
 
-    _, _, _, carved = jax.lax.while_loop(
-        lambda carry: carry[0] >= 0, one_block,
-        (jnp.minimum(walked_blocks, blocks) - 1, jnp.zeros((num_agents,), jnp.float32),
-         jnp.full((num_agents,), jnp.inf, jnp.float32), altitude))
-    return carved
+def _carve_block(carry, block, per_run, graph: Graph):
+    """:func:`carve`'s step over one block of path columns (``block``: their nodes i32[A, B],
+    -1 past each path's end, and slots, -1 where no move was made), from ``carry``: per drop the
+    length walked after the block f32[A] and the best way to water found there f32[A], and the
+    altitudes carved so far f32[N]."""
+    after, best, carved = carry
+    altitude, params = per_run
+    nodes, slot = block
+    on_path = nodes >= 0
+    node = jnp.where(on_path, nodes, 0)
+    edge = move_lengths(graph, node, slot)
+    # to_end[a, k]: length drop a walks from this node to where it stopped.
+    to_end = after[:, None] + ordered_cumsum(edge, axis=1, reverse=True)
+    depth = altitude[node]
+    water = jnp.where(on_path & (depth < params.initial_height),
+                      depth / params.erosion - to_end, jnp.inf)
+    reach = jnp.minimum(jax.lax.cummin(water, axis=1, reverse=True), best[:, None])
+    carves = on_path & jnp.isfinite(reach)
+    carved = carved.at[jnp.where(carves, node, carved.shape[0])].min(
+        params.erosion * (reach + to_end), mode="drop")
+    return to_end[:, 0], reach[:, 0], carved
 
 
 def regrade(state: RFDState, before: Graph, after: Graph, old: Task, new: Task,

@@ -11,7 +11,8 @@ from jaxswarm.swarm.walking.loop import (AGENTS_PER_LANE, COMPACT_SHARE, FEWEST_
                                          lanes_for, visited_nodes, walk)
 from jaxswarm.swarm.walking.log import MoveLog
 from jaxswarm.swarm.walking.options import EVERY_MOVE, WalkerOptions
-from jaxswarm.swarm.walking.moves import fold_agents, move_widths, on_moves, on_walk
+from jaxswarm.swarm.walking.moves import (fold_agents, fold_blocks_backwards, move_widths,
+                                          on_moves, on_walk)
 from jaxswarm.swarm.walking.sampler import FORCED, sample_masked
 from jaxswarm.swarm.walking.streams import uniforms
 from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
@@ -20,5 +21,6 @@ from jaxswarm.swarm.walking.tables import (edge_table, goal_log_distance, heads,
 __all__ = ["AGENTS_PER_LANE", "COMPACT_SHARE", "EVERY_MOVE", "EdgeGroups", "FEWEST_LANES",
            "FORCED", "LANES", "Move", "MoveLog", "SMALLEST_COMPACTION", "STEPS_PER_REFILL",
            "StepHook", "Walk", "WalkerOptions", "edge_groups", "edge_table", "fold_agents",
-           "goal_log_distance", "heads", "lanes_for", "move_widths", "neighbour_slots", "on_moves",
-           "on_walk", "sample_masked", "step_budget", "uniforms", "visited_nodes", "walk"]
+           "fold_blocks_backwards", "goal_log_distance", "heads", "lanes_for", "move_widths",
+           "neighbour_slots", "on_moves", "on_walk", "sample_masked", "step_budget", "uniforms",
+           "visited_nodes", "walk"]

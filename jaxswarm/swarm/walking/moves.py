@@ -19,7 +19,9 @@ without arriving do not make every agent's row that long.
 
 A rule that takes the agents one after another (IWD's drops that arrived change the soil in agent
 order) folds over the used agents only (:func:`fold_agents`): each agent's row is read from the log
-when its turn comes, so a walk in which few agents matter costs little after it.
+when its turn comes, so a walk in which few agents matter costs little after it. A rule that works
+backwards along the paths a few columns at a time (rfd_graded's carving) folds over the blocks of
+columns the batch's paths reach (:func:`fold_blocks_backwards`), every run of a batch in each step.
 """
 from __future__ import annotations
 
@@ -31,7 +33,7 @@ import jax.numpy as jnp
 from jax.custom_batching import custom_vmap
 
 from jaxswarm.runtime.batching import fold_runs, unfold_runs
-from jaxswarm.swarm.walking.log import MoveLog, agent_rows, paths
+from jaxswarm.swarm.walking.log import MoveLog, agent_rows, columns, paths
 
 NARROWEST = 128
 """The narrowest width :func:`~jaxswarm.swarm.walking.moves.move_widths` offers."""
@@ -218,3 +220,49 @@ def _fold_runs(step: Callable, widths: tuple[int, ...], log: MoveLog, used, carr
 
     return jax.lax.switch(_width_index(widths, jnp.where(used, log.moves, 0)),
                           [within(width) for width in widths], carry)
+
+
+def fold_blocks_backwards(step: Callable, log: MoveLog, carry: Any, per_run: Any = None,
+                          shared: Any = None, *, block: int):
+    """``carry`` after ``step`` of every block of ``block`` path columns that holds a node of a
+    path, from the last such block to the first (columns ``k * block .. (k + 1) * block - 1``
+    for ``k`` down to 0): the work grows with the batch's longest path, not with the budget.
+
+    A batch (a ``vmap`` of walks, nested or not) steps its runs together, in one loop from the
+    last block any agent of the batch reached: a run whose paths end earlier first sees blocks
+    past them (every node -1), on which ``step`` must return its carry as it was. One loop for
+    the batch costs a step of every run for each block of the longest path; a small swarm's
+    steps are cheap beside the loop's own cost per step, which the batch then pays once.
+
+    Args:
+      step: ``(carry, (nodes i32[A, block], slots [A, block]), per_run, shared) -> carry``, the
+        block's columns of every agent's path and slots (:func:`~.log.columns`: -1 past a
+        path's end; a path's last node has no move, so its slot reads -1).
+      log: the walk's log.
+      carry: a pytree, this run's state before the last block (batched like the walk).
+      per_run: a pytree of this run's other inputs (batched like the walk).
+      shared: a pytree of inputs every run of a batch shares (the map); when a ``vmap``
+        batches one of its leaves, each run of that ``vmap`` is folded on its own.
+      block: columns per step (static).
+
+    Returns:
+      ``carry`` after the first block.
+    """
+    apply = _runs_folded(functools.partial(_fold_blocks, step, block))
+    return _one_run(apply, (log, carry, per_run), shared)
+
+
+def _fold_blocks(step: Callable, block: int, log: MoveLog, carry, per_run, shared):
+    """:func:`fold_blocks_backwards` of R runs (a leading axis R on ``log``, ``carry`` and
+    ``per_run``)."""
+    blocks = -(-(log.max_steps + 1) // block)
+    # A path of m moves holds columns 0 .. m: the blocks up to column max(moves).
+    reached = jnp.minimum((jnp.max(log.moves) + block) // block, blocks)
+    on_run = jax.vmap(step, in_axes=(0, 0, 0, None))
+    read = jax.vmap(columns, in_axes=(0, None))
+
+    def one_block(k, carry):
+        first = (reached - 1 - k) * block
+        return on_run(carry, read(log, first + jnp.arange(block)), per_run, shared)
+
+    return jax.lax.fori_loop(0, reached, one_block, carry)
