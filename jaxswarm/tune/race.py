@@ -146,25 +146,27 @@ def iterated_race(evaluator: Evaluator, space: Space, baseline: dict,
 def _race_size(spec, state: _Race, budget: int, elites: int, j: int,
                survivors: int) -> int | None:
     """irace's ``N_j``, the settings iteration ``j`` races with ``budget`` runs and ``elites``
-    elites, or None where irace stops: no more settings than the race keeps (or than the
-    elites), or a budget that cannot pay for the new settings' first ``first_test`` instances.
-    An elitist race that cannot pay for its new instances gives them up, for good."""
+    elites (whose known results an elitist race counts as paid), or None where irace stops: no
+    more settings than the race keeps (or than the elites), or a budget that cannot pay for the
+    new settings' first ``first_test`` instances. An elitist race that cannot pay for its new
+    instances gives them up, for good."""
     mu = spec.first_test
-    old = state.seen if elites else 0
+    known = elites if spec.elitist else 0
+    old = state.seen if known else 0
 
     def count(iteration, mu, new):
         n = max(mu + min(5, iteration), old + new)
-        return min((budget + elites * old) // n, MOST_SETTINGS)
+        return min((budget + known * old) // n, MOST_SETTINGS)
 
-    size = count(j, mu, state.new_instances if elites else 0)
-    if elites and size <= survivors and state.new_instances:
+    size = count(j, mu, state.new_instances if known else 0)
+    if known and size <= survivors and state.new_instances:
         state.new_instances = 0
         size = count(j, mu, 0)
-    if elites and size <= survivors:
+    if known and size <= survivors:
         size = count(1, 1, 0)
     if size <= survivors or (elites and size <= elites):
         return None
-    if (size - elites) * mu + elites * min(state.new_instances, mu) > budget:
+    if (size - known) * mu + known * min(state.new_instances, mu) > budget:
         return None
     return size
 
