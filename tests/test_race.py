@@ -31,8 +31,9 @@ class Planted:
         self.ran.update((s.number, i) for s in settings for i in instances)
         noise = np.array([np.random.default_rng(1000 + 7 * m + s).normal(0, 0.05)
                           for m, s in instances])
-        return np.array([[(s.values["alpha"] - 1.3) ** 2 + 0.05 * (s.values.get("erosion", 2.0) != 2.0)
-                          + n for n in noise] for s in settings])
+        return np.array([[(s.values["alpha"] - 1.3) ** 2 + n
+                          + 0.05 * (s.values.get("erosion", 2.0) != 2.0) for n in noise]
+                         for s in settings])
 
 
 def planted_race(budget=600, seeds=40, race=None, params=None, seed=0):

@@ -1,5 +1,6 @@
-"""Iterated racing as irace runs it (López-Ibáñez et al., Operations Research Perspectives 3, 2016;
-the rules of irace's code where the paper leaves them open, ``docs/tuning.md`` lists them).
+"""Iterated racing as irace runs it (López-Ibáñez et al., Operations Research Perspectives 3,
+2016; the rules of irace's code where the paper leaves them open; ``docs/tuning.md`` lists them
+and where this differs).
 
 :func:`iterated_race` makes at least ``N_iter = floor(2 + log2 d)`` iterations for ``d`` free
 params, and more while the budget pays for a race (each extra one takes all that is left). An
@@ -13,9 +14,9 @@ default) starts with ``new_instances`` instances no race has seen, then the inst
 instance) is never run again) and cannot be dropped until the race has passed every instance they
 were run on. New settings: an elite picked by rank, each number drawn from a truncated normal
 around the elite's value with the elite's own deviation (shrunk by ``(1 / N_new)^(1 / d)`` an
-iteration along its lineage), each choice from the elite's probabilities (moved towards its value by
-``(j - 1) / N_iter``, capped at ``0.2^(1 / d)``); when two settings of a race are nearly the same,
-the models of their elites soft-restart and the new settings are drawn again.
+iteration along its lineage), each choice from the elite's probabilities (moved towards its value
+by ``(j - 1) / N_iter``, capped at ``0.2^(1 / d)``); when two settings of a race are nearly the
+same, the models of their elites soft-restart and the new settings are drawn again.
 """
 from __future__ import annotations
 
@@ -32,6 +33,10 @@ from jaxswarm.tune.stats import race_step, ranks
 
 MOST_SETTINGS = 1024
 """irace's ``maxConfigurations``: the most settings one race takes."""
+
+RESTART_THRESHOLD = 1e-4
+"""irace's ``softRestartThreshold``: two numbers of a race's settings are nearly the same (a soft
+restart's trigger) when they differ by at most this share of their range."""
 
 PROBABILITY_CAP = 0.2
 """A choice's probability is capped at ``PROBABILITY_CAP ** (1 / d)`` after each update (irace's
@@ -358,16 +363,12 @@ def _draw(space: Space, rng: np.random.Generator, model: Model, parent: Setting)
 def _similar(space: Space, settings: list[dict], elite_of: list[int]) -> set[int]:
     """The elites behind every pair of ``settings`` (free values; ``elite_of``: each one's elite,
     itself or its parent) that are nearly the same: every choice equal, every number within
-    ``restart_threshold`` of its range (irace's ``softRestartThreshold``, 1e-4)."""
+    ``RESTART_THRESHOLD`` of its range."""
     behind = set()
     for a, b in itertools.combinations(range(len(settings)), 2):
         if all(_close(space.domains[n], settings[a][n], settings[b][n]) for n in space.free):
             behind |= {elite_of[a], elite_of[b]}
     return behind
-
-
-RESTART_THRESHOLD = 1e-4
-"""Two numbers are nearly the same when they differ by at most this share of their range."""
 
 
 def _close(domain, a, b) -> bool:

@@ -183,7 +183,6 @@ def from_unit(domain: Real | Integer, unit: float) -> float:
     return int(round(value)) if isinstance(domain, Integer) else value
 
 
-
 def cell_unit(domain: Real | Integer, value: float) -> float:
     """``value`` of a numeric domain as a point of ``[0, 1]`` on the scale draws use: a real's
     :func:`to_unit`; an integer ``v`` as the middle of its cell ``[v, v + 1)`` of the interval

@@ -198,13 +198,13 @@ def race_iterations(free: int) -> int:
 def smallest_budget(spec: TuneSpec) -> int:
     """The least budget with which ``spec``'s method searches at all.
 
-    race: irace's ``computeMinimumBudget``, ``(N_min + 1) N_iter T`` for ``N_min = N_iter =
-    floor(2 + log2 d)``, enough for every iteration to race one setting more than it keeps: ``T
-    = first_test + 1 + (N_iter - 1) max(1, new_instances)`` instances (elitist; the first
-    ``first_test + 1`` and one new or one more a later iteration; ``first_test + 5`` without
-    elitism; over 5 iterations irace counts the new instances of the later ones once); es: one
-    step, ``2 es_pairs first_test`` runs; random: the baseline and one drawn setting; grid:
-    every setting of its grid once (at ``grid_points``, else at 2 points per param).
+    race: irace's least (``computeMinimumBudget``), ``(N_min + 1) N_iter T`` with ``N_min =
+    N_iter = floor(2 + log2 d)``: every iteration races one setting more than it keeps over
+    ``T`` instances, ``first_test + 1`` and ``max(1, new_instances)`` more for each later
+    iteration (past the fifth irace adds ``new_instances`` alone), or ``first_test + 5``
+    without elitism; es: one step, ``2 es_pairs first_test`` runs; random: the baseline and one
+    drawn setting; grid: every setting of its grid once (at ``grid_points``, else at 2 points
+    per param).
     """
     if spec.method == "race":
         iterations = race_iterations(len(spec.space.free))
