@@ -36,6 +36,7 @@ Run from the repository root::
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import shutil
 import statistics
@@ -53,7 +54,7 @@ from jaxswarm.runtime.cpu import backends_started, configure
 from jaxswarm.studies import provenance
 from jaxswarm.sweep.batches import SUCCESS_GAP
 from jaxswarm.tune import tune, tune_spec_from_dict
-from jaxswarm.tune.spec import METHODS
+from jaxswarm.tune.spec import METHODS, smallest_budget
 from jaxswarm.tune.tuner import default_values
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,7 +164,9 @@ def _compare(document: dict, path: str, args) -> list[dict]:
     The grid runs first, with ``args.grid_budget`` times the spec's budget; the other methods
     then get the runs the grid spent (the least over its seeds) divided by that factor, so the
     race is judged against a grid that spent ``args.grid_budget`` times as many runs even
-    where the grid's settings and instances do not fill its budget."""
+    where the grid's settings and instances do not fill its budget. A budget below the method's
+    least (:func:`~jaxswarm.tune.spec.smallest_budget`: irace's for the race) is raised to it;
+    the race then spends more than that share, and its ``near_grid`` verdict says so."""
     methods = args.methods.split(",")
     budget = document["tune"]["budget"]
     rows = []
@@ -179,7 +182,9 @@ def _compare(document: dict, path: str, args) -> list[dict]:
             changed = dict(document, tune=dict(
                 document["tune"], method=method, seed=seed, budget=method_budget,
                 name=f"{document['tune'].get('name', 'tune')}_{method}_{seed}"))
-            spec = tune_spec_from_dict(changed, source=path)
+            spec = tune_spec_from_dict(dict(changed, tune=dict(changed["tune"], budget=budget)),
+                                       source=path)
+            spec = dataclasses.replace(spec, budget=max(method_budget, smallest_budget(spec)))
             result = tune(spec, args.stores / spec.name)
             table = result.held_out.set_index("label")
             rows.append(dict(spec=path, algorithm=spec.algorithm, method=method, seed=seed,

@@ -39,7 +39,7 @@ def sweep_document(**changes):
 
 def tune_document(**changes):
     """A small race: RFD*'s alpha and p_base on 12 training instances, 2 held out."""
-    tune = {"name": "small", "algorithm": "rfd_star", "method": "race", "budget": 60,
+    tune = {"name": "small", "algorithm": "rfd_star", "method": "race", "budget": 72,
             "objective": "gap", "iterations": sizes.ITERATIONS, "seed": 3, "chunk_size": 20,
             "training": {"maps": ["maze20", "mosaic20"], "seeds": 6},
             "held_out": {"maps": ["alley20"], "seeds": [100, 101]},
@@ -191,7 +191,7 @@ def test_a_combination_is_the_grid_s_without_building_the_grid():
         "alpha": {"low": 1.0, "high": 100.0}, "p_base": {"low": 1.5, "high": 1000.0},
         "erosion": {"low": 0.5, "high": 50.0}}),
      "t.toml: tune.grid_points: a grid of 1,000 points per param has 1,000,000,000 settings, "
-     "more than the budget of 60 runs; the smallest budget for it is 1,000,000,000"),
+     "more than the budget of 72 runs; the smallest budget for it is 1,000,000,000"),
     (dict(tune={"budget": 2_000_000}),
      "t.toml: tune.budget: 2,000,000 training runs and up to 8 held-out runs (4 settings on 2 "
      "instances) are 2,000,008 runs, more than the limit of 1,000,000 runs"),
@@ -205,13 +205,13 @@ def test_a_tune_of_more_runs_than_it_may_make_is_refused(changes, message):
 
 
 def test_max_runs_sets_the_limit_of_a_tune(tmp_path, capsys):
-    assert tune_spec_from_dict(tune_document(), max_runs=68).budget == 60
-    with pytest.raises(TuneSpecError, match="are 68 runs, more than the limit of 67 runs"):
-        tune_spec_from_dict(tune_document(), max_runs=67)
+    assert tune_spec_from_dict(tune_document(), max_runs=80).budget == 72
+    with pytest.raises(TuneSpecError, match="are 80 runs, more than the limit of 79 runs"):
+        tune_spec_from_dict(tune_document(), max_runs=79)
     spec = tmp_path / "t.toml"
     spec.write_text(toml(tune_document()))
-    assert "are 68 runs, more than the limit of 67 runs" in exit_message(
-        ["tune", str(spec), "--max-runs", "67", "--out", str(tmp_path / "out")], capsys)
+    assert "are 80 runs, more than the limit of 79 runs" in exit_message(
+        ["tune", str(spec), "--max-runs", "79", "--out", str(tmp_path / "out")], capsys)
     assert not (tmp_path / "out").exists()
 
 
@@ -254,13 +254,16 @@ def test_a_sweep_says_after_its_first_chunk_how_long_the_rest_takes():
 # Messages --------------------------------------------------------------------------------------
 
 def test_a_budget_too_small_to_race_is_refused_naming_the_smallest():
-    """Two free params: irace's 3 iterations; the first must race two settings over
-    first_test = 3 instances and one more: 3 x 2 x 4 = 24 runs."""
+    """Two free params: irace's least, (N_min + 1) N_iter T with N_min = N_iter = 3 and T =
+    first_test + 1 + (N_iter - 1) new instances = 3 + 1 + 2: 4 x 3 x 6 = 72 runs."""
     with pytest.raises(TuneSpecError) as error:
-        tune_spec_from_dict(tune_document(tune={"budget": 23}), source="t.toml")
-    assert ("t.toml: tune.budget: a budget of 23 runs is too small for method race: the "
-            "smallest is 24") in str(error.value)
-    assert tune_spec_from_dict(tune_document(tune={"budget": 24})).budget == 24
+        tune_spec_from_dict(tune_document(tune={"budget": 71}), source="t.toml")
+    assert ("t.toml: tune.budget: a budget of 71 runs is too small for method race: the "
+            "smallest is 72") in str(error.value)
+    assert tune_spec_from_dict(tune_document(tune={"budget": 72})).budget == 72
+    # Without elitism irace's least is (N_min + 1) N_iter (first_test + 5): 4 x 3 x 8 = 96.
+    with pytest.raises(TuneSpecError, match="the smallest is 96"):
+        tune_spec_from_dict(tune_document(tune={"race": {"first_test": 3, "elitist": False}}))
 
 
 @pytest.mark.parametrize("method, budget, least", [("es", 23, 24), ("random", 1, 2)])

@@ -21,6 +21,7 @@ from jaxswarm.tune import TuneSpecError, load_tune_spec, tune, tune_spec_from_di
 from jaxswarm.tune.evaluate import Setting
 from jaxswarm.tune.race import iterated_race
 from jaxswarm.tune.search import es_search, grid_search, random_search
+from jaxswarm.tune.spec import smallest_budget
 from jaxswarm.tune.space import Choice, Integer, Real, Space, Tied, from_unit, to_unit
 from jaxswarm.tune.tuner import baseline_values, default_values
 
@@ -34,7 +35,7 @@ def document(**changes):
     Every call of its runs holds at most 5 (at most 5 settings race on an instance, 2 are held
     out), so it is padded to a quarter of the chunk of 20: 5 runs, the chunk of test_sweep.py's
     sweeps, whose compiled program the two files share."""
-    tune_table = {"name": "tiny", "algorithm": "rfd_star", "method": "race", "budget": 60,
+    tune_table = {"name": "tiny", "algorithm": "rfd_star", "method": "race", "budget": 72,
                   "objective": "gap", "iterations": sizes.ITERATIONS, "seed": 3,
                   "chunk_size": 20,
                   "training": {"maps": ["maze20", "mosaic20"], "seeds": 6},
@@ -191,7 +192,7 @@ def test_the_es_gradient_points_downhill_from_centred_ranks():
 
 
 def test_a_baseline_is_where_the_search_starts_and_what_the_best_is_judged_beside(tmp_path):
-    spec = tune_spec_from_dict(document(tune={"baseline": {"alpha": 2.0}, "budget": 30}))
+    spec = tune_spec_from_dict(document(tune={"baseline": {"alpha": 2.0}, "budget": 72}))
     p_base = float(make("rfd_star").default_params.p_base)
     assert baseline_values(spec) == {"alpha": 2.0, "erosion": 2.0,
                                      "p_base": pytest.approx(p_base)}
@@ -371,10 +372,14 @@ def test_the_calibration_script_writes_its_tables(tmp_path, monkeypatch):
     comparison = pd.read_csv(out / "comparison.csv")
     assert len(comparison) == 2 * 3
     assert (comparison["runs"] <= comparison["budget"]).all()
-    for _, rows in comparison.groupby("algorithm"):  # each spec's own grid sets its budgets
+    specs = {"iwd": "tunes/quick/iwd.toml", "aco_star": "tunes/quick/aco_star.toml"}
+    for algorithm, rows in comparison.groupby("algorithm"):  # each spec's grid sets the budgets
+        spec = load_tune_spec(specs[algorithm])
         budget = rows.set_index("method")["budget"]
         grid_runs = rows.loc[rows["method"] == "grid", "runs"].min()
-        assert budget["grid"] == 3 * 60 and budget["random"] == budget["race"] == grid_runs // 3
+        assert budget["grid"] == 3 * spec.budget and budget["random"] == grid_runs // 3
+        # the race gets a third of the grid's runs, or irace's least where a third falls short
+        assert budget["race"] == max(grid_runs // 3, smallest_budget(spec))
     assert "near_grid" in (out / "comparison.md").read_text()
     for name in ("table.md", "comparison.md", "provenance.json", "iwd/race.png",
                  "aco_star/best.json"):

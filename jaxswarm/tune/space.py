@@ -11,7 +11,9 @@ A setting is a dict ``name -> value`` over every param of the space. Domains:
 Draws are keyed (NumPy generators seeded from the tuner's key), so a resumed tune draws the
 same settings. The unit cube ``[0, 1]^d`` of the free params (log-scaled where ``log``) is the
 space the grid, the evolution strategies and irace's normal draws work in
-(:func:`to_unit`, :func:`from_unit`).
+(:func:`to_unit`, :func:`from_unit`). Draws of an integer take its values as cells of equal width,
+``[v, v + 1)`` for each ``v`` of ``[low, high]``, as irace draws them (:func:`cell_unit`,
+:func:`from_cell_unit`), so that the ends of its range come up as often as the inner values.
 """
 from __future__ import annotations
 
@@ -100,7 +102,8 @@ class Space:
         return setting
 
     def uniform(self, rng: np.random.Generator, count: int) -> list[dict]:
-        """``count`` settings drawn uniformly (log-uniformly on log scales)."""
+        """``count`` settings drawn uniformly (log-uniformly on log scales; every value of an
+        integer range equally often, :func:`from_cell_unit`)."""
         settings = []
         for _ in range(count):
             free = {}
@@ -109,7 +112,7 @@ class Space:
                 if isinstance(domain, Choice):
                     free[name] = domain.values[rng.integers(len(domain.values))]
                 else:
-                    free[name] = from_unit(domain, rng.random())
+                    free[name] = from_cell_unit(domain, rng.random())
             settings.append(self.complete(free))
         return settings
 
@@ -179,3 +182,34 @@ def from_unit(domain: Real | Integer, unit: float) -> float:
     value = min(max(value, low), high)
     return int(round(value)) if isinstance(domain, Integer) else value
 
+
+def cell_unit(domain: Real | Integer, value: float) -> float:
+    """``value`` of a numeric domain as a point of ``[0, 1]`` on the scale draws use: a real's
+    :func:`to_unit`; an integer ``v`` as the middle of its cell ``[v, v + 1)`` of the interval
+    ``[low, high + 1)`` (on its log scale when ``log``)."""
+    if isinstance(domain, Real):
+        return to_unit(domain, value)
+    return _cells(domain, float(value) + 0.5)
+
+
+def from_cell_unit(domain: Real | Integer, unit: float) -> float:
+    """The value of a numeric domain at ``unit`` (in ``[0, 1]``, clipped) on the scale draws use:
+    a real's :func:`from_unit`; for an integer the cell of ``[low, high + 1)`` it falls in (the
+    last cell at 1), so a uniform ``unit`` draws every integer equally often."""
+    if isinstance(domain, Real):
+        return from_unit(domain, unit)
+    unit = min(max(float(unit), 0.0), 1.0)
+    low, top = float(domain.low), float(domain.high + 1)
+    if domain.log:
+        value = math.exp(math.log(low) + unit * (math.log(top) - math.log(low)))
+    else:
+        value = low + unit * (top - low)
+    return int(min(math.floor(value), domain.high))
+
+
+def _cells(domain: Integer, value: float) -> float:
+    """``value`` as a point of ``[0, 1]`` over the integer's ``[low, high + 1)``."""
+    low, top = float(domain.low), float(domain.high + 1)
+    if domain.log:
+        return (math.log(value) - math.log(low)) / (math.log(top) - math.log(low))
+    return (value - low) / (top - low)

@@ -5,7 +5,8 @@ Its tables: ``[tune]`` (``name``, ``algorithm``, ``method`` of :data:`METHODS`, 
 ``objective`` of :data:`OBJECTIVES`, ``iterations``, ``patience``, ``seed``, ``chunk_size``,
 ``grid_points``, ``es_pairs``, ``es_sigma``, ``es_learning_rate``, ``unsolved_gap``),
 ``[tune.training]`` and ``[tune.held_out]`` (``maps``, ``seeds``), ``[tune.race]``
-(``first_test``, ``alpha``), ``[tune.baseline]``, ``[config]`` (the swarm factory's static
+(``first_test``, ``alpha``, ``elitist``, ``new_instances``, ``elitist_limit``, ``soft_restart``,
+``spend_remaining``), ``[tune.baseline]``, ``[config]`` (the swarm factory's static
 options) and ``[params]`` (traced; a domain ``{ low, high }`` with ``log`` or ``integer``,
 ``{ choices }``, ``{ tied }``, or a number). ``docs/tuning.md`` shows a spec and what each key
 means. :func:`load_tune_spec` reads a file, :func:`tune_spec_from_dict` a parsed one; every
@@ -38,7 +39,8 @@ OBJECTIVES = ("success", "gap", "time_to_target", "evaluations")
 TUNE_KEYS = {"name", "algorithm", "method", "budget", "objective", "iterations", "patience",
              "seed", "chunk_size", "training", "held_out", "race", "grid_points", "es_pairs",
              "es_sigma", "es_learning_rate", "unsolved_gap", "baseline"}
-RACE_KEYS = {"first_test", "alpha"}
+RACE_KEYS = {"first_test", "alpha", "elitist", "new_instances", "elitist_limit", "soft_restart",
+             "spend_remaining"}
 INSTANCE_KEYS = {"maps", "seeds"}
 DOMAIN_KEYS = {"low", "high", "log", "integer", "choices", "tied"}
 
@@ -88,6 +90,11 @@ class TuneSpec:
     space: Space
     first_test: int = 5
     alpha: float = 0.05
+    elitist: bool = True
+    new_instances: int = 1
+    elitist_limit: int = 2
+    soft_restart: bool = True
+    spend_remaining: bool = True
     grid_points: int | None = None
     es_pairs: int = 4
     es_sigma: float = 0.1
@@ -157,7 +164,7 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>",
     space = Space({**domains, **static})
     if not space.free:
         fail("[params]", "nothing to tune: give at least one range or choice")
-    first_test, alpha = _race_keys(tune.get("race", {}), method, training, fail)
+    race = _race_keys(tune.get("race", {}), method, training, fail)
     patience = tune.get("patience")
     spec = TuneSpec(
         name=name, algorithm=algorithm, method=method,
@@ -168,7 +175,7 @@ def tune_spec_from_dict(document: dict, *, source: str = "<dict>",
         chunk_size=positive_int(tune.get("chunk_size", DEFAULT_CHUNK_SIZE), "tune.chunk_size",
                                 fail),
         training=training, held_out=held_out, config=config, fixed=fixed, space=space,
-        first_test=first_test, alpha=alpha,
+        **race,
         grid_points=(None if "grid_points" not in tune
                      else positive_int(tune["grid_points"], "tune.grid_points", fail)),
         es_pairs=positive_int(tune.get("es_pairs", 4), "tune.es_pairs", fail),
@@ -191,13 +198,24 @@ def race_iterations(free: int) -> int:
 def smallest_budget(spec: TuneSpec) -> int:
     """The least budget with which ``spec``'s method searches at all.
 
-    race: the first iteration (a ``1 / N_iter`` share of the budget) races the baseline and one
-    drawn setting, each at ``first_test + 1`` runs (:mod:`jaxswarm.tune.race`); es: one step,
-    ``2 es_pairs first_test`` runs; random: the baseline and one drawn setting; grid: every
-    setting of its grid once (at ``grid_points``, else at 2 points per param).
+    race: irace's least (``computeMinimumBudget``), ``(N_min + 1) N_iter T`` with ``N_min =
+    N_iter = floor(2 + log2 d)``: every iteration races one setting more than it keeps over
+    ``T`` instances, ``first_test + 1`` and ``max(1, new_instances)`` more for each later
+    iteration (past the fifth irace adds ``new_instances`` alone), or ``first_test + 5``
+    without elitism; es: one step, ``2 es_pairs first_test`` runs; random: the baseline and one
+    drawn setting; grid: every setting of its grid once (at ``grid_points``, else at 2 points
+    per param).
     """
     if spec.method == "race":
-        return race_iterations(len(spec.space.free)) * 2 * (spec.first_test + 1)
+        iterations = race_iterations(len(spec.space.free))
+        new = max(1, spec.new_instances)
+        if not spec.elitist:
+            per_race = spec.first_test + 5
+        elif iterations <= 5:
+            per_race = spec.first_test + 1 + (iterations - 1) * new
+        else:
+            per_race = spec.first_test + 1 + (iterations - 5) * spec.new_instances + 5 * new
+        return (iterations + 1) * iterations * per_race
     if spec.method == "es":
         return 2 * spec.es_pairs * spec.first_test
     if spec.method == "random":
@@ -228,9 +246,10 @@ def _check_runs(spec: TuneSpec, fail, max_runs: int | None) -> None:
 def _why_least(spec: TuneSpec) -> str:
     """Why :func:`smallest_budget` is what it is for ``spec``'s method, in a few words."""
     if spec.method == "race":
-        return (f"{race_iterations(len(spec.space.free))} iterations, the first racing the "
-                f"baseline and one drawn setting at first_test + 1 = {spec.first_test + 1} runs "
-                "each")
+        iterations = race_iterations(len(spec.space.free))
+        return (f"irace's least: {iterations} iterations, each racing {iterations + 1} settings "
+                f"on at least first_test + 1 = {spec.first_test + 1} instances and the "
+                "instances the iterations before it added")
     if spec.method == "es":
         return (f"one step: {spec.es_pairs} antithetic pairs on first_test = {spec.first_test} "
                 "instances")
@@ -248,10 +267,12 @@ def _table(value: Any, key: str, allowed: set, fail) -> dict:
     return value
 
 
-def _race_keys(table: Any, method: str, training: Instances, fail) -> tuple[int, float]:
-    """``(first_test, alpha)`` of the ``[tune.race]`` table: the instances before the first test,
-    at least 2 (the tests compare settings on two instances or more) and, for a race, at most
-    the training instances; the tests' level, in (0, 1)."""
+def _race_keys(table: Any, method: str, training: Instances, fail) -> dict:
+    """The ``[tune.race]`` table's settings (irace's defaults where absent): ``first_test``, the
+    instances before the first test, at least 2 (the tests compare settings on two instances or
+    more) and, for a race, at most the training instances; ``alpha``, the tests' level, in
+    (0, 1); ``elitist``, ``new_instances`` (a natural number), ``elitist_limit`` (a natural
+    number, 0 for none), ``soft_restart`` and ``spend_remaining`` (see :mod:`.race`)."""
     race = _table(table, "tune.race", RACE_KEYS, fail)
     alpha = race.get("alpha", 0.05)
     if not is_number(alpha) or not 0 < alpha < 1:
@@ -263,7 +284,16 @@ def _race_keys(table: Any, method: str, training: Instances, fail) -> tuple[int,
     if method == "race" and first_test > len(training.pairs):
         fail("tune.race.first_test", f"{first_test} is more than the {len(training.pairs)} "
              "training instances: no test would ever drop a setting")
-    return first_test, float(alpha)
+    switches = {}
+    for key in ("elitist", "soft_restart", "spend_remaining"):
+        switches[key] = race.get(key, True)
+        if not isinstance(switches[key], bool):
+            fail(f"tune.race.{key}", f"must be true or false, got {switches[key]!r}")
+    return dict(first_test=first_test, alpha=float(alpha), **switches,
+                new_instances=_natural(race.get("new_instances", 1), "tune.race.new_instances",
+                                       fail),
+                elitist_limit=_natural(race.get("elitist_limit", 2), "tune.race.elitist_limit",
+                                       fail))
 
 
 def _one_of(value: Any, allowed: tuple, key: str, fail) -> str:
