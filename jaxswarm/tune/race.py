@@ -311,8 +311,8 @@ def _update_models(space: Space, state: _Race, elites: list[Setting], j: int,
             model.deviation[name] *= shrink
         for name, p in model.probabilities.items():
             values = space.domains[name].values
-            p = p * (1.0 - shift) + shift * np.array([v == elite.values[name] for v in values])
-            p = p / p.sum()
+            p = _normalised(p * (1.0 - shift)
+                            + shift * np.array([v == elite.values[name] for v in values]))
             model.probabilities[name] = _normalised(np.minimum(p, cap))
         models[elite.number] = model
     state.models = models

@@ -189,7 +189,7 @@ def cell_unit(domain: Real | Integer, value: float) -> float:
     ``[low, high + 1)`` (on its log scale when ``log``)."""
     if isinstance(domain, Real):
         return to_unit(domain, value)
-    return _cells(domain, float(value) + 0.5)
+    return to_unit(_cells(domain), float(value) + 0.5)
 
 
 def from_cell_unit(domain: Real | Integer, unit: float) -> float:
@@ -198,18 +198,9 @@ def from_cell_unit(domain: Real | Integer, unit: float) -> float:
     last cell at 1), so a uniform ``unit`` draws every integer equally often."""
     if isinstance(domain, Real):
         return from_unit(domain, unit)
-    unit = min(max(float(unit), 0.0), 1.0)
-    low, top = float(domain.low), float(domain.high + 1)
-    if domain.log:
-        value = math.exp(math.log(low) + unit * (math.log(top) - math.log(low)))
-    else:
-        value = low + unit * (top - low)
-    return int(min(math.floor(value), domain.high))
+    return int(min(math.floor(from_unit(_cells(domain), unit)), domain.high))
 
 
-def _cells(domain: Integer, value: float) -> float:
-    """``value`` as a point of ``[0, 1]`` over the integer's ``[low, high + 1)``."""
-    low, top = float(domain.low), float(domain.high + 1)
-    if domain.log:
-        return (math.log(value) - math.log(low)) / (math.log(top) - math.log(low))
-    return (value - low) / (top - low)
+def _cells(domain: Integer) -> Real:
+    """The reals ``[low, high + 1)`` an integer's cells cover, on its scale."""
+    return Real(float(domain.low), float(domain.high + 1), domain.log)
